@@ -1,0 +1,48 @@
+#pragma once
+// Geometry is double throughout; Eigen's fixed-size types keep it allocation-free.
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <cmath>
+
+namespace clearway {
+
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+
+/// A rigid transform: a point p in the local frame is R·p + t in the parent frame.
+struct Pose {
+  Mat3 R = Mat3::Identity();
+  Vec3 t = Vec3::Zero();
+
+  /// The identity transform.
+  static Pose identity() { return {}; }
+  /// A pure translation.
+  static Pose translation(const Vec3& t) { Pose p; p.t = t; return p; }
+  /// From a quaternion (x, y, z, w; normalised here) and a translation.
+  static Pose fromQuaternion(double qx, double qy, double qz, double qw, const Vec3& t) {
+    Pose p;
+    p.R = Eigen::Quaterniond(qw, qx, qy, qz).normalized().toRotationMatrix();
+    p.t = t;
+    return p;
+  }
+
+  /// Maps a point from the local frame to the parent frame.
+  Vec3 operator*(const Vec3& p) const { return R * p + t; }
+  /// Composition: (this * other) maps other's local frame into this pose's parent frame.
+  Pose operator*(const Pose& o) const { Pose p; p.R = R * o.R; p.t = R * o.t + t; return p; }
+  /// The inverse transform.
+  Pose inverse() const { Pose p; p.R = R.transpose(); p.t = -(p.R * t); return p; }
+  /// True when every entry is finite.
+  bool isFinite() const { return R.allFinite() && t.allFinite(); }
+};
+
+/// The pose of frame b expressed in frame a: inverse(a) * b, computed without forming the inverse.
+inline Pose relativePose(const Pose& a, const Pose& b) {
+  Pose p;
+  p.R = a.R.transpose() * b.R;
+  p.t = a.R.transpose() * (b.t - a.t);
+  return p;
+}
+
+}  // namespace clearway

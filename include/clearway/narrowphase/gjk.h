@@ -1,0 +1,198 @@
+#pragma once
+// GJK distance and intersection on support mappings.
+// Based on: G. van den Bergen, "A Fast and Robust GJK Implementation for Collision Detection of
+// Convex Objects" (JGT 1999) and "Collision Detection in Interactive 3D Environments" (2003):
+// termination on the gap between upper bound ‖v‖ and lower bound v·w/‖v‖, on ‖v‖ under an absolute
+// tolerance scaled by the simplex, on a repeated support point, on no progress, or at the cap.
+// Sub-algorithm: signed volumes (simplex.h). Shapes are swept cores (primitives.h): GJK runs on the
+// cores and the radii are subtracted at the end, the "hybrid" approach that makes sphere and
+// capsule queries exact in one or two iterations.
+#include <clearway/narrowphase/simplex.h>
+#include <clearway/narrowphase/status.h>
+#include <clearway/shape/shape.h>
+#include <clearway/tolerances.h>
+
+namespace clearway {
+
+/// Result of a distance query. Points and normal are in the world frame (the frame of the poses).
+struct DistanceResult {
+  double distance = 0.0;     ///< upper bound on the distance, 0 when the shapes overlap
+  double lower_bound = 0.0;  ///< certified lower bound on the distance (GJK's v·w/‖v‖ minus the radii)
+  Vec3 point_a = Vec3::Zero();  ///< closest point on A (world)
+  Vec3 point_b = Vec3::Zero();  ///< closest point on B (world)
+  Vec3 normal = Vec3::Zero();   ///< unit, from A towards B; zero when the cores overlap
+  Status status = Status::NotConverged;
+  int iterations = 0;
+  /// True when the shapes may touch: overlap, touching, or a query that failed (never "free" by accident).
+  bool mayCollide() const noexcept { return isFailure(status) || distance <= 0.0; }
+};
+
+/// The separating axis found by the last intersection query of a pair, kept by the caller for the next one.
+struct SimplexCache {
+  Vec3 axis = Vec3::Zero();  ///< in A's local frame, so it survives when both shapes move together
+  bool valid = false;
+};
+
+/// Result of an intersection query.
+struct IntersectResult {
+  bool intersecting = true;  ///< true also when status is a failure: callers assume a collision
+  Status status = Status::NotConverged;
+  int iterations = 0;
+};
+
+namespace detail {
+
+// The absolute tolerance of GJK: below ‖v‖ ≤ tol·max‖yᵢ‖ the rounding in v exceeds v itself.
+inline double simplexScale(const Simplex& s) noexcept {
+  double m = 0.0;
+  for (int i = 0; i < s.n; ++i) m = std::max(m, s.p[i].w.squaredNorm());
+  return m;
+}
+
+inline bool inSimplex(const Simplex& s, const Vec3& w) noexcept {
+  for (int i = 0; i < s.n; ++i)
+    if (s.p[i].w == w) return true;
+  return false;
+}
+
+struct GjkCoreResult {
+  Vec3 a, b;          // witnesses on the cores, A's frame
+  double dist;        // ‖v‖: upper bound on the core distance
+  double lower;       // lower bound on the core distance
+  Status status;
+  int iterations;
+};
+
+}  // namespace detail
+
+/// Distance between the cores of a Minkowski difference, in A's frame (the building block of every query).
+/// When `final_simplex` is given it receives the last simplex (EPA starts from it).
+template <class MD>
+detail::GjkCoreResult gjkCoreDistance(const MD& md, const Tolerances& tol,
+                                      detail::Simplex* final_simplex = nullptr) noexcept {
+  using namespace detail;
+  Simplex s;
+  Vec3 dir = md.center();
+  if (!(dir.squaredNorm() > 0.0)) dir = Vec3::UnitX();
+  s.p[0] = md.support(-dir);
+  s.lambda[0] = 1.0;
+  s.n = 1;
+  Vec3 v = s.p[0].w;
+  double vv = v.squaredNorm();
+  double lower = 0.0;
+  GjkCoreResult r{s.p[0].a, s.p[0].b, std::sqrt(vv), 0.0, Status::NotConverged, 0};
+  for (int it = 1; it <= tol.gjk_max_iterations; ++it) {
+    r.iterations = it;
+    if (!(vv >= 0.0) || !std::isfinite(vv)) { r.status = Status::NotConverged; return r; }
+    if (vv <= tol.gjk_absolute * tol.gjk_absolute * simplexScale(s)) { r.status = Status::Touching; break; }
+    const SupportPoint p = md.support(-v);
+    const double vw = v.dot(p.w);
+    if (vw > 0.0) lower = std::max(lower, vw / std::sqrt(vv));
+    // ‖v‖ − v·w/‖v‖ ≤ ε‖v‖, multiplied through by ‖v‖ to avoid a square root.
+    if (vv - vw <= tol.gjk_relative * vv) { r.status = Status::Converged; break; }
+    if (inSimplex(s, p.w)) { r.status = Status::RepeatedSupport; break; }
+    s.p[s.n++] = p;
+    const Simplex before = s;
+    const Vec3 v_next = reduceSimplex(s);
+    const double vv_next = v_next.squaredNorm();
+    if (s.n == 4) { v = v_next; vv = 0.0; r.status = Status::Overlapping; break; }
+    // ‖v‖ must strictly decrease in exact arithmetic; when rounding stops that, the previous simplex is
+    // the best answer there is.
+    if (!(vv_next < vv)) { s = before; s.n = before.n - 1; r.status = Status::NoProgress; break; }
+    v = v_next;
+    vv = vv_next;
+  }
+  if (r.status == Status::NotConverged) return r;  // cap reached: no certificate
+  if (final_simplex) *final_simplex = s;
+  simplexWitnesses(s, r.a, r.b);
+  r.dist = r.status == Status::Overlapping ? 0.0 : std::sqrt(vv);
+  r.lower = r.status == Status::Overlapping || r.status == Status::Touching ? 0.0 : std::min(lower, r.dist);
+  return r;
+}
+
+/// Distance between two posed convex shapes given as concrete types (the fast path for hot loops).
+template <class A, class B>
+DistanceResult gjkDistance(const A& a, const Pose& pose_a, const B& b, const Pose& pose_b,
+                           const Tolerances& tol = {}) noexcept {
+  const MinkowskiDifference<A, B> md{a, b, relativePose(pose_a, pose_b)};
+  const detail::GjkCoreResult c = gjkCoreDistance(md, tol);
+  DistanceResult r;
+  r.status = c.status;
+  r.iterations = c.iterations;
+  if (isFailure(c.status)) return r;
+  const double ra = a.radius(), rb = b.radius();
+  Vec3 n = c.b - c.a;
+  const double len = n.norm();
+  n = len > 0.0 ? Vec3(n / len) : Vec3::Zero();
+  // The witnesses move out of the cores by each radius along the normal; inside the skins they cross.
+  r.point_a = pose_a * (c.a + ra * n);
+  r.point_b = pose_a * (c.b - rb * n);
+  r.normal = pose_a.R * n;
+  r.distance = std::max(0.0, c.dist - ra - rb);
+  r.lower_bound = std::max(0.0, c.lower - ra - rb);
+  if (c.dist < ra + rb && c.status != Status::Overlapping) r.status = Status::Overlapping;
+  return r;
+}
+
+/// Boolean intersection that stops at the first separating axis; the axis goes back into `cache`
+/// and starts the next query of the same pair, so smoothly moving pairs take about one iteration.
+/// Shapes within a band of gjk_absolute·(their size) of touching count as intersecting.
+template <class A, class B>
+IntersectResult gjkIntersect(const A& a, const Pose& pose_a, const B& b, const Pose& pose_b,
+                             const Tolerances& tol, SimplexCache& cache) noexcept {
+  using namespace detail;
+  const MinkowskiDifference<A, B> md{a, b, relativePose(pose_a, pose_b)};
+  const double rsum = md.radius();
+  Vec3 v = cache.valid ? cache.axis : md.center();
+  if (!(v.squaredNorm() > 0.0)) v = Vec3::UnitX();
+  Simplex s;
+  double vv = v.squaredNorm();
+  double lower = -INFINITY;
+  IntersectResult r;
+  for (int it = 1; it <= tol.gjk_max_iterations; ++it) {
+    r.iterations = it;
+    const SupportPoint p = md.support(-v);
+    const double vlen = std::sqrt(vv);
+    // The band keeps exactly touching shapes (rounding either way) on the colliding side.
+    const double band = tol.gjk_absolute * (std::sqrt(std::max(simplexScale(s), p.w.squaredNorm())) + rsum);
+    const double vw = v.dot(p.w);
+    if (vw > (rsum + band) * vlen) {
+      cache.axis = v;
+      cache.valid = true;
+      r.intersecting = false;
+      r.status = Status::Separated;
+      return r;
+    }
+    lower = std::max(lower, vw / vlen);
+    if (s.n > 0 && (inSimplex(s, p.w) || vv - vw <= tol.gjk_relative * vv)) {
+      // The distance is known to rounding (or to the tolerance) and is not above the band: decide
+      // by the certified lower bound, colliding when in doubt.
+      r.intersecting = !(lower > rsum + band);
+      r.status = inSimplex(s, p.w) ? Status::RepeatedSupport : Status::Converged;
+      if (!r.intersecting) { cache.axis = v; cache.valid = true; }
+      return r;
+    }
+    s.p[s.n++] = p;
+    const Vec3 v_next = reduceSimplex(s);
+    const double vv_next = v_next.squaredNorm();
+    if (s.n == 4) { r.status = Status::Overlapping; return r; }
+    if (vv_next <= (rsum + band) * (rsum + band)) { r.status = Status::Touching; return r; }
+    if (!(vv_next < vv) && it > 1) { r.status = Status::NoProgress; return r; }  // intersecting, conservatively
+    if (!std::isfinite(vv_next)) { r.status = Status::NotConverged; return r; }
+    v = v_next;
+    vv = vv_next;
+  }
+  r.status = Status::NotConverged;
+  return r;
+}
+
+/// Distance between two posed shapes: witness points and normal in the world frame.
+/// A non-finite pose yields Status::InvalidInput.
+DistanceResult gjkDistance(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b,
+                           const Tolerances& tol = {}) noexcept;
+
+/// Intersection of two posed shapes with separating-axis caching (see the template above).
+IntersectResult gjkIntersect(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b,
+                             const Tolerances& tol, SimplexCache& cache) noexcept;
+
+}  // namespace clearway

@@ -1,0 +1,120 @@
+#pragma once
+// The GJK ray cast and shape cast.
+// Based on: G. van den Bergen, "Ray Casting against General Convex Objects with Application to
+// Continuous Collision Detection" (2004). GJK runs from a point x on the ray; whenever a support
+// plane separates x from the shape, the ray is clipped to that plane, x advances to the clip point
+// and the plane's normal becomes the hit normal. λ only grows and is always a certified lower
+// bound on the time of impact, which is why a capped run may still answer "hit at λ" safely.
+// A shape cast of A (translating) against B (still) is a ray cast from the origin along −velocity
+// against A − B; swept radii shift the support planes outward (the cores stay exact).
+#include <clearway/narrowphase/gjk.h>
+
+namespace clearway {
+
+/// Result of a ray or shape cast. Normal and point are in the world frame.
+struct CastResult {
+  bool hit = true;          ///< also true on failure: the caller assumes contact at t
+  double t = 0.0;           ///< time of impact (ray parameter); 0 when starting in contact
+  Vec3 normal = Vec3::Zero();  ///< unit outward normal of the still shape at the contact; zero when starting inside
+  Vec3 point = Vec3::Zero();   ///< contact point on the still shape
+  Status status = Status::NotConverged;
+  int iterations = 0;
+};
+
+/// A ray in the world frame: the points origin + t·direction, 0 ≤ t ≤ max_t.
+struct Ray {
+  Vec3 origin = Vec3::Zero();
+  Vec3 direction = Vec3::UnitX();
+  double max_t = 1.0;
+};
+
+namespace detail {
+
+// Ray from the origin along r against the swept set core(D) ⊕ ball(D.radius()), in A's frame.
+template <class MD>
+CastResult castCore(const MD& md, const Vec3& r, double max_t, const Tolerances& tol, Vec3& hit_b_core,
+                    Vec3& normal_d) noexcept {
+  CastResult out;
+  const double rsum = md.radius();
+  double lambda = 0.0;
+  Vec3 x = Vec3::Zero();
+  Vec3 n = Vec3::Zero();
+  Simplex s;  // points of core(D) with their witnesses; the working simplex is {x − p}
+  Vec3 v = x - md.center();
+  if (!(v.squaredNorm() > 0.0)) v = r.squaredNorm() > 0.0 ? Vec3(-r) : Vec3(Vec3::UnitX());
+  double lw[4] = {1.0, 0.0, 0.0, 0.0};
+  for (int it = 1; it <= tol.cast_max_iterations; ++it) {
+    out.iterations = it;
+    const double vlen = v.norm();
+    if (!std::isfinite(vlen)) { out.status = Status::NotConverged; break; }
+    const SupportPoint p = md.support(v);
+    const double vw = v.dot(x - p.w);
+    bool clipped = false;
+    if (vw > rsum * vlen) {
+      // The support plane (pushed out by the skin) separates x from the shape: clip the ray to it.
+      const double vr = v.dot(r);
+      if (!(vr < 0.0)) { out.hit = false; out.status = Status::Separated; return out; }
+      lambda -= (vw - rsum * vlen) / vr;
+      if (!(lambda <= max_t)) { out.hit = false; out.status = Status::Separated; return out; }
+      x = lambda * r;
+      n = v;
+      clipped = true;
+    }
+    if (inSimplex(s, p.w)) {
+      // Only rounding can repeat a point without a clip (exactly, ‖v‖ ≤ rsum would have ended the loop).
+      if (!clipped) { out.status = Status::RepeatedSupport; break; }
+    } else {
+      s.p[s.n++] = p;
+    }
+    Simplex y = s;
+    for (int i = 0; i < y.n; ++i) y.p[i].w = x - s.p[i].w;
+    closestWeights(y, lw);
+    compactSimplex(s, lw);
+    compactSimplex(y, lw);
+    v.setZero();
+    double scale = 0.0;
+    for (int i = 0; i < y.n; ++i) {
+      v += y.lambda[i] * y.p[i].w;
+      scale = std::max(scale, y.p[i].w.squaredNorm());
+    }
+    if (s.n == 4) { out.status = Status::Overlapping; break; }
+    const double gap = v.norm() - rsum;
+    if (gap <= tol.cast_relative * (std::sqrt(scale) + rsum)) { out.status = Status::Converged; break; }
+  }
+  out.hit = true;
+  out.t = lambda;
+  Vec3 a_core, b_core;
+  simplexWitnesses(s, a_core, b_core);
+  hit_b_core = b_core;
+  // With a skin the direction from the core to x is the exact normal; without, the last clip plane is.
+  const double vn = v.norm();
+  normal_d = rsum > 0.0 && vn > 0.0 ? Vec3(v / vn) : (n.squaredNorm() > 0.0 ? Vec3(n.normalized()) : Vec3::Zero());
+  return out;
+}
+
+}  // namespace detail
+
+/// Shape cast: A translates by t·velocity_a (world), B stays; the first t in [0, max_t] at which they touch.
+template <class A, class B>
+CastResult gjkShapeCast(const A& a, const Pose& pose_a, const Vec3& velocity_a, const B& b, const Pose& pose_b,
+                        double max_t, const Tolerances& tol = {}) noexcept {
+  const MinkowskiDifference<A, B> md{a, b, relativePose(pose_a, pose_b)};
+  const Vec3 r = -(pose_a.R.transpose() * velocity_a);
+  Vec3 b_core, n_d;
+  CastResult out = detail::castCore(md, r, max_t, tol, b_core, n_d);
+  if (!out.hit) return out;
+  // D = A − B, so D's outward normal at the hit is B's inward one.
+  const Vec3 n_b = -n_d;
+  out.normal = pose_a.R * n_b;
+  out.point = pose_a * (b_core + b.radius() * n_b);
+  return out;
+}
+
+/// Ray cast against a posed shape: the smallest t in [0, ray.max_t] with origin + t·direction in the solid.
+CastResult gjkRayCast(const Shape& shape, const Pose& pose, const Ray& ray, const Tolerances& tol = {}) noexcept;
+
+/// Shape cast of two posed shapes (see the template above); non-finite input yields Status::InvalidInput.
+CastResult gjkShapeCast(const Shape& a, const Pose& pose_a, const Vec3& velocity_a, const Shape& b,
+                        const Pose& pose_b, double max_t, const Tolerances& tol = {}) noexcept;
+
+}  // namespace clearway

@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Installs every Debian package that Clearway's build, tests, tools and benchmarks need.
+# Safe to run again; uses sudo when not root.
+set -euo pipefail
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+packages=(
+  build-essential cmake git pkg-config
+  libeigen3-dev                      # geometry
+  liburdfdom-dev libassimp-dev       # robots: URDF and meshes
+  liboctomap-dev                     # environment: OctoMap
+  libompl-dev libboost-serialization-dev libboost-filesystem-dev libboost-system-dev  # OMPL plugin
+  libyaml-cpp-dev nlohmann-json3-dev # scene files, query files
+  libgtest-dev libgmock-dev libbenchmark-dev  # tests and benchmarks
+  libfcl-dev                         # benchmarks only: FCL side by side
+  gnuplot-nox                        # benchmark plots (PNG)
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ "${#missing[@]}" -gt 0 ]; then
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+echo "install-deps: all ${#packages[@]} packages present"

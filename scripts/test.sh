@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# The test command: installs dependencies, builds with AddressSanitizer and UndefinedBehaviorSanitizer
+# (benchmarks are built too, not run), and runs every test through CTest.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/install-deps.sh
+BUILD=${BUILD:-build-test}
+cmake -S . -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCLEARWAY_SANITIZE=ON \
+  -DCLEARWAY_BUILD_TESTS=ON -DCLEARWAY_BUILD_BENCHMARKS=ON -DCLEARWAY_BUILD_TOOLS=ON
+cmake --build "$BUILD" -j2
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+ctest --test-dir "$BUILD" --output-on-failure -j2
