@@ -7,7 +7,7 @@ if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 packages=(
   build-essential cmake git pkg-config
   libeigen3-dev                      # geometry
-  liburdfdom-dev libassimp-dev       # robots: URDF and meshes
+  liburdfdom-dev libassimp-dev libtinyxml2-dev  # robots: URDF, meshes, SRDF
   liboctomap-dev                     # environment: OctoMap
   libompl-dev libboost-serialization-dev libboost-filesystem-dev libboost-system-dev  # OMPL plugin
   libyaml-cpp-dev nlohmann-json3-dev # scene files, query files

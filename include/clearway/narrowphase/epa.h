@@ -163,9 +163,12 @@ PenetrationResult epaPenetration(const A& a, const Pose& pose_a, const B& b, con
   const double ra = a.radius(), rb = b.radius();
   Vec3 ca = g.a, cb = g.b, n;
   double core_signed;
-  if (g.status != Status::Overlapping && g.status != Status::Touching && g.dist > 0.0) {
+  // The normal is normalised by the witnesses' own gap: ‖v‖ differs from ‖b − a‖ by rounding of order
+  // 2⁻⁵³·max‖y‖, which at a distance of 1e-9·max‖y‖ left the "unit" normal 1e-8 off unit length.
+  const double gap = (cb - ca).norm();
+  if (g.status != Status::Overlapping && g.status != Status::Touching && g.dist > 0.0 && gap > 0.0) {
     // Hybrid: the cores are apart, so their closest points give the contact even if the skins overlap.
-    n = (cb - ca) / g.dist;
+    n = (cb - ca) / gap;
     core_signed = g.dist;
   } else {
     const detail::EpaCoreResult e = epaCore(md, simplex, tol);

@@ -31,6 +31,7 @@ struct DistanceResult {
 struct SimplexCache {
   Vec3 axis = Vec3::Zero();  ///< in A's local frame, so it survives when both shapes move together
   bool valid = false;
+  std::int32_t hint_a = -1, hint_b = -1;  ///< where the support searches of A and B ended (hulls resume there)
 };
 
 /// Result of an intersection query.
@@ -105,7 +106,10 @@ detail::GjkCoreResult gjkCoreDistance(const MD& md, const Tolerances& tol,
   if (r.status == Status::NotConverged) return r;  // cap reached: no certificate
   if (final_simplex) *final_simplex = s;
   simplexWitnesses(s, r.a, r.b);
-  r.dist = r.status == Status::Overlapping ? 0.0 : std::sqrt(vv);
+  // Touching means ‖v‖ is below rounding: the distance is 0 (tolerances.h). Reporting ‖v‖ instead made
+  // mayCollide() false for pairs whose simplex merely passed near the origin while they overlapped deeply
+  // (a 1e-3 box overlapping a 1e3 box's corner by 1e-4 came out "free" at 1.6e-13).
+  r.dist = r.status == Status::Overlapping || r.status == Status::Touching ? 0.0 : std::sqrt(vv);
   r.lower = r.status == Status::Overlapping || r.status == Status::Touching ? 0.0 : std::min(lower, r.dist);
   return r;
 }
@@ -141,7 +145,13 @@ template <class A, class B>
 IntersectResult gjkIntersect(const A& a, const Pose& pose_a, const B& b, const Pose& pose_b,
                              const Tolerances& tol, SimplexCache& cache) noexcept {
   using namespace detail;
-  const MinkowskiDifference<A, B> md{a, b, relativePose(pose_a, pose_b)};
+  const MinkowskiDifference<A, B> md{a, b, relativePose(pose_a, pose_b), cache.hint_a, cache.hint_b};
+  // The support searches' end points go back into the cache however the query ends.
+  struct SaveHints {
+    const MinkowskiDifference<A, B>& md;
+    SimplexCache& cache;
+    ~SaveHints() { cache.hint_a = md.hint_a; cache.hint_b = md.hint_b; }
+  } save_hints{md, cache};
   const double rsum = md.radius();
   Vec3 v = cache.valid ? cache.axis : md.center();
   if (!(v.squaredNorm() > 0.0)) v = Vec3::UnitX();
@@ -173,7 +183,23 @@ IntersectResult gjkIntersect(const A& a, const Pose& pose_a, const B& b, const P
       return r;
     }
     s.p[s.n++] = p;
-    const Vec3 v_next = reduceSimplex(s);
+    Vec3 v_next = reduceSimplex(s);
+    // v is a weighted sum of points ~max‖y‖ long, so once ‖v‖ ≪ max‖y‖ its direction is off by
+    // ~2⁻⁵³·max‖y‖/‖v‖ rad and v·w/‖v‖ misses the distance by that times max‖y‖: boxes 1e-8 apart
+    // (size 1) got a negative lower bound and were called intersecting (via RepeatedSupport or
+    // NoProgress). Three points left: the closest point is the origin's projection on the triangle's
+    // plane, which its normal gives to rounding at any ‖v‖. Two: v must be orthogonal to the edge;
+    // removing the along-edge error keeps support(−v) from swinging to a far endpoint (an error across
+    // the edge only turns v inside the edge's normal cone, which leaves v·w unchanged).
+    if (s.n == 3) {
+      const Vec3 n = (s.p[1].w - s.p[0].w).cross(s.p[2].w - s.p[0].w);
+      const double nn = n.squaredNorm();
+      if (nn > 0.0) v_next = n * (n.dot(s.p[0].w) / nn);
+    } else if (s.n == 2) {
+      const Vec3 e = s.p[1].w - s.p[0].w;
+      const double ee = e.squaredNorm();
+      if (ee > 0.0) v_next -= e * (v_next.dot(e) / ee);
+    }
     const double vv_next = v_next.squaredNorm();
     if (s.n == 4) { r.status = Status::Overlapping; return r; }
     if (vv_next <= (rsum + band) * (rsum + band)) { r.status = Status::Touching; return r; }

@@ -19,6 +19,8 @@ class ConvexHull {
 
   /// A hull vertex farthest along d (local frame); exact (a brute-force scan would return the same value).
   Vec3 support(const Vec3& d) const noexcept;
+  /// The same, hill-climbing from vertex `hint` (if valid) and leaving the answer's index in it.
+  Vec3 support(const Vec3& d, std::int32_t& hint) const noexcept;
   double radius() const noexcept { return 0.0; }
   /// An interior point of the hull (the mean of its vertices).
   Vec3 center() const noexcept { return center_; }

@@ -5,6 +5,10 @@
 // dispatch per iteration.
 #include <clearway/math.h>
 
+#include <cstdint>
+#include <type_traits>
+#include <utility>
+
 namespace clearway {
 
 /// A shape seen through a pose: support and center in the pose's parent frame.
@@ -27,6 +31,22 @@ struct Margin {
   Vec3 center() const noexcept { return shape.center(); }
 };
 
+namespace detail {
+// Shapes that can resume a support search from a previous answer (ConvexHull) expose
+// support(d, hint); for the others the hint is ignored.
+template <class S, class = void>
+struct HasHintedSupport : std::false_type {};
+template <class S>
+struct HasHintedSupport<S, std::void_t<decltype(std::declval<const S&>().support(
+                               std::declval<const Vec3&>(), std::declval<std::int32_t&>()))>> : std::true_type {};
+
+template <class S>
+Vec3 supportWithHint(const S& s, const Vec3& d, std::int32_t& hint) noexcept {
+  if constexpr (HasHintedSupport<S>::value) return s.support(d, hint);
+  else return s.support(d);
+}
+}  // namespace detail
+
 /// A support point of A − B with its witnesses on A's and B's cores (all in A's frame).
 struct SupportPoint {
   Vec3 w, a, b;
@@ -39,11 +59,13 @@ struct MinkowskiDifference {
   const A& a;
   const B& b;
   Pose b_in_a;
+  // Where the last support searches of A and B ended (warm starts; a query owns its difference).
+  mutable std::int32_t hint_a = -1, hint_b = -1;
 
   /// The support point of core(A) − core(B) farthest along d (A's frame).
   SupportPoint support(const Vec3& d) const noexcept {
-    const Vec3 pa = a.support(d);
-    const Vec3 pb = b_in_a * b.support(-(b_in_a.R.transpose() * d));
+    const Vec3 pa = detail::supportWithHint(a, d, hint_a);
+    const Vec3 pb = b_in_a * detail::supportWithHint(b, -(b_in_a.R.transpose() * d), hint_b);
     return {pa - pb, pa, pb};
   }
   double radius() const noexcept { return a.radius() + b.radius(); }

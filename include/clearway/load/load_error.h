@@ -1,0 +1,38 @@
+#pragma once
+// The one exception of the load stage: bad input (a robot or mesh file) named by file, element and reason,
+// so that a user can go straight to the offending line.
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace clearway {
+
+/// Thrown when a URDF, SRDF or mesh cannot be loaded. what() is "FILE: ELEMENT: REASON"
+/// (the element part is left out when the problem concerns the whole file).
+class LoadError : public std::runtime_error {
+ public:
+  LoadError(std::string file, std::string element, std::string reason)
+      : std::runtime_error(format(file, element, reason)),
+        file_(std::move(file)),
+        element_(std::move(element)),
+        reason_(std::move(reason)) {}
+
+  /// The file at fault, as the caller named it (a URDF, SRDF or mesh path).
+  const std::string& file() const noexcept { return file_; }
+  /// The element at fault, e.g. "joint 'elbow' (line 12)"; empty when the whole file is at fault.
+  const std::string& element() const noexcept { return element_; }
+  /// What is wrong, in words.
+  const std::string& reason() const noexcept { return reason_; }
+
+  /// The "FILE: ELEMENT: REASON" form also used for load warnings.
+  static std::string format(const std::string& file, const std::string& element, const std::string& reason) {
+    std::string s = file;
+    if (!element.empty()) s += (s.empty() ? "" : ": ") + element;
+    return s + (s.empty() ? "" : ": ") + reason;
+  }
+
+ private:
+  std::string file_, element_, reason_;
+};
+
+}  // namespace clearway

@@ -1,0 +1,97 @@
+#include <clearway/kinematics/forward_kinematics.h>
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace clearway {
+namespace {
+
+// The motion of a joint in its own frame for its variables (or, for a mimic, its computed value).
+Pose jointMotion(const Joint& j, const double* v) noexcept {
+  Pose m;
+  switch (j.type) {
+    case JointType::Fixed: break;
+    case JointType::Revolute:
+    case JointType::Continuous: m.R = Eigen::AngleAxisd(v[0], j.axis).toRotationMatrix(); break;
+    case JointType::Prismatic: m.t = v[0] * j.axis; break;
+    case JointType::Planar: {
+      Vec3 u, w;
+      planarBasis(j.axis, &u, &w);
+      m.t = v[0] * u + v[1] * w;
+      m.R = Eigen::AngleAxisd(v[2], j.axis).toRotationMatrix();
+      break;
+    }
+    case JointType::Floating: {
+      m.t = Vec3(v[0], v[1], v[2]);
+      const double norm = std::sqrt(v[3] * v[3] + v[4] * v[4] + v[5] * v[5] + v[6] * v[6]);
+      // A zero quaternion (rejected by validateJointVector) gives NaN rather than a made-up rotation.
+      m.R = norm > 0.0 ? Mat3(Eigen::Quaterniond(v[6] / norm, v[3] / norm, v[4] / norm, v[5] / norm).toRotationMatrix())
+                       : Mat3::Constant(std::numeric_limits<double>::quiet_NaN());
+      break;
+    }
+  }
+  return m;
+}
+
+std::string show(double x) {
+  std::ostringstream s;
+  s.precision(17);
+  s << x;
+  return s.str();
+}
+
+}  // namespace
+
+void planarBasis(const Vec3& axis, Vec3* u, Vec3* v) noexcept {
+  // u = ŷ × n for axes away from ŷ (for n = ẑ: u = x̂), else n × ẑ; then v = n × u.
+  const Vec3 w = std::abs(axis.y()) < 0.9 ? Vec3(Vec3::UnitY().cross(axis)) : Vec3(axis.cross(Vec3::UnitZ()));
+  *u = w.normalized();
+  *v = axis.cross(*u);
+}
+
+void computeLinkPoses(const RobotModel& model, const double* q, Pose* link_poses) noexcept {
+  const std::vector<Link>& links = model.links();
+  const std::vector<Joint>& joints = model.joints();
+  link_poses[0] = Pose::identity();
+  for (std::size_t i = 1; i < links.size(); ++i) {
+    const Joint& j = joints[links[i].parent_joint];
+    const Pose frame = link_poses[j.parent_link] * j.origin;
+    if (j.type == JointType::Fixed) {
+      link_poses[i] = frame;
+    } else if (j.isMimic()) {
+      const double value = j.mimic.multiplier * q[joints[j.mimic.joint].first_variable] + j.mimic.offset;
+      link_poses[i] = frame * jointMotion(j, &value);
+    } else {
+      link_poses[i] = frame * jointMotion(j, q + j.first_variable);
+    }
+  }
+}
+
+bool validateJointVector(const RobotModel& model, const double* q, std::string* why) {
+  const std::vector<JointVariable>& vars = model.variables();
+  for (std::size_t i = 0; i < vars.size(); ++i) {
+    const JointVariable& v = vars[i];
+    if (!std::isfinite(q[i])) {
+      if (why) *why = "variable " + std::to_string(i) + " '" + v.name + "' is " + show(q[i]);
+      return false;
+    }
+    if (q[i] < v.lower - kJointLimitTolerance || q[i] > v.upper + kJointLimitTolerance) {
+      if (why)
+        *why = "variable " + std::to_string(i) + " '" + v.name + "' = " + show(q[i]) + " is outside its limits [" +
+               show(v.lower) + ", " + show(v.upper) + "]";
+      return false;
+    }
+  }
+  for (const Joint& j : model.joints()) {
+    if (j.type != JointType::Floating) continue;
+    const double* r = q + j.first_variable + 3;
+    if (!(r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3] > 0.0)) {
+      if (why) *why = "floating joint '" + j.name + "' has a zero quaternion";
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace clearway

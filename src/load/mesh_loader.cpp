@@ -1,0 +1,262 @@
+// Mesh files → TriangleMesh through assimp. Assimp reads the file and triangulates it; everything that
+// decides what the triangles *are* (node transforms, unit and up axis, scale, welding, degenerate faces)
+// is done here in double precision, so that the result does not depend on assimp's post-processing
+// choices beyond triangulation.
+#include <clearway/load/load_error.h>
+#include <clearway/load/triangle_mesh.h>
+
+#include <assimp/Importer.hpp>
+#include <assimp/config.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <system_error>
+#include <unordered_map>
+#include <vector>
+
+namespace clearway {
+namespace {
+
+// A mesh larger than this (m, largest bounding-box extent after scale) is probably in millimetres.
+constexpr double kMillimetreExtent = 10.0;
+// A triangle whose height is below this fraction of its longest edge has zero area up to rounding.
+constexpr double kDegenerateRelative = 1e-12;
+
+// An affine map x ↦ A·x + b in double precision (node transforms may scale, e.g. a COLLADA <unit>).
+struct Affine {
+  Mat3 A = Mat3::Identity();
+  Vec3 b = Vec3::Zero();
+  Affine operator*(const Affine& o) const { return {A * o.A, A * o.b + b}; }
+  Vec3 operator*(const Vec3& x) const { return A * x + b; }
+};
+
+Affine toAffine(const aiMatrix4x4& m) {
+  Affine t;
+  t.A << m.a1, m.a2, m.a3, m.b1, m.b2, m.b3, m.c1, m.c2, m.c3;
+  t.b << m.a4, m.b4, m.c4;
+  return t;
+}
+
+std::string lowerExtension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  if (!ext.empty() && ext[0] == '.') ext.erase(0, 1);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+std::string number(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", x);
+  return buf;
+}
+
+// Assimp turns every COLLADA scene y-up by a rotation in the root node (after the <unit> scale). The
+// rotation it uses for a Z_UP file maps (x, y, z) to (x, z, −y); seeing it tells us the file was Z_UP.
+bool isColladaZUpRotation(const Mat3& root) {
+  const double det = root.determinant();
+  if (!(det > 0.0)) return false;
+  const Mat3 rotation = root / std::cbrt(det);
+  Mat3 z_up_to_y_up;
+  z_up_to_y_up << 1, 0, 0, 0, 0, 1, 0, -1, 0;
+  return (rotation - z_up_to_y_up).cwiseAbs().maxCoeff() < 1e-9;
+}
+
+// Vertices at bit-identical positions become one (−0 and +0 are one position).
+struct PositionKey {
+  double x, y, z;
+  bool operator==(const PositionKey& o) const { return x == o.x && y == o.y && z == o.z; }
+};
+struct PositionHash {
+  std::size_t operator()(const PositionKey& k) const noexcept {
+    std::uint64_t h = 1469598103934665603ull;
+    for (double d : {k.x, k.y, k.z}) {
+      std::uint64_t bits;
+      std::memcpy(&bits, &d, sizeof bits);
+      h = (h ^ bits) * 1099511628211ull;
+      h ^= h >> 29;
+    }
+    return static_cast<std::size_t>(h);
+  }
+};
+
+class Merger {
+ public:
+  Merger(const aiScene& scene, const std::string& path, const Vec3& scale) : scene_(scene), path_(path), scale_(scale) {}
+
+  void addNode(const aiNode& node, const Affine& parent) {
+    const Affine world = parent * toAffine(node.mTransformation);
+    for (unsigned i = 0; i < node.mNumMeshes; ++i) addMesh(*scene_.mMeshes[node.mMeshes[i]], world);
+    for (unsigned i = 0; i < node.mNumChildren; ++i) addNode(*node.mChildren[i], world);
+  }
+
+  TriangleMesh mesh;
+  std::size_t degenerate = 0, points_and_lines = 0;
+
+ private:
+  void addMesh(const aiMesh& m, const Affine& world) {
+    // A mirroring transform turns counter-clockwise triangles clockwise; swap two corners to undo it.
+    const bool mirrored = world.A.determinant() * scale_.prod() < 0.0;
+    index_.assign(m.mNumVertices, -1);
+    for (unsigned f = 0; f < m.mNumFaces; ++f) {
+      const aiFace& face = m.mFaces[f];
+      if (face.mNumIndices != 3) {
+        ++points_and_lines;
+        continue;
+      }
+      std::array<std::int32_t, 3> t{};
+      for (int k = 0; k < 3; ++k) t[k] = vertex(m, face.mIndices[k], world);
+      if (mirrored) std::swap(t[1], t[2]);
+      if (isDegenerate(t)) {
+        ++degenerate;
+        continue;
+      }
+      mesh.triangles.push_back(t);
+    }
+  }
+
+  // The merged index of vertex i of mesh m (transformed, scaled and welded on first use).
+  std::int32_t vertex(const aiMesh& m, unsigned i, const Affine& world) {
+    if (index_[i] >= 0) return index_[i];
+    const aiVector3D& v = m.mVertices[i];
+    Vec3 p = (world * Vec3(v.x, v.y, v.z)).cwiseProduct(scale_);
+    if (!p.allFinite())
+      throw LoadError(path_, "", "vertex " + std::to_string(i) + " of mesh '" + m.mName.C_Str() +
+                                     "' has a non-finite coordinate");
+    p += Vec3::Zero();  // −0 → +0
+    const auto [it, inserted] = welded_.try_emplace(PositionKey{p.x(), p.y(), p.z()},
+                                                    static_cast<std::int32_t>(mesh.vertices.size()));
+    if (inserted) mesh.vertices.push_back(p);
+    return index_[i] = it->second;
+  }
+
+  bool isDegenerate(const std::array<std::int32_t, 3>& t) const {
+    if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) return true;
+    const Vec3& a = mesh.vertices[t[0]];
+    const Vec3& b = mesh.vertices[t[1]];
+    const Vec3& c = mesh.vertices[t[2]];
+    const double longest2 = std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()});
+    // |(b−a)×(c−a)| = longest edge · height.
+    return !((b - a).cross(c - a).norm() > kDegenerateRelative * longest2);
+  }
+
+  const aiScene& scene_;
+  const std::string& path_;
+  Vec3 scale_;
+  std::vector<std::int32_t> index_;
+  std::unordered_map<PositionKey, std::int32_t, PositionHash> welded_;
+};
+
+// Edges (as sorted vertex pairs) with the number of triangles using them: one count per open or
+// non-manifold edge.
+void countBadEdges(const TriangleMesh& mesh, std::size_t* open, std::size_t* non_manifold) {
+  std::unordered_map<std::uint64_t, int> uses;
+  uses.reserve(mesh.triangles.size() * 2);
+  for (const auto& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const auto a = static_cast<std::uint32_t>(std::min(t[k], t[(k + 1) % 3]));
+      const auto b = static_cast<std::uint32_t>(std::max(t[k], t[(k + 1) % 3]));
+      ++uses[(std::uint64_t{a} << 32) | b];
+    }
+  }
+  *open = *non_manifold = 0;
+  for (const auto& [edge, n] : uses) {
+    if (n == 1) ++*open;
+    if (n > 2) ++*non_manifold;
+  }
+}
+
+}  // namespace
+
+bool isClosed(const TriangleMesh& mesh) {
+  std::size_t open = 0, non_manifold = 0;
+  countBadEdges(mesh, &open, &non_manifold);
+  return !mesh.triangles.empty() && open == 0 && non_manifold == 0;
+}
+
+TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<std::string>* warnings) {
+  auto warn = [&](const std::string& reason) {
+    if (warnings) warnings->push_back(LoadError::format(path, "", reason));
+  };
+  if (!scale.allFinite() || (scale.array() == 0.0).any())
+    throw LoadError(path, "", "scale must be finite and non-zero in every component");
+
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw LoadError(path, "", "mesh file not found");
+  if (std::filesystem::file_size(path, ec) == 0) throw LoadError(path, "", "empty mesh: the file is empty");
+
+  const std::string ext = lowerExtension(path);
+  Assimp::Importer importer;
+  if (ext.empty() || !importer.IsExtensionSupported(ext))
+    throw LoadError(path, "", "unsupported mesh format '" + ext + "' (use STL, DAE or OBJ)");
+
+  // Only positions matter. Vertices are joined below by exact position, not by assimp's
+  // JoinIdenticalVertices: on every mesh of ../shared/robots both give the same vertices, ours in a
+  // third of the time (assimp compares every attribute through a spatial sort).
+  importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS,
+                              aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS | aiComponent_COLORS |
+                                  aiComponent_TEXCOORDS | aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS |
+                                  aiComponent_TEXTURES | aiComponent_LIGHTS | aiComponent_CAMERAS |
+                                  aiComponent_MATERIALS);
+  const aiScene* scene = importer.ReadFile(
+      path, aiProcess_Triangulate | aiProcess_RemoveComponent);
+  if (scene == nullptr || scene->mRootNode == nullptr)
+    throw LoadError(path, "", std::string("assimp cannot read it: ") + importer.GetErrorString());
+
+  Affine root;
+  if (ext == "dae" || ext == "zae") {
+    // Assimp has made the scene y-up (after the <unit> scale); turn it z-up: y → z, z → −y.
+    root.A << 1, 0, 0, 0, 0, -1, 0, 1, 0;
+    if (!isColladaZUpRotation(toAffine(scene->mRootNode->mTransformation).A))
+      warn("COLLADA <up_axis> is not Z_UP: rotated so that the file's up axis is z "
+           "(RViz and MoveIt ignore <up_axis> and show this mesh unrotated)");
+  }
+
+  Merger merger(*scene, path, scale);
+  merger.addNode(*scene->mRootNode, root);
+  TriangleMesh mesh = std::move(merger.mesh);
+
+  if (merger.points_and_lines > 0)
+    warn(std::to_string(merger.points_and_lines) + " point and line primitives ignored");
+  if (merger.degenerate > 0) warn(std::to_string(merger.degenerate) + " zero-area triangles dropped");
+  if (mesh.triangles.empty()) throw LoadError(path, "", "empty mesh: no triangles");
+
+  // Keep only vertices that some triangle uses (corners of dropped triangles may be left over).
+  std::vector<std::int32_t> remap(mesh.vertices.size(), -1);
+  std::vector<Vec3> used;
+  used.reserve(mesh.vertices.size());
+  for (auto& t : mesh.triangles) {
+    for (std::int32_t& i : t) {
+      if (remap[i] < 0) {
+        remap[i] = static_cast<std::int32_t>(used.size());
+        used.push_back(mesh.vertices[i]);
+      }
+      i = remap[i];
+    }
+  }
+  mesh.vertices = std::move(used);
+
+  std::size_t open = 0, non_manifold = 0;
+  countBadEdges(mesh, &open, &non_manifold);
+  if (open > 0 || non_manifold > 0)
+    warn("not closed (" + std::to_string(open) + " edges with one triangle, " + std::to_string(non_manifold) +
+         " with more than two): its inside is not well defined");
+
+  Vec3 lo = mesh.vertices[0], hi = mesh.vertices[0];
+  for (const Vec3& v : mesh.vertices) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  const double extent = (hi - lo).maxCoeff();
+  if (extent > kMillimetreExtent)
+    warn("largest extent is " + number(extent) + " m after scale: probably millimetres (scale=\"0.001 0.001 0.001\"?)");
+  return mesh;
+}
+
+}  // namespace clearway

@@ -1,0 +1,120 @@
+#include "load/mesh_uri.h"
+
+#include <cctype>
+#include <cstdlib>
+#include <filesystem>
+#include <system_error>
+
+namespace clearway::detail {
+namespace {
+
+namespace fs = std::filesystem;
+
+// How deep below a search path a package folder (one with a package.xml) is looked for.
+constexpr int kPackageSearchDepth = 3;
+
+bool startsWith(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
+
+std::vector<std::string> splitPathList(const char* list) {
+  std::vector<std::string> out;
+  if (list == nullptr) return out;
+  std::string item;
+  for (const char* p = list;; ++p) {
+    if (*p == ':' || *p == '\0') {
+      if (!item.empty()) out.push_back(item);
+      item.clear();
+      if (*p == '\0') break;
+    } else {
+      item += *p;
+    }
+  }
+  return out;
+}
+
+// %XX escapes of a URI path.
+std::string percentDecode(const std::string& s) {
+  std::string out;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s[i] == '%' && i + 2 < s.size() && std::isxdigit(static_cast<unsigned char>(s[i + 1])) &&
+        std::isxdigit(static_cast<unsigned char>(s[i + 2]))) {
+      out += static_cast<char>(std::stoi(s.substr(i + 1, 2), nullptr, 16));
+      i += 2;
+    } else {
+      out += s[i];
+    }
+  }
+  return out;
+}
+
+bool isDirectory(const fs::path& p) {
+  std::error_code ec;
+  return fs::is_directory(p, ec);
+}
+
+// The folder of package name under search path root, or empty.
+fs::path findPackage(const fs::path& root, const std::string& name, bool search_below) {
+  if (!isDirectory(root)) return {};
+  if (root.filename() == name) return root;
+  if (isDirectory(root / name)) return root / name;
+  if (isDirectory(root / "share" / name)) return root / "share" / name;
+  if (!search_below) return {};
+  std::error_code ec;
+  fs::recursive_directory_iterator it(root, fs::directory_options::skip_permission_denied, ec), end;
+  for (; !ec && it != end; it.increment(ec)) {
+    if (it.depth() >= kPackageSearchDepth) it.disable_recursion_pending();
+    if (!it->is_directory(ec)) continue;
+    if (it->path().filename() == name && fs::exists(it->path() / "package.xml", ec)) return it->path();
+  }
+  return {};
+}
+
+}  // namespace
+
+ResolvedUri resolveMeshUri(const std::string& uri, const std::string& urdf_dir,
+                           const std::vector<std::string>& package_paths) {
+  ResolvedUri r;
+  if (startsWith(uri, "package://")) {
+    const std::string rest = uri.substr(std::string("package://").size());
+    const std::size_t slash = rest.find('/');
+    const std::string name = rest.substr(0, slash);
+    const std::string inside = slash == std::string::npos ? "" : rest.substr(slash + 1);
+    if (name.empty() || inside.empty()) {
+      r.error = "malformed package URI (expected package://NAME/PATH)";
+      return r;
+    }
+    fs::path package;
+    for (const std::string& p : package_paths)
+      if (package.empty()) package = findPackage(p, name, true);
+    for (const std::string& p : splitPathList(std::getenv("ROS_PACKAGE_PATH")))
+      if (package.empty()) package = findPackage(p, name, true);
+    for (const std::string& p : splitPathList(std::getenv("AMENT_PREFIX_PATH")))
+      if (package.empty() && isDirectory(fs::path(p) / "share" / name)) package = fs::path(p) / "share" / name;
+    if (package.empty()) {
+      r.error = "unresolved package://" + name + ": no package '" + name +
+                "' in the search paths given, ROS_PACKAGE_PATH or AMENT_PREFIX_PATH";
+      return r;
+    }
+    r.path = (package / inside).lexically_normal().string();
+    return r;
+  }
+  if (startsWith(uri, "file://")) {
+    std::string rest = uri.substr(std::string("file://").size());
+    if (startsWith(rest, "localhost/")) rest = rest.substr(std::string("localhost").size());
+    if (!startsWith(rest, "/")) {
+      r.error = "file:// URI without an absolute path (expected file:///PATH)";
+      return r;
+    }
+    r.path = percentDecode(rest);
+    return r;
+  }
+  const std::size_t scheme = uri.find("://");
+  if (scheme != std::string::npos) {
+    r.error = "unsupported URI scheme '" + uri.substr(0, scheme) + "://' (use a path, file:// or package://)";
+    return r;
+  }
+  const fs::path p(uri);
+  r.path = (p.is_absolute() ? p : fs::path(urdf_dir) / p).lexically_normal().string();
+  return r;
+}
+
+}  // namespace clearway::detail

@@ -1,0 +1,87 @@
+#pragma once
+// Helpers for tests that read robot files: a private temporary folder to write small (often broken)
+// URDF, SRDF and mesh files into, paths to the robots in robots/ and ../shared/robots, and a check
+// that a LoadError names what it should.
+#include <clearway/load/load_error.h>
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+
+namespace clearway::test {
+
+/// A folder under the system temp folder, removed (with its content) when the object goes away.
+class TempDir {
+ public:
+  TempDir() {
+    std::random_device rd;
+    path_ = std::filesystem::temp_directory_path() /
+            ("clearway-test-" + std::to_string(::getpid()) + "-" + std::to_string(rd()));
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+
+  /// The absolute path of name inside the folder.
+  std::string path(const std::string& name) const { return (path_ / name).string(); }
+  /// Writes text (bytes as given) to name, creating folders; returns its path.
+  std::string write(const std::string& name, const std::string& text) const {
+    const std::filesystem::path p = path_ / name;
+    std::filesystem::create_directories(p.parent_path());
+    std::ofstream(p, std::ios::binary) << text;
+    return p.string();
+  }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// robots/<rel> in the source tree.
+inline std::string sourceRobot(const std::string& rel) { return std::string(CLEARWAY_SOURCE_DIR) + "/robots/" + rel; }
+
+/// ../shared/robots/<rel>, or "" when the shared data is not there.
+inline std::string sharedRobot(const std::string& rel) {
+  const std::string p = std::string(CLEARWAY_SHARED_DIR) + "/robots/" + rel;
+  return std::filesystem::exists(p) ? p : "";
+}
+
+#define CLEARWAY_SHARED_ROBOT_OR_SKIP(var, rel)                                                        \
+  const std::string var = ::clearway::test::sharedRobot(rel);                                        \
+  if (var.empty())                                                                                   \
+    GTEST_SKIP() << "shared robot data not found: " << CLEARWAY_SHARED_DIR << "/robots/" << rel       \
+                 << " (the development data next to the repository; see DATA.md)"
+
+/// A closed unit-free tetrahedron as an ASCII STL (4 outward triangles).
+inline std::string tetrahedronStl(const std::string& extra_facets = "") {
+  auto facet = [](const char* a, const char* b, const char* c) {
+    return std::string("facet normal 0 0 0\nouter loop\nvertex ") + a + "\nvertex " + b + "\nvertex " + c +
+           "\nendloop\nendfacet\n";
+  };
+  return "solid tet\n" + facet("0 0 0", "0 1 0", "1 0 0") + facet("0 0 0", "1 0 0", "0 0 1") +
+         facet("0 0 0", "0 0 1", "0 1 0") + facet("1 0 0", "0 1 0", "0 0 1") + extra_facets + "endsolid tet\n";
+}
+
+/// Runs statement, which must throw LoadError whose file() is file, whose element() contains element
+/// and whose reason() contains reason.
+#define EXPECT_LOAD_ERROR(statement, file_, element_, reason_)                                          \
+  do {                                                                                               \
+    try {                                                                                            \
+      statement;                                                                                     \
+      ADD_FAILURE() << "no LoadError from " #statement;                                              \
+    } catch (const ::clearway::LoadError& e) {                                                       \
+      EXPECT_EQ(e.file(), (file_)) << e.what();                                                      \
+      EXPECT_NE(e.element().find(element_), std::string::npos) << "element: " << e.what();           \
+      EXPECT_NE(e.reason().find(reason_), std::string::npos) << "reason: " << e.what();              \
+      EXPECT_EQ(std::string(e.what()), ::clearway::LoadError::format(e.file(), e.element(), e.reason())); \
+    }                                                                                                \
+  } while (false)
+
+}  // namespace clearway::test

@@ -1,0 +1,220 @@
+// loadRobot on bad input: each problem a user can make in a URDF, an SRDF or a mesh is a LoadError that
+// names the file, the element (with its line) and the reason.
+#include <clearway/load/robot_loader.h>
+
+#include "load/robot_files.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+using namespace clearway;
+using clearway::test::TempDir;
+
+namespace {
+
+// A two-link robot: link a, then link b on joint j; the pieces in braces are replaced per test.
+std::string twoLinks(const std::string& joint_type = "revolute", const std::string& joint_extra = "",
+                     const std::string& link_b = "") {
+  return "<robot name=\"r\">\n"
+         "  <link name=\"a\"><collision><geometry><box size=\"1 1 1\"/></geometry></collision></link>\n"
+         "  <link name=\"b\">" + link_b + "</link>\n"
+         "  <joint name=\"j\" type=\"" + joint_type + "\">\n"
+         "    <parent link=\"a\"/><child link=\"b\"/>\n"
+         "    <limit lower=\"-1\" upper=\"1\" velocity=\"1\" effort=\"1\"/>\n" + joint_extra +
+         "  </joint>\n"
+         "</robot>\n";
+}
+
+std::string meshLink(const std::string& file) {
+  return "<collision><geometry><mesh filename=\"" + file + "\"/></geometry></collision>";
+}
+
+class BadInput : public ::testing::Test {
+ protected:
+  TempDir dir;
+};
+
+}  // namespace
+
+TEST_F(BadInput, MissingUrdf) {
+  const std::string urdf = dir.path("nowhere.urdf");
+  EXPECT_LOAD_ERROR(loadRobot(urdf), urdf, "", "cannot open");
+}
+
+TEST_F(BadInput, MalformedXml) {
+  const std::string urdf = dir.write("malformed.urdf", "<robot name=\"r\">\n  <link name=\"a\">\n</robot>\n");
+  EXPECT_LOAD_ERROR(loadRobot(urdf), urdf, "line 2", "malformed XML");  // the unclosed element
+  const std::string not_robot = dir.write("not_robot.urdf", "<model name=\"r\"/>\n");
+  EXPECT_LOAD_ERROR(loadRobot(not_robot), not_robot, "", "not <robot>");
+}
+
+TEST_F(BadInput, UnknownJointType) {
+  const std::string urdf = dir.write("rotary.urdf", twoLinks("rotary"));
+  EXPECT_LOAD_ERROR(loadRobot(urdf), urdf, "joint 'j' (line 4)", "unknown joint type 'rotary'");
+  const std::string untyped = dir.write("untyped.urdf", twoLinks(""));
+  EXPECT_LOAD_ERROR(loadRobot(untyped), untyped, "joint 'j'", "unknown joint type ''");
+}
+
+TEST_F(BadInput, NanInAnOrigin) {
+  const std::string joint = dir.write("nan_joint.urdf", twoLinks("revolute", "    <origin xyz=\"0 nan 0\"/>\n"));
+  EXPECT_LOAD_ERROR(loadRobot(joint), joint, "joint 'j' <origin> (line 7)", "non-finite");
+  const std::string collision = dir.write(
+      "nan_collision.urdf",
+      twoLinks("revolute", "",
+               "<collision><origin rpy=\"0 0 inf\"/><geometry><sphere radius=\"1\"/></geometry></collision>"));
+  EXPECT_LOAD_ERROR(loadRobot(collision), collision, "link 'b' <collision> <origin> (line 3)", "non-finite");
+  const std::string huge = dir.write("huge_origin.urdf", twoLinks("revolute", "    <origin xyz=\"0 1e999 0\"/>\n"));
+  EXPECT_LOAD_ERROR(loadRobot(huge), huge, "joint 'j' <origin>", "out of the range of double");
+  const std::string malformed = dir.write("short_origin.urdf", twoLinks("revolute", "    <origin xyz=\"0 1\"/>\n"));
+  EXPECT_LOAD_ERROR(loadRobot(malformed), malformed, "joint 'j' <origin>", "expected 3 numbers");
+  const std::string limit = dir.write(
+      "nan_limit.urdf", "<robot name=\"r\"><link name=\"a\"/><link name=\"b\"/><joint name=\"j\" type=\"prismatic\">"
+                        "<parent link=\"a\"/><child link=\"b\"/><limit lower=\"nan\" upper=\"1\" velocity=\"1\" "
+                        "effort=\"1\"/></joint></robot>");
+  EXPECT_LOAD_ERROR(loadRobot(limit), limit, "joint 'j' <limit>", "non-finite");
+}
+
+TEST_F(BadInput, LoopInTheKinematicTree) {
+  // c is the child of two joints (a closed chain).
+  const std::string two_parents = dir.write("two_parents.urdf", R"(<robot name="r">
+    <link name="a"/><link name="b"/><link name="c"/>
+    <joint name="j1" type="fixed"><parent link="a"/><child link="b"/></joint>
+    <joint name="j2" type="fixed"><parent link="b"/><child link="c"/></joint>
+    <joint name="j3" type="fixed"><parent link="a"/><child link="c"/></joint>
+  </robot>)");
+  EXPECT_LOAD_ERROR(loadRobot(two_parents), two_parents, "joint 'j3' (line 5)",
+                    "loop in the kinematic tree: link 'c' is already the child of joint 'j2'");
+  // b and c form a cycle of their own, out of reach of the root (urdfdom accepts this file).
+  const std::string cycle = dir.write("cycle.urdf", R"(<robot name="r">
+    <link name="root"/><link name="b"/><link name="c"/>
+    <joint name="j2" type="fixed"><parent link="b"/><child link="c"/></joint>
+    <joint name="j3" type="fixed"><parent link="c"/><child link="b"/></joint>
+  </robot>)");
+  EXPECT_LOAD_ERROR(loadRobot(cycle), cycle, "link 'b' (line 2)", "loop in the kinematic tree");
+  // Every link has a parent.
+  const std::string ring = dir.write("ring.urdf", R"(<robot name="r">
+    <link name="b"/><link name="c"/>
+    <joint name="j2" type="fixed"><parent link="b"/><child link="c"/></joint>
+    <joint name="j3" type="fixed"><parent link="c"/><child link="b"/></joint>
+  </robot>)");
+  EXPECT_LOAD_ERROR(loadRobot(ring), ring, "", "loop in the kinematic tree");
+  const std::string self = dir.write("self.urdf", R"(<robot name="r">
+    <link name="a"/><joint name="j" type="fixed"><parent link="a"/><child link="a"/></joint>
+  </robot>)");
+  EXPECT_LOAD_ERROR(loadRobot(self), self, "joint 'j'", "loop in the kinematic tree");
+}
+
+TEST_F(BadInput, SeveralRootsAndUnknownLinks) {
+  const std::string forest = dir.write("forest.urdf", "<robot name=\"r\"><link name=\"a\"/>\n<link name=\"b\"/></robot>");
+  EXPECT_LOAD_ERROR(loadRobot(forest), forest, "link 'b' (line 2)", "a second root link");
+  const std::string unknown = dir.write("unknown_link.urdf", R"(<robot name="r"><link name="a"/>
+    <joint name="j" type="fixed"><parent link="a"/><child link="ghost"/></joint></robot>)");
+  EXPECT_LOAD_ERROR(loadRobot(unknown), unknown, "joint 'j' <child> (line 2)", "no link named 'ghost'");
+  const std::string empty = dir.write("empty.urdf", "<robot name=\"r\"/>");
+  EXPECT_LOAD_ERROR(loadRobot(empty), empty, "", "no <link>");
+}
+
+TEST_F(BadInput, InvertedLimits) {
+  const std::string urdf = dir.write(
+      "inverted.urdf", "<robot name=\"r\"><link name=\"a\"/><link name=\"b\"/>\n<joint name=\"j\" type=\"revolute\">"
+                       "<parent link=\"a\"/><child link=\"b\"/>\n<limit lower=\"1\" upper=\"-1\" velocity=\"1\" "
+                       "effort=\"1\"/></joint></robot>");
+  EXPECT_LOAD_ERROR(loadRobot(urdf), urdf, "joint 'j' <limit> (line 3)", "inverted limits: lower 1 > upper -1");
+  const std::string no_limit = dir.write(
+      "no_limit.urdf", "<robot name=\"r\"><link name=\"a\"/><link name=\"b\"/><joint name=\"j\" type=\"prismatic\">"
+                       "<parent link=\"a\"/><child link=\"b\"/></joint></robot>");
+  EXPECT_LOAD_ERROR(loadRobot(no_limit), no_limit, "joint 'j'", "needs <limit");
+}
+
+TEST_F(BadInput, Mimics) {
+  const std::string ghost = dir.write("mimic_ghost.urdf", twoLinks("revolute", "    <mimic joint=\"ghost\"/>\n"));
+  EXPECT_LOAD_ERROR(loadRobot(ghost), ghost, "joint 'j' <mimic>", "mimics 'ghost', which is not a joint");
+  const std::string cycle = dir.write("mimic_cycle.urdf", R"(<robot name="r">
+    <link name="a"/><link name="b"/><link name="c"/>
+    <joint name="j1" type="continuous"><parent link="a"/><child link="b"/><mimic joint="j2"/></joint>
+    <joint name="j2" type="continuous"><parent link="b"/><child link="c"/><mimic joint="j1"/></joint>
+  </robot>)");
+  EXPECT_LOAD_ERROR(loadRobot(cycle), cycle, "joint 'j", "mimic cycle");
+  const std::string fixed_leader = dir.write("mimic_fixed.urdf", R"(<robot name="r">
+    <link name="a"/><link name="b"/><link name="c"/>
+    <joint name="j1" type="fixed"><parent link="a"/><child link="b"/></joint>
+    <joint name="j2" type="continuous"><parent link="b"/><child link="c"/><mimic joint="j1"/></joint>
+  </robot>)");
+  EXPECT_LOAD_ERROR(loadRobot(fixed_leader), fixed_leader, "joint 'j2'", "a fixed joint (not one variable)");
+}
+
+TEST_F(BadInput, UnsupportedGeometry) {
+  const std::string urdf = dir.write("cone.urdf", twoLinks("revolute", "", "<collision><geometry><cone radius=\"1\" length=\"1\"/></geometry></collision>"));
+  EXPECT_LOAD_ERROR(loadRobot(urdf), urdf, "link 'b' <collision> <geometry> <cone> (line 3)", "unsupported geometry <cone>");
+  const std::string zero = dir.write("zero_radius.urdf", twoLinks("revolute", "", "<collision><geometry><sphere radius=\"0\"/></geometry></collision>"));
+  EXPECT_LOAD_ERROR(loadRobot(zero), zero, "<sphere>", "radius > 0");
+  const std::string none = dir.write("no_geometry.urdf", twoLinks("revolute", "", "<collision></collision>"));
+  EXPECT_LOAD_ERROR(loadRobot(none), none, "link 'b' <collision> (line 3)", "no <geometry>");
+}
+
+TEST_F(BadInput, MissingMeshFile) {
+  const std::string urdf = dir.write("missing_mesh.urdf", twoLinks("revolute", "", meshLink("meshes/missing.stl")));
+  EXPECT_LOAD_ERROR(loadRobot(urdf), urdf, "link 'b' <collision> (line 3)", "mesh file not found");
+  try {
+    loadRobot(urdf);
+  } catch (const LoadError& e) {
+    EXPECT_NE(e.reason().find(dir.path("meshes/missing.stl")), std::string::npos) << "names the resolved path: " << e.what();
+  }
+}
+
+TEST_F(BadInput, UnsupportedMeshFormat) {
+  dir.write("part.SLDPRT", "a SolidWorks part");
+  const std::string urdf = dir.write("cad.urdf", twoLinks("revolute", "", meshLink("part.SLDPRT")));
+  EXPECT_LOAD_ERROR(loadRobot(urdf), urdf, "link 'b' <collision>", "unsupported mesh format 'sldprt'");
+}
+
+TEST_F(BadInput, EmptyMesh) {
+  dir.write("empty.stl", "solid empty\nendsolid empty\n");
+  const std::string urdf = dir.write("empty_mesh.urdf", twoLinks("revolute", "", meshLink("empty.stl")));
+  EXPECT_LOAD_ERROR(loadRobot(urdf), urdf, "link 'b' <collision>", "empty mesh");
+}
+
+TEST_F(BadInput, BadMeshUris) {
+  const std::string package = dir.write("package.urdf", twoLinks("revolute", "", meshLink("package://no_such_package/m.stl")));
+  EXPECT_LOAD_ERROR(loadRobot(package), package, "link 'b' <collision>", "unresolved package://no_such_package");
+  const std::string http = dir.write("http.urdf", twoLinks("revolute", "", meshLink("http://example.com/m.stl")));
+  EXPECT_LOAD_ERROR(loadRobot(http), http, "link 'b' <collision>", "unsupported URI scheme 'http://'");
+  const std::string file = dir.write("file.urdf", twoLinks("revolute", "", meshLink("file://relative/m.stl")));
+  EXPECT_LOAD_ERROR(loadRobot(file), file, "link 'b' <collision>", "without an absolute path");
+}
+
+TEST_F(BadInput, SrdfNamingAMissingLink) {
+  const std::string urdf = dir.write("r.urdf", twoLinks());
+  const std::string srdf = dir.write("r.srdf", "<robot name=\"r\">\n"
+                                               "  <disable_collisions link1=\"a\" link2=\"b\" reason=\"Adjacent\"/>\n"
+                                               "  <disable_collisions link1=\"a\" link2=\"ghost\" reason=\"Never\"/>\n"
+                                               "</robot>\n");
+  EXPECT_LOAD_ERROR(loadRobot(urdf, srdf), srdf, "<disable_collisions> (line 3)", "link2 'ghost' is not a link of");
+}
+
+TEST_F(BadInput, BadSrdfFile) {
+  const std::string urdf = dir.write("r.urdf", twoLinks());
+  const std::string missing = dir.path("missing.srdf");
+  EXPECT_LOAD_ERROR(loadRobot(urdf, missing), missing, "", "cannot open");
+  const std::string malformed = dir.write("malformed.srdf", "<robot name=\"r\">\n<disable_collisions link1=\"a\"\n");
+  EXPECT_LOAD_ERROR(loadRobot(urdf, malformed), malformed, "line", "malformed XML");
+  const std::string half = dir.write("half.srdf", "<robot name=\"r\"><disable_collisions link1=\"a\"/></robot>");
+  EXPECT_LOAD_ERROR(loadRobot(urdf, half), half, "<disable_collisions> (line 1)", "no link2 attribute");
+}
+
+TEST_F(BadInput, SuspiciousMeshesAreWarnings) {
+  // The arm6 wrist is modelled in millimetres; without its scale it is 100 m tall. An open mesh is
+  // reported too. Both load (a warning is not an error), naming the link and the mesh.
+  dir.write("open.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const std::string urdf = dir.write(
+      "suspicious.urdf",
+      twoLinks("revolute", "",
+               meshLink(test::sourceRobot("arm6/meshes/wrist1_mm.stl")) + meshLink("open.obj")));
+  const RobotModel m = loadRobot(urdf);
+  ASSERT_EQ(m.loadWarnings().size(), 2u);
+  EXPECT_EQ(m.loadWarnings()[0].rfind(urdf + ": link 'b' <collision> (line 3): mesh '", 0), 0u) << m.loadWarnings()[0];
+  EXPECT_NE(m.loadWarnings()[0].find("probably millimetres"), std::string::npos) << m.loadWarnings()[0];
+  EXPECT_NE(m.loadWarnings()[1].find("open.obj: not closed (3 edges with one triangle"), std::string::npos)
+      << m.loadWarnings()[1];
+}
