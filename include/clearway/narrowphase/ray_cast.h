@@ -50,14 +50,16 @@ CastResult castCore(const MD& md, const Vec3& r, double max_t, const Tolerances&
     const SupportPoint p = md.support(v);
     const double vw = v.dot(x - p.w);
     bool clipped = false;
-    // x within the cast tolerance of the support plane counts as touching ("a hit when the ray point is
-    // within cast_relative·max‖yᵢ‖ of the shape", relative to its size): only a plane beyond it may clip
-    // or prove a miss. Without the margin, a ray starting on a rotated box's vertex (2e-16 outside after
-    // rounding) and pointing away was a certified miss. The size includes ‖x − centre‖: with x on a vertex
-    // the yᵢ alone are ~1e-16 long. Clips still go to the plane itself, so λ stays a lower bound.
+    // x within rounding of the support plane counts as touching: only a plane beyond that band may clip
+    // or prove a miss. Without it, a ray starting on a rotated box's vertex (2e-16 outside after
+    // rounding) and pointing away was a certified miss. The band is the rounding band of GJK
+    // (gjk_absolute relative to the size), not the cast tolerance: a band of cast_relative stopped clips
+    // early at loose tolerances and left x short of the stopping test (capped runs on cylinders). The size
+    // includes ‖x − centre‖: with x on a vertex the yᵢ alone are ~1e-16 long. Clips still go to the plane
+    // itself, so λ stays a lower bound.
     double reach = std::max((x - md.center()).squaredNorm(), (x - p.w).squaredNorm());
     for (int i = 0; i < s.n; ++i) reach = std::max(reach, (x - s.p[i].w).squaredNorm());
-    const double margin = tol.cast_relative * (std::sqrt(reach) + rsum);
+    const double margin = tol.gjk_absolute * (std::sqrt(reach) + rsum);
     if (vw > (rsum + margin) * vlen) {
       // The support plane (pushed out by the skin) separates x from the shape: clip the ray to it.
       const double vr = v.dot(r);
