@@ -16,16 +16,29 @@
 #include <vector>
 
 // Counts every allocation in this test program, so that a test can prove computeLinkPoses makes none.
+// Every unaligned form of new and delete is replaced, so that (under AddressSanitizer too) each block is
+// freed by the family that allocated it; the aligned forms stay the runtime's.
 namespace {
 std::atomic<long> g_allocations{0};
-}
-void* operator new(std::size_t n) {
+void* countedAllocation(std::size_t n) noexcept {
   ++g_allocations;
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
+  return std::malloc(n == 0 ? 1 : n);
+}
+void* countedAllocationOrThrow(std::size_t n) {
+  if (void* p = countedAllocation(n)) return p;
   throw std::bad_alloc();
 }
+}  // namespace
+void* operator new(std::size_t n) { return countedAllocationOrThrow(n); }
+void* operator new[](std::size_t n) { return countedAllocationOrThrow(n); }
+void* operator new(std::size_t n, const std::nothrow_t&) noexcept { return countedAllocation(n); }
+void* operator new[](std::size_t n, const std::nothrow_t&) noexcept { return countedAllocation(n); }
 void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
 
 using namespace clearway;
 using clearway::test::TempDir;
