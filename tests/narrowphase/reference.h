@@ -113,6 +113,7 @@ struct Mesh {
   std::vector<std::array<Vec3, 3>> tris;   ///< fan triangulation of the faces (degenerate for segments/points)
   std::vector<Vec3> tri_center;            ///< bounding sphere of each triangle, for culling only
   std::vector<double> tri_radius;
+  std::vector<std::array<Vec3, 2>> edges;  ///< every distinct side of a triangle in tris (nonzero length)
   std::vector<Vec3> plane_n;               ///< solid only: unit outward face normals
   std::vector<double> plane_d;             ///< solid only: n·x ≤ d inside
   std::vector<Vec3> axes;                  ///< unit face normals (one per direction, sign ignored)
@@ -147,6 +148,7 @@ inline Mesh meshFromFaces(const std::vector<Vec3>& verts, const std::vector<std:
   Mesh m;
   m.verts = verts;
   m.solid = solid;
+  std::vector<std::pair<int, int>> edge_ids;
   for (const Vec3& v : verts) m.center += v;
   m.center /= static_cast<double>(verts.size());
   for (const auto& f : faces) {
@@ -155,8 +157,21 @@ inline Mesh meshFromFaces(const std::vector<Vec3>& verts, const std::vector<std:
     // Newell's normal: robust for any planar loop, zero for a degenerate one.
     Vec3 n = Vec3::Zero();
     for (int i = 0; i < k; ++i) n += verts[f[i]].cross(verts[f[(i + 1) % k]]);
-    if (k == 2) m.tris.push_back({verts[f[0]], verts[f[1]], verts[f[1]]});  // a segment: a degenerate triangle
-    for (int i = 1; i + 1 < k; ++i) m.tris.push_back({verts[f[0]], verts[f[i]], verts[f[i + 1]]});
+    const auto addEdge = [&](int i, int j) {
+      if (i == j) return;
+      if (std::find(edge_ids.begin(), edge_ids.end(), std::make_pair(std::min(i, j), std::max(i, j))) == edge_ids.end())
+        edge_ids.emplace_back(std::min(i, j), std::max(i, j));
+    };
+    if (k == 2) {  // a segment: a degenerate triangle
+      m.tris.push_back({verts[f[0]], verts[f[1]], verts[f[1]]});
+      addEdge(f[0], f[1]);
+    }
+    for (int i = 1; i + 1 < k; ++i) {
+      m.tris.push_back({verts[f[0]], verts[f[i]], verts[f[i + 1]]});
+      addEdge(f[0], f[i]);
+      addEdge(f[i], f[i + 1]);
+      addEdge(f[i + 1], f[0]);
+    }
     if (k >= 3) {
       detail::addDirection(m.axes, n);
       if (solid && n.norm() > 0.0) {
@@ -171,6 +186,7 @@ inline Mesh meshFromFaces(const std::vector<Vec3>& verts, const std::vector<std:
     }
   }
   if (faces.empty()) m.tris.push_back({verts[0], verts[0], verts[0]});  // a point
+  for (const auto& [i, j] : edge_ids) m.edges.push_back({verts[i], verts[j]});
   for (const auto& t : m.tris) {
     const Vec3 c = (t[0] + t[1] + t[2]) / 3.0;
     m.tri_center.push_back(c);
@@ -261,6 +277,8 @@ inline Mesh translated(Mesh m, const Vec3& t) {
   for (Vec3& v : m.verts) v += t;
   for (auto& tri : m.tris)
     for (Vec3& v : tri) v += t;
+  for (auto& e : m.edges)
+    for (Vec3& v : e) v += t;
   for (Vec3& c : m.tri_center) c += t;
   for (std::size_t i = 0; i < m.plane_n.size(); ++i) m.plane_d[i] += m.plane_n[i].dot(t);
   m.center += t;
@@ -268,19 +286,38 @@ inline Mesh translated(Mesh m, const Vec3& t) {
   return m;
 }
 
-/// The closest pair of boundary features of two meshes (the distance when they are disjoint).
+/// The closest pair of boundary features of two meshes (the distance when they are disjoint): the minimum
+/// over triangle pairs of triangleTriangle. Evaluated without repeats: the 6 point–triangle and 9
+/// segment–segment candidates of all triangle pairs are exactly every vertex against every triangle of
+/// the other mesh, and every side against every side; shared vertices and sides are taken once.
 inline Closest featureDistance(const Mesh& a, const Mesh& b) {
   // Start from the closest vertex pair (a realised pair, so the minimum stays exact) so that the
-  // bounding-sphere test below culls from the first triangle pair on.
+  // bounding-sphere tests below cull from the first candidate on; skipping a candidate whose lower
+  // bound cannot beat the best is exact.
   Closest best;
   for (const Vec3& p : a.verts)
     for (const Vec3& q : b.verts) keepCloser(best, p, q);
-  for (std::size_t i = 0; i < a.tris.size(); ++i) {
+  const auto cannotBeat = [&](double lower) { return lower > 0.0 && lower * lower > best.dist2 * (1.0 + 1e-9); };
+  for (const Vec3& p : a.verts) {
     for (std::size_t j = 0; j < b.tris.size(); ++j) {
-      // Bounding spheres give a lower bound; skipping pairs that cannot beat the best is exact.
-      const double lb = (a.tri_center[i] - b.tri_center[j]).norm() - a.tri_radius[i] - b.tri_radius[j];
-      if (lb > 0.0 && lb * lb > best.dist2 * (1.0 + 1e-9)) continue;
-      const Closest c = triangleTriangle(a.tris[i], b.tris[j]);
+      if (cannotBeat((p - b.tri_center[j]).norm() - b.tri_radius[j])) continue;
+      const auto& t = b.tris[j];
+      keepCloser(best, p, closestOnTriangle(p, t[0], t[1], t[2]));
+    }
+  }
+  for (const Vec3& q : b.verts) {
+    for (std::size_t i = 0; i < a.tris.size(); ++i) {
+      if (cannotBeat((q - a.tri_center[i]).norm() - a.tri_radius[i])) continue;
+      const auto& t = a.tris[i];
+      keepCloser(best, closestOnTriangle(q, t[0], t[1], t[2]), q);
+    }
+  }
+  for (const auto& ea : a.edges) {
+    const Vec3 ca = 0.5 * (ea[0] + ea[1]);
+    const double ra = 0.5 * (ea[1] - ea[0]).norm();
+    for (const auto& eb : b.edges) {
+      if (cannotBeat((0.5 * (eb[0] + eb[1]) - ca).norm() - ra - 0.5 * (eb[1] - eb[0]).norm())) continue;
+      const Closest c = segmentSegment(ea[0], ea[1], eb[0], eb[1]);
       if (c.dist2 < best.dist2) best = c;
     }
   }

@@ -114,7 +114,8 @@ TEST(HardCases, NearTouchingBoxes) {
 // box's edge (A turned 45° about x so its top edge runs along x; B turned so one vertex points straight
 // down), and a segment's endpoint over another segment's interior (bare and as capsule cores). Everything
 // else of B is higher and everything else of A lower, so the distance is the vertical gap. Gaps 1e-3 …
-// 1e-9 in a tilted frame. Bound: 1e-12 + gjk_relative·gap; intersect false for every gap ≥ 1e-9.
+// 1e-9 in a tilted frame; then a triangle–segment pair found by the random tests. Bound: 1e-12 +
+// gjk_relative·gap; intersect false for every gap ≥ 1e-9.
 TEST(HardCases, NearTouchingVertexOverEdge) {
   const Shape cube = Box(Vec3(0.5, 0.5, 0.5));
   const Mat3 edge_up = rotation(M_PI / 4, Vec3::UnitX());
@@ -142,6 +143,27 @@ TEST(HardCases, NearTouchingVertexOverEdge) {
                    posed(kTilt * tilt_b, kTilt * (Vec3(0.3, 0, 0.375 + gap) - b_end)), gap, 1e-12 + 1e-6 * gap,
                    1e-9 - 1e-15);
   }
+  // Found by RandomNarrowphase.NearContactPairs: a small triangle's vertex 2.06e-9 from a long segment.
+  // GJK ended on an edge of A − B with v's along-edge rounding tilting the axis, and gjkIntersect called
+  // the pair intersecting. Reference distance from reference.h (triangle–segment, exact features).
+  const Shape tri = Triangle(Vec3(0.007729582154937284, 0.12986955404829928, -0.12424730845308646),
+                             Vec3(-0.012643136516748086, 0.076988939615152338, 0.10891322400715837),
+                             Vec3(-0.12647330868911755, 0.029200127155893301, 0.067926114537738919));
+  const Pose pt = Pose::fromQuaternion(0.81270013651119388, 0.46270724426253651, -0.29001593159805433,
+                                       0.20325170021667438,
+                                       Vec3(-1.0810956790820823, -0.36683679202637276, 1.0012622076601365));
+  const Vec3 s0(0.69305188002416462, 0.13642140277083115, 0.27619121544263647),
+      s1(-0.62875183832107384, -0.37594104111981536, 0.24573119728679302);
+  const Pose ps = Pose::fromQuaternion(
+      0.6305088824798516, 0.25048566753642665, 0.71250645052896022, -0.17902524243095363,
+      Vec3(-0.25287659314533051, -0.99844681143732317, 0.61953379342904547) +
+          Vec3(-0.83946281872894146, 0.45533192348613266, 0.18493350640369377));
+  const Triangle& t = std::get<Triangle>(tri);
+  const double exact =
+      ref::signedDistance(ref::meshFromTriangle(pt * t.v[0], pt * t.v[1], pt * t.v[2]), ref::meshFromSegment(ps * s0, ps * s1))
+          .value;
+  ASSERT_GT(exact, 1e-9);
+  expectDistance(tri, pt, Segment(s0, s1), ps, exact, 1e-12 + 1e-6 * exact, 1e-9);
 }
 
 // Face–face contact of parallel faces (B turned about the common normal), exactly parallel edge–edge
