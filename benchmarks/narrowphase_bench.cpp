@@ -424,10 +424,8 @@ void benchDistance(const Family<FA, FB>& f, const Settings& s, std::vector<Row>&
   // FCL's own GJK: gjk_tolerance is relative in its main test ((‖v‖ − v·w/‖v‖) ≤ tol·‖v‖) but also
   // absolute: ‖v‖ < tol is reported as "inside", and a support point within √tol of one of the last
   // four ends the loop.
-  auto indep = [&](double tol) {
-    fcl::detail::GJKSolver_indep<double> solver;
-    solver.gjk_tolerance = tol;
-    if (tol <= kTight) solver.gjk_max_iterations = 1000;
+  // Both FCL solvers run through the same pass; only their tolerance fields differ.
+  auto fclPass = [&](auto solver, const char* method, double tol) {
     Outputs& o = outputs.emplace_back(n);
     passes.push_back(makePass(n, [&f, &o, solver](std::size_t i) {
       const PairCase& c = f.cases[i];
@@ -440,27 +438,20 @@ void benchDistance(const Family<FA, FB>& f, const Settings& s, std::vector<Row>&
       o.failed[i] = !ok;
     }));
     Row row;
-    row.family = f.name, row.method = "fcl_indep", row.tol = tol;
+    row.family = f.name, row.method = method, row.tol = tol;
     rows.push_back(row);
+  };
+  auto indep = [&](double tol) {
+    fcl::detail::GJKSolver_indep<double> solver;
+    solver.gjk_tolerance = tol;
+    if (tol <= kTight) solver.gjk_max_iterations = 1000;
+    fclPass(solver, "fcl_indep", tol);
   };
   // libccd: distance_tolerance is absolute (metres): stop when ‖v‖ improved by less than it.
   auto libccd = [&](double tol) {
     fcl::detail::GJKSolver_libccd<double> solver;
     solver.distance_tolerance = tol;
-    Outputs& o = outputs.emplace_back(n);
-    passes.push_back(makePass(n, [&f, &o, solver](std::size_t i) {
-      const PairCase& c = f.cases[i];
-      double d = -1;
-      Vec3 p1, p2;
-      const bool ok = solver.shapeDistance(f.fa[c.ia], c.ta, f.fb[c.ib], c.tb, &d, &p1, &p2);
-      doNotOptimize(p1);
-      doNotOptimize(p2);
-      o.value[i] = d;
-      o.failed[i] = !ok;
-    }));
-    Row row;
-    row.family = f.name, row.method = "fcl_libccd", row.tol = tol;
-    rows.push_back(row);
+    fclPass(solver, "fcl_libccd", tol);
   };
 
   // The reference itself (error 0 by definition) and FCL at its tightest: the cross-check.
