@@ -1,0 +1,119 @@
+#pragma once
+// One link's collision geometry, as the self-collision and environment checks see it: the exact
+// triangles of its meshes in an AabbTree, its primitives, and the convex hull of all of it. The hull
+// contains the link, so "hulls apart" proves "links apart" in one GJK call; only when the hulls
+// overlap do the triangles decide (seeds/000: oriented AABB trees descended together, then
+// primitive–primitive tests through the narrow phase).
+//
+// A mesh is its triangles, a surface: a mesh wholly inside another mesh does not intersect it (as in
+// FCL's BVHModel), though its hull does. Primitives (boxes, spheres, ...) are solids. Closed sets
+// throughout: touching counts as intersecting.
+//
+// Every query answers in the frames of the poses given; a LinkGeometry itself is in the link frame.
+#include <clearway/kinematics/robot_model.h>
+#include <clearway/load/triangle_mesh.h>
+#include <clearway/narrowphase/gjk.h>
+#include <clearway/shape/convex_hull.h>
+#include <clearway/shape/shape.h>
+#include <clearway/tolerances.h>
+#include <clearway/tree/aabb_tree.h>
+
+#include <vector>
+
+namespace clearway {
+
+/// How two link geometries are compared.
+enum class GeometryMode {
+  Hull,  ///< convex hulls only: conservative (may report a collision the triangles do not have, never the reverse)
+  Mesh,  ///< hulls first; when they overlap, the exact triangles and primitives decide
+};
+
+/// A link's triangles (in an AabbTree), primitives and convex hull, all in the link frame. Immutable.
+class LinkGeometry {
+ public:
+  /// A primitive collision element placed in the link frame.
+  struct Primitive {
+    Shape shape;
+    Pose pose;
+  };
+
+  /// The triangles of one mesh (already in the link frame). Throws ShapeError for a mesh without
+  /// triangles, a triangle index out of range or a non-finite vertex.
+  explicit LinkGeometry(const TriangleMesh& mesh, const TreeBuildOptions& options = {});
+  /// All collision elements of a link (RobotModel::link(i).collisions): meshes index `meshes`
+  /// (RobotModel::meshes()) and are placed by each element's origin, as are primitives.
+  /// Throws ShapeError when there is no element, an element is neither mesh nor primitive, or a mesh
+  /// index, triangle index or coordinate is invalid.
+  LinkGeometry(const std::vector<CollisionElement>& elements, const std::vector<TriangleMesh>& meshes,
+               const TreeBuildOptions& options = {});
+
+  /// Every mesh triangle, link frame; tree() indexes this list.
+  const std::vector<Triangle>& triangles() const noexcept { return triangles_; }
+  /// The AabbTree over triangles() (empty when the link has primitives only).
+  const AabbTree& tree() const noexcept { return tree_; }
+  /// The primitive elements (empty for a mesh-only link).
+  const std::vector<Primitive>& primitives() const noexcept { return primitives_; }
+  /// A convex hull containing every triangle and primitive (curved primitives enter as circumscribed
+  /// polytopes, so the hull is slightly larger than their hull).
+  const ConvexHull& hull() const noexcept { return hull_; }
+  /// The box of hull() in the link frame.
+  const Aabb& bounds() const noexcept { return bounds_; }
+  /// The largest distance of a hull vertex from the link frame's origin.
+  double boundingRadius() const noexcept { return bounding_radius_; }
+  /// A ball containing the hull (the first, cheapest test): centre in the link frame, and radius.
+  const Vec3& sphereCenter() const noexcept { return sphere_center_; }
+  double sphereRadius() const noexcept { return sphere_radius_; }
+
+ private:
+  LinkGeometry(std::vector<Triangle> triangles, std::vector<Primitive> primitives, const TreeBuildOptions& options);
+
+  std::vector<Triangle> triangles_;
+  std::vector<Primitive> primitives_;
+  AabbTree tree_;
+  ConvexHull hull_;
+  Aabb bounds_;
+  double bounding_radius_ = 0.0;
+  Vec3 sphere_center_ = Vec3::Zero();
+  double sphere_radius_ = 0.0;
+};
+
+/// True when the two links are within `padding` metres of each other (padding ≥ 0; 0: touching counts).
+/// Hull: the bounding spheres, then one GJK test of the hulls. Mesh: the same, then the two triangle trees descended together
+/// (oriented boxes, SAT lite), then triangle pairs (a separating-axis test, confirmed by GJK), and
+/// primitives against triangles and primitives. `hull_cache`, if given, carries the hulls' separating
+/// axis to the next query of the same pair (keep one per link pair and thread).
+/// Pairs within the narrow phase's band (tol.gjk_absolute times the pair's size) of touching count as
+/// intersecting. Never "free" by accident: a non-finite pose or padding, or a narrow-phase query that
+/// does not converge, answers true.
+bool meshesIntersect(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                     const Tolerances& tol, GeometryMode mode, double padding = 0.0,
+                     SimplexCache* hull_cache = nullptr) noexcept;
+
+/// The same for a convex shape (an obstacle, a primitive) against a link: hull first, then (Mesh mode)
+/// the shape's box in the link frame against the triangle tree, and the link's primitives.
+bool shapeIntersectsLink(const Shape& shape, const Pose& pose_shape, const LinkGeometry& link, const Pose& pose_link,
+                         const Tolerances& tol, GeometryMode mode, double padding = 0.0,
+                         SimplexCache* hull_cache = nullptr) noexcept;
+
+/// The distance between the exact geometries of two links (triangles and primitives): the minimum over
+/// element pairs of GJK's distance, pairs pruned by their boxes' separation. `distance` is an upper
+/// bound and `lower_bound` a certified lower bound, both 0 when the links intersect; points and normal
+/// (from A to B) in the world frame (the poses' frame). With relative_error = 0 the two agree within
+/// tol.gjk_relative; a relative_error e > 0 lets the search skip pairs that cannot be closer than
+/// distance / (1 + e), so lower_bound ≥ distance / (1 + e) only (much faster: conservative advancement
+/// needs a lower bound, not the exact distance). A narrow-phase failure, a non-finite pose or a negative
+/// relative_error gives distance 0 and a failure status.
+DistanceResult meshDistance(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                            const Tolerances& tol = {}, double relative_error = 0.0) noexcept;
+
+namespace detail {
+
+/// The separating-axis test of two closed triangles given in one frame: true when one of the 17 axes
+/// (2 normals, 9 edge–edge cross products, 6 in-plane edge normals) separates them by more than `slack`
+/// metres (slack > 0 must exceed the rounding of the coordinates: then "true" is certain). Complete
+/// for non-degenerate triangles in exact arithmetic; a false "false" can come only from rounding.
+bool trianglesSeparated(const Vec3 a[3], const Vec3 b[3], double slack) noexcept;
+
+}  // namespace detail
+
+}  // namespace clearway

@@ -1,0 +1,487 @@
+// LinkGeometry: construction (triangles, tree, hull) and the link-level queries. Every query runs in
+// the frame of its first link (A): B's tree is seen through b_in_a, primitives are placed in A's frame,
+// and only the final witnesses go back to the world frame.
+//
+// Tolerance bookkeeping: a pair counts as intersecting when its distance is at most
+//   slack = padding + band,   band = max(tol.gjk_absolute, 64 ulps) · scale,
+// scale bounding every coordinate of the pair in A's frame. Box tests and the triangle SAT only
+// discard pairs certainly farther apart than slack (the band dwarfs their rounding); what they keep,
+// GJK decides within its own band, which is at most this one.
+#include <clearway/shape/link_geometry.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <utility>
+
+namespace clearway {
+namespace {
+
+// ---- Construction -----------------------------------------------------------------------------------
+
+std::vector<Triangle> meshTriangles(const TriangleMesh& mesh, const Pose& origin, std::vector<Triangle> out = {}) {
+  const auto nv = static_cast<std::int64_t>(mesh.vertices.size());
+  for (const auto& t : mesh.triangles) {
+    for (const std::int32_t i : t)
+      if (i < 0 || i >= nv)
+        throw ShapeError("link geometry: triangle index " + std::to_string(i) + " out of range (" +
+                         std::to_string(nv) + " vertices)");
+    out.emplace_back(origin * mesh.vertices[t[0]], origin * mesh.vertices[t[1]], origin * mesh.vertices[t[2]]);
+  }
+  return out;
+}
+
+// Unit directions whose hull circumscribes the unit ball once scaled by kBallScale: a Fibonacci sphere.
+constexpr double kPi = 3.14159265358979323846;
+constexpr int kBallPoints = 64;
+constexpr int kCirclePoints = 16;
+
+struct UnitBall {
+  std::vector<Vec3> points;  // scaled so that their hull contains the unit ball
+};
+
+const UnitBall& circumscribedUnitBall() {
+  static const UnitBall ball = [] {
+    UnitBall b;
+    const double golden = kPi * (3.0 - std::sqrt(5.0));
+    for (int i = 0; i < kBallPoints; ++i) {
+      const double z = 1.0 - (2.0 * i + 1.0) / kBallPoints;
+      const double r = std::sqrt(1.0 - z * z);
+      b.points.emplace_back(r * std::cos(golden * i), r * std::sin(golden * i), z);
+    }
+    // The hull's nearest face plane to the centre: scaling by its inverse pushes every face out to
+    // distance ≥ 1, and the factor 1 + 1e-9 covers the rounding of the planes.
+    const ConvexHull hull(b.points);
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const auto& t : hull.triangles()) {
+      const Vec3& p0 = hull.vertices()[t[0]];
+      const Vec3 n = (hull.vertices()[t[1]] - p0).cross(hull.vertices()[t[2]] - p0).normalized();
+      nearest = std::min(nearest, std::abs(n.dot(p0)));
+    }
+    const double scale = (1.0 + 1e-9) / nearest;
+    for (Vec3& p : b.points) p *= scale;
+    return b;
+  }();
+  return ball;
+}
+
+// Points whose hull contains the primitive placed by `pose`: its vertices when it has any, otherwise a
+// circumscribed polytope (a regular polygon outside each circle, the scaled Fibonacci sphere around
+// each sphere-swept core).
+struct HullPoints {
+  const Pose& pose;
+  std::vector<Vec3>& out;
+
+  void ball(const Vec3& c, double r) const {
+    for (const Vec3& u : circumscribedUnitBall().points) out.push_back(pose * (c + r * u));
+  }
+  void circle(double z, double r) const {
+    const double R = r / std::cos(kPi / kCirclePoints) * (1.0 + 1e-12);
+    for (int i = 0; i < kCirclePoints; ++i) {
+      const double phi = 2.0 * kPi * i / kCirclePoints;
+      out.push_back(pose * Vec3(R * std::cos(phi), R * std::sin(phi), z));
+    }
+  }
+  void operator()(const Point& s) const { out.push_back(pose * s.p); }
+  void operator()(const Segment& s) const { out.push_back(pose * s.p0); out.push_back(pose * s.p1); }
+  void operator()(const Triangle& s) const { for (const Vec3& v : s.v) out.push_back(pose * v); }
+  void operator()(const Box& s) const {
+    for (int i = 0; i < 8; ++i)
+      out.push_back(pose * Vec3((i & 1 ? 1 : -1) * s.half.x(), (i & 2 ? 1 : -1) * s.half.y(), (i & 4 ? 1 : -1) * s.half.z()));
+  }
+  void operator()(const Sphere& s) const { ball(Vec3::Zero(), s.r); }
+  void operator()(const Capsule& s) const { ball(Vec3(0, 0, -s.h), s.r); ball(Vec3(0, 0, s.h), s.r); }
+  void operator()(const Cylinder& s) const { circle(-s.h, s.r); circle(s.h, s.r); }
+  void operator()(const Cone& s) const { circle(-s.h, s.r); out.push_back(pose * Vec3(0, 0, s.h)); }
+  void operator()(const ConvexHull& s) const { for (const Vec3& v : s.vertices()) out.push_back(pose * v); }
+};
+
+std::vector<Vec3> hullPoints(const std::vector<Triangle>& triangles, const std::vector<LinkGeometry::Primitive>& prims) {
+  std::vector<Vec3> points;
+  points.reserve(3 * triangles.size());
+  for (const Triangle& t : triangles)
+    for (const Vec3& v : t.v) points.push_back(v);
+  // Each mesh vertex is a corner of about six triangles: quickhull runs twice as fast without the copies.
+  const auto less = [](const Vec3& p, const Vec3& q) {
+    return p.x() < q.x() || (p.x() == q.x() && (p.y() < q.y() || (p.y() == q.y() && p.z() < q.z())));
+  };
+  std::sort(points.begin(), points.end(), less);
+  points.erase(std::unique(points.begin(), points.end()), points.end());
+  for (const auto& p : prims) std::visit(HullPoints{p.pose, points}, p.shape);
+  if (points.empty()) throw ShapeError("link geometry: no triangles and no primitives");
+  return points;
+}
+
+std::vector<Aabb> triangleBoxes(const std::vector<Triangle>& triangles) {
+  std::vector<Aabb> boxes(triangles.size());
+  for (std::size_t i = 0; i < triangles.size(); ++i)
+    for (const Vec3& v : triangles[i].v) boxes[i].grow(v);
+  return boxes;
+}
+
+// ---- Query helpers ----------------------------------------------------------------------------------
+
+// A shape with `pad` metres of skin, keeping the hull's warm-started support search (shape/support.h's
+// Margin forwards only support(d)).
+template <class S>
+struct Padded {
+  const S& shape;
+  double pad;
+  Vec3 support(const Vec3& d) const noexcept { return shape.support(d); }
+  Vec3 support(const Vec3& d, std::int32_t& hint) const noexcept { return detail::supportWithHint(shape, d, hint); }
+  double radius() const noexcept { return shape.radius() + pad; }
+  Vec3 center() const noexcept { return shape.center(); }
+};
+
+// The tight box, in the parent frame of `pose`, of a shape placed by it (6 support queries).
+template <class S>
+Aabb shapeBox(const S& s, const Pose& pose) noexcept {
+  Aabb box;
+  const double r = s.radius();
+  for (int i = 0; i < 3; ++i) {
+    const Vec3 d = pose.R.row(i).transpose();  // the parent's axis i in the shape's frame
+    box.max[i] = (pose * s.support(d))[i] + r;
+    box.min[i] = (pose * s.support(-d))[i] - r;
+  }
+  return box;
+}
+
+struct PairBand {
+  double slack;  // padding + band: what boxes and the SAT must keep
+};
+
+PairBand pairBand(double scale, double padding, const Tolerances& tol) noexcept {
+  const double rel = std::max(tol.gjk_absolute, 64.0 * std::numeric_limits<double>::epsilon());
+  return {padding + rel * (scale + padding)};
+}
+
+// Triangle of A (A's frame) against triangle of B (B's frame, placed by b_in_a): the SAT discards
+// pairs certainly apart; GJK decides the rest (and pads).
+bool trianglePairIntersects(const Triangle& ta, const Triangle& tb, const Pose& b_in_a, const Tolerances& tol,
+                            double padding, double slack) noexcept {
+  const Vec3 vb[3] = {b_in_a * tb.v[0], b_in_a * tb.v[1], b_in_a * tb.v[2]};
+  if (detail::trianglesSeparated(ta.v, vb, slack)) return false;
+  SimplexCache cache;
+  return gjkIntersect(Padded<Triangle>{ta, padding}, Pose::identity(), tb, b_in_a, tol, cache).intersecting;
+}
+
+// A convex shape placed in the link's frame by `shape_in_link` against the link's triangles.
+template <class S>
+bool shapeIntersectsTriangles(const S& s, const Pose& shape_in_link, const LinkGeometry& link, const Tolerances& tol,
+                              double padding, double slack) noexcept {
+  if (link.triangles().empty()) return false;
+  const Aabb box = shapeBox(s, shape_in_link).inflated(slack);
+  const std::vector<Triangle>& tris = link.triangles();
+  return link.tree().query(box, [&](std::int32_t i) {
+    SimplexCache cache;
+    return gjkIntersect(Padded<S>{s, padding}, shape_in_link, tris[i], Pose::identity(), tol, cache).intersecting;
+  });
+}
+
+bool shapeIntersectsTriangles(const Shape& s, const Pose& shape_in_link, const LinkGeometry& link, const Tolerances& tol,
+                              double padding, double slack) noexcept {
+  return std::visit([&](const auto& c) { return shapeIntersectsTriangles(c, shape_in_link, link, tol, padding, slack); },
+                    s);
+}
+
+bool shapesIntersect(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, const Tolerances& tol,
+                     double padding) noexcept {
+  return std::visit(
+      [&](const auto& sa, const auto& sb) {
+        using SA = std::decay_t<decltype(sa)>;
+        SimplexCache cache;
+        return gjkIntersect(Padded<SA>{sa, padding}, pa, sb, pb, tol, cache).intersecting;
+      },
+      a, b);
+}
+
+// The exact part of a Mesh-mode test, in A's frame.
+bool exactIntersect(const LinkGeometry& a, const LinkGeometry& b, const Pose& b_in_a, const Tolerances& tol,
+                    double padding, double slack) noexcept {
+  const std::vector<Triangle>& ta = a.triangles();
+  const std::vector<Triangle>& tb = b.triangles();
+  if (!ta.empty() && !tb.empty() &&
+      forEachOverlap(a.tree(), b.tree(), b_in_a,
+                     [&](std::int32_t i, std::int32_t j) {
+                       return trianglePairIntersects(ta[i], tb[j], b_in_a, tol, padding, slack);
+                     },
+                     slack))
+    return true;
+  if (!a.primitives().empty() || !b.primitives().empty()) {
+    const Pose a_in_b = b_in_a.inverse();
+    for (const auto& p : a.primitives())
+      if (shapeIntersectsTriangles(p.shape, a_in_b * p.pose, b, tol, padding, slack)) return true;
+    for (const auto& p : b.primitives())
+      if (shapeIntersectsTriangles(p.shape, b_in_a * p.pose, a, tol, padding, slack)) return true;
+    for (const auto& p : a.primitives())
+      for (const auto& q : b.primitives())
+        if (shapesIntersect(p.shape, p.pose, q.shape, b_in_a * q.pose, tol, padding)) return true;
+  }
+  return false;
+}
+
+bool validPadding(double padding) noexcept { return padding >= 0.0 && std::isfinite(padding); }
+
+// True when the bounding spheres (centres given in one frame) are farther apart than the padding and
+// the band (of the pair's scale, as in the exact tests).
+bool spheresApart(const Vec3& ca, double ra, const Vec3& cb, double rb, double padding, const Tolerances& tol) noexcept {
+  const double reach = ra + rb + padding;
+  const double scale = ca.norm() + cb.norm() + reach;
+  const double limit = reach + std::max(tol.gjk_absolute, 64.0 * std::numeric_limits<double>::epsilon()) * scale;
+  return (ca - cb).squaredNorm() > limit * limit;
+}
+
+}  // namespace
+
+// ---- LinkGeometry -------------------------------------------------------------------------------------
+
+LinkGeometry::LinkGeometry(std::vector<Triangle> triangles, std::vector<Primitive> primitives,
+                           const TreeBuildOptions& options)
+    : triangles_(std::move(triangles)),
+      primitives_(std::move(primitives)),
+      tree_(triangleBoxes(triangles_), options),
+      hull_(hullPoints(triangles_, primitives_)) {
+  for (const Vec3& v : hull_.vertices()) {
+    bounds_.grow(v);
+    bounding_radius_ = std::max(bounding_radius_, v.norm());
+  }
+  sphere_center_ = bounds_.center();
+  for (const Vec3& v : hull_.vertices()) sphere_radius_ = std::max(sphere_radius_, (v - sphere_center_).norm());
+  // Rounding of the norms (relative) and of the centre (relative to the coordinates).
+  sphere_radius_ = sphere_radius_ * (1.0 + 1e-12) + 1e-12 * bounding_radius_;
+}
+
+LinkGeometry::LinkGeometry(const TriangleMesh& mesh, const TreeBuildOptions& options)
+    : LinkGeometry(meshTriangles(mesh, Pose::identity()), {}, options) {}  // no triangles: hullPoints throws
+
+namespace {
+std::vector<Triangle> elementTriangles(const std::vector<CollisionElement>& elements,
+                                       const std::vector<TriangleMesh>& meshes) {
+  if (elements.empty()) throw ShapeError("link geometry: no collision elements");
+  std::vector<Triangle> out;
+  for (const CollisionElement& e : elements) {
+    if (e.primitive) continue;
+    if (e.mesh < 0 || e.mesh >= static_cast<int>(meshes.size()))
+      throw ShapeError("link geometry: mesh index " + std::to_string(e.mesh) + " out of range (" +
+                       std::to_string(meshes.size()) + " meshes)");
+    if (!e.origin.isFinite()) throw ShapeError("link geometry: an element origin is not finite");
+    out = meshTriangles(meshes[e.mesh], e.origin, std::move(out));
+  }
+  return out;
+}
+
+std::vector<LinkGeometry::Primitive> elementPrimitives(const std::vector<CollisionElement>& elements) {
+  std::vector<LinkGeometry::Primitive> out;
+  for (const CollisionElement& e : elements) {
+    if (!e.primitive) continue;
+    if (!e.origin.isFinite()) throw ShapeError("link geometry: an element origin is not finite");
+    out.push_back({*e.primitive, e.origin});
+  }
+  return out;
+}
+}  // namespace
+
+LinkGeometry::LinkGeometry(const std::vector<CollisionElement>& elements, const std::vector<TriangleMesh>& meshes,
+                           const TreeBuildOptions& options)
+    : LinkGeometry(elementTriangles(elements, meshes), elementPrimitives(elements), options) {}
+
+// ---- Queries ------------------------------------------------------------------------------------------
+
+bool meshesIntersect(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                     const Tolerances& tol, GeometryMode mode, double padding, SimplexCache* hull_cache) noexcept {
+  if (!pose_a.isFinite() || !pose_b.isFinite() || !validPadding(padding)) return true;
+  // Conservative filters from cheapest to dearest: bounding spheres, the boxes of the hulls as oriented
+  // boxes (6 face axes), the hulls (GJK); then the exact geometry.
+  if (spheresApart(pose_a * a.sphereCenter(), a.sphereRadius(), pose_b * b.sphereCenter(), b.sphereRadius(), padding,
+                   tol))
+    return false;
+  const Pose b_in_a = relativePose(pose_a, pose_b);
+  const double scale = a.boundingRadius() + b.boundingRadius() + b_in_a.t.norm();
+  const double slack = pairBand(scale, padding, tol).slack;
+  if (detail::OrientedBoxTest(b_in_a, slack, scale).separated<false>(a.bounds(), b.bounds())) return false;
+  SimplexCache scratch;
+  SimplexCache& cache = hull_cache ? *hull_cache : scratch;
+  const IntersectResult hulls = gjkIntersect(Padded<ConvexHull>{a.hull(), padding}, pose_a, b.hull(), pose_b, tol, cache);
+  if (!hulls.intersecting) return false;
+  if (mode == GeometryMode::Hull) return true;
+  return exactIntersect(a, b, b_in_a, tol, padding, slack);
+}
+
+bool shapeIntersectsLink(const Shape& shape, const Pose& pose_shape, const LinkGeometry& link, const Pose& pose_link,
+                         const Tolerances& tol, GeometryMode mode, double padding, SimplexCache* hull_cache) noexcept {
+  if (!pose_shape.isFinite() || !pose_link.isFinite() || !validPadding(padding)) return true;
+  if (spheresApart(pose_shape.t, boundingRadius(shape), pose_link * link.sphereCenter(), link.sphereRadius(), padding,
+                   tol))
+    return false;
+  SimplexCache scratch;
+  SimplexCache& cache = hull_cache ? *hull_cache : scratch;
+  const bool hulls = std::visit(
+      [&](const auto& s) {
+        using S = std::decay_t<decltype(s)>;
+        return gjkIntersect(Padded<S>{s, padding}, pose_shape, link.hull(), pose_link, tol, cache).intersecting;
+      },
+      shape);
+  if (!hulls) return false;
+  if (mode == GeometryMode::Hull) return true;
+  // In the link's frame.
+  const Pose shape_in_link = relativePose(pose_link, pose_shape);
+  const double scale = link.boundingRadius() + shape_in_link.t.norm() + boundingRadius(shape);
+  const double slack = pairBand(scale, padding, tol).slack;
+  if (shapeIntersectsTriangles(shape, shape_in_link, link, tol, padding, slack)) return true;
+  for (const auto& p : link.primitives())
+    if (shapesIntersect(shape, shape_in_link, p.shape, p.pose, tol, padding)) return true;
+  return false;
+}
+
+namespace {
+
+// The running minimum of a distance query, in A's frame.
+struct DistanceMin {
+  DistanceResult best;
+  // Pairs certainly farther than this are skipped: best.distance / (1 + relative_error).
+  double cutoff = std::numeric_limits<double>::infinity();
+  double shrink = 1.0;
+  bool failed = false;
+
+  explicit DistanceMin(double relative_error) : shrink(1.0 / (1.0 + relative_error)) {
+    best.distance = std::numeric_limits<double>::infinity();
+    best.lower_bound = std::numeric_limits<double>::infinity();
+    best.status = Status::Separated;
+  }
+  // Returns true when the search can stop (an overlap, or a failure).
+  bool add(const DistanceResult& r) {
+    best.iterations += r.iterations;
+    if (isFailure(r.status)) {
+      failed = true;
+      return true;
+    }
+    best.lower_bound = std::min(best.lower_bound, r.lower_bound);
+    if (r.distance < best.distance) {
+      const int iterations = best.iterations;
+      const double lower = best.lower_bound;
+      best = r;
+      best.iterations = iterations;
+      best.lower_bound = lower;
+      cutoff = r.distance * shrink;
+    }
+    return best.distance <= 0.0;
+  }
+};
+
+// How far apart two triangles are along the unit axis u (from a's side towards b's): their projections'
+// gap, a lower bound on their distance (negative when the projections overlap).
+double projectedGap(const Vec3 a[3], const Vec3 b[3], const Vec3& u) noexcept {
+  const double a0 = u.dot(a[0]), a1 = u.dot(a[1]), a2 = u.dot(a[2]);
+  const double b0 = u.dot(b[0]), b1 = u.dot(b[1]), b2 = u.dot(b[2]);
+  return std::max(std::min({b0, b1, b2}) - std::max({a0, a1, a2}), std::min({a0, a1, a2}) - std::max({b0, b1, b2}));
+}
+
+template <class S>
+void shapeTrianglesDistance(const S& s, const Pose& shape_in_link, const LinkGeometry& link, const Tolerances& tol,
+                            DistanceMin& m, bool shape_is_a, const Pose& link_in_a) {
+  if (link.triangles().empty()) return;
+  const Aabb box = shapeBox(s, shape_in_link);
+  const std::vector<Triangle>& tris = link.triangles();
+  // The tree is in the link's frame; the results go to A's frame (identity when the shape is B's).
+  link.tree().forEachWithin(box, m.cutoff, [&](std::int32_t i) {
+    DistanceResult r = shape_is_a ? gjkDistance(s, shape_in_link, tris[i], Pose::identity(), tol)
+                                  : gjkDistance(tris[i], Pose::identity(), s, shape_in_link, tol);
+    r.point_a = link_in_a * r.point_a;
+    r.point_b = link_in_a * r.point_b;
+    r.normal = link_in_a.R * r.normal;
+    return m.add(r);
+  });
+}
+
+}  // namespace
+
+DistanceResult meshDistance(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                            const Tolerances& tol, double relative_error) noexcept {
+  if (!pose_a.isFinite() || !pose_b.isFinite() || !(relative_error >= 0.0) || !std::isfinite(relative_error)) {
+    DistanceResult r;
+    r.status = Status::InvalidInput;
+    return r;
+  }
+  const Pose b_in_a = relativePose(pose_a, pose_b);
+  DistanceMin m(relative_error);
+  const std::vector<Triangle>& ta = a.triangles();
+  const std::vector<Triangle>& tb = b.triangles();
+  bool stop = false;
+  if (!ta.empty() && !tb.empty()) {
+    // Box gaps are loose for distance (a triangle's box, turned, reaches far beyond it), so a triangle
+    // pair passing them is first projected on two axes, each gap a lower bound on its distance: the
+    // line through the centroids (tight for small triangles far apart) and the normal of the best pair
+    // so far (tight for surfaces facing each other). GJK runs only when neither reaches the cutoff.
+    const double rounding = 1e-12 * (a.boundingRadius() + b.boundingRadius() + b_in_a.t.norm());
+    stop = forEachPairWithin(a.tree(), b.tree(), b_in_a, m.cutoff, [&](std::int32_t i, std::int32_t j) {
+      if (m.cutoff < std::numeric_limits<double>::infinity()) {
+        const Vec3* va = ta[i].v;
+        const Vec3 vb[3] = {b_in_a * tb[j].v[0], b_in_a * tb[j].v[1], b_in_a * tb[j].v[2]};
+        const Vec3 u = (vb[0] + vb[1] + vb[2]) - (va[0] + va[1] + va[2]);
+        const double len = u.norm();
+        if (len > 0.0 && projectedGap(va, vb, u / len) - rounding >= m.cutoff) return false;
+        if (projectedGap(va, vb, m.best.normal) - rounding >= m.cutoff) return false;
+      }
+      return m.add(gjkDistance(ta[i], Pose::identity(), tb[j], b_in_a, tol));
+    });
+  }
+  if (!stop && (!a.primitives().empty() || !b.primitives().empty())) {
+    const Pose a_in_b = b_in_a.inverse();
+    for (const auto& p : a.primitives())
+      std::visit([&](const auto& s) { shapeTrianglesDistance(s, a_in_b * p.pose, b, tol, m, true, b_in_a); }, p.shape);
+    for (const auto& p : b.primitives())
+      std::visit([&](const auto& s) { shapeTrianglesDistance(s, b_in_a * p.pose, a, tol, m, false, Pose::identity()); },
+                 p.shape);
+    for (const auto& p : a.primitives())
+      for (const auto& q : b.primitives())
+        if (!m.failed) m.add(gjkDistance(p.shape, p.pose, q.shape, b_in_a * q.pose, tol));
+  }
+  DistanceResult r = m.best;
+  if (m.failed) {
+    r.status = Status::NotConverged;
+    r.distance = 0.0;
+    r.lower_bound = 0.0;
+    return r;
+  }
+  // Pairs skipped were at least the final cutoff apart; with a relative error, that is below the distance.
+  r.lower_bound = std::min({r.lower_bound, r.distance, m.cutoff});
+  r.point_a = pose_a * r.point_a;
+  r.point_b = pose_a * r.point_b;
+  r.normal = pose_a.R * r.normal;
+  return r;
+}
+
+// ---- Triangle–triangle separating axes ----------------------------------------------------------------
+
+namespace detail {
+
+bool trianglesSeparated(const Vec3 a[3], const Vec3 b[3], double slack) noexcept {
+  // Axes shorter than this are (near-)parallel cross products: skipping them only keeps a pair.
+  constexpr double kMinAxis2 = 1e-200;
+  const auto apart = [&](const Vec3& L) {
+    const double a0 = L.dot(a[0]), a1 = L.dot(a[1]), a2 = L.dot(a[2]);
+    const double b0 = L.dot(b[0]), b1 = L.dot(b[1]), b2 = L.dot(b[2]);
+    const double gap = std::max(std::min({b0, b1, b2}) - std::max({a0, a1, a2}),
+                                std::min({a0, a1, a2}) - std::max({b0, b1, b2}));
+    if (!(gap > 0.0)) return false;
+    const double ll = L.squaredNorm();
+    return ll > kMinAxis2 && gap * gap > slack * slack * ll;
+  };
+  const Vec3 ea[3] = {a[1] - a[0], a[2] - a[1], a[0] - a[2]};
+  const Vec3 eb[3] = {b[1] - b[0], b[2] - b[1], b[0] - b[2]};
+  const Vec3 na = ea[0].cross(ea[1]);
+  const Vec3 nb = eb[0].cross(eb[1]);
+  if (apart(na) || apart(nb)) return true;
+  for (const Vec3& e : ea)
+    for (const Vec3& f : eb)
+      if (apart(e.cross(f))) return true;
+  // Parallel planes: the Minkowski difference is flat, and its in-plane edge normals are the axes.
+  for (int i = 0; i < 3; ++i)
+    if (apart(na.cross(ea[i])) || apart(nb.cross(eb[i]))) return true;
+  return false;
+}
+
+}  // namespace detail
+
+}  // namespace clearway
