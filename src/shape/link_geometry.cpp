@@ -452,6 +452,34 @@ DistanceResult meshDistance(const LinkGeometry& a, const Pose& pose_a, const Lin
   return r;
 }
 
+DistanceResult shapeLinkDistance(const Shape& shape, const Pose& pose_shape, const LinkGeometry& link,
+                                 const Pose& pose_link, const Tolerances& tol, double relative_error) noexcept {
+  if (!pose_shape.isFinite() || !pose_link.isFinite() || !(relative_error >= 0.0) || !std::isfinite(relative_error)) {
+    DistanceResult r;
+    r.status = Status::InvalidInput;
+    return r;
+  }
+  // In the link's frame: its tree needs no transform, and the shape is A (its results need none either).
+  const Pose shape_in_link = relativePose(pose_link, pose_shape);
+  DistanceMin m(relative_error);
+  std::visit([&](const auto& s) { shapeTrianglesDistance(s, shape_in_link, link, tol, m, true, Pose::identity()); },
+             shape);
+  for (const auto& p : link.primitives())
+    if (!m.failed && !(m.best.distance <= 0.0)) m.add(gjkDistance(shape, shape_in_link, p.shape, p.pose, tol));
+  DistanceResult r = m.best;
+  if (m.failed) {
+    r.status = Status::NotConverged;
+    r.distance = 0.0;
+    r.lower_bound = 0.0;
+    return r;
+  }
+  r.lower_bound = std::min({r.lower_bound, r.distance, m.cutoff});
+  r.point_a = pose_link * r.point_a;
+  r.point_b = pose_link * r.point_b;
+  r.normal = pose_link.R * r.normal;
+  return r;
+}
+
 // ---- Triangle–triangle separating axes ----------------------------------------------------------------
 
 namespace detail {

@@ -106,6 +106,13 @@ bool shapeIntersectsLink(const Shape& shape, const Pose& pose_shape, const LinkG
 DistanceResult meshDistance(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
                             const Tolerances& tol = {}, double relative_error = 0.0) noexcept;
 
+/// The distance between a convex shape (A, an obstacle or a voxel) and a link's exact geometry (B):
+/// the minimum over the link's triangles and primitives, with the same bounds, frames and relative_error
+/// as meshDistance (normal from the shape towards the link). The link's hull is not consulted: callers
+/// that want a cheap lower bound first ask GJK for the shape-to-hull distance.
+DistanceResult shapeLinkDistance(const Shape& shape, const Pose& pose_shape, const LinkGeometry& link,
+                                 const Pose& pose_link, const Tolerances& tol = {}, double relative_error = 0.0) noexcept;
+
 namespace detail {
 
 /// The separating-axis test of two closed triangles given in one frame: true when one of the 17 axes

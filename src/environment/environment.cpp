@@ -1,0 +1,314 @@
+// Environment: obstacles and voxels in world-frame AABB trees, and the link queries against them.
+//
+// A link is first reduced to its world box (the box of its hull's box placed by the pose), which picks
+// the candidates from each tree. Candidates then meet tests from cheapest to dearest: for voxels the
+// link's box as an oriented box (6 face axes), then GJK against the link's hull (one warm-started
+// cache for all voxels of a query: every voxel is axis-aligned, so the last separating axis is a good
+// start for the next), and only in Mesh mode, when the hull touches voxels, the triangles. When more
+// than a few voxels pass the hull, the voxel tree and the link's triangle tree are descended together
+// (world frame against link frame), which tests each voxel only against the triangles near it.
+//
+// Slack: boxes are grown by padding + band, band = 4·max(gjk_absolute, 64 ulps)·scale with scale
+// bounding every coordinate of the query, so box culling never drops a pair that GJK (whose own band
+// is gjk_absolute times the pair's size) would call touching.
+#include <clearway/environment/environment.h>
+
+#include <clearway/shape/support.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <utility>
+
+namespace clearway {
+namespace {
+
+// The world box of a shape placed by `pose`: 6 support queries plus the sweep radius, widened by a
+// few roundings of its coordinates.
+Aabb shapeWorldBox(const Shape& shape, const Pose& pose) noexcept {
+  return std::visit(
+      [&](const auto& s) {
+        Aabb box;
+        const double r = s.radius();
+        for (int i = 0; i < 3; ++i) {
+          const Vec3 d = pose.R.row(i).transpose();  // world axis i in the shape's frame
+          box.max[i] = (pose * s.support(d))[i] + r;
+          box.min[i] = (pose * s.support(-d))[i] - r;
+        }
+        const double scale = box.min.cwiseAbs().cwiseMax(box.max.cwiseAbs()).maxCoeff();
+        return box.inflated(16.0 * std::numeric_limits<double>::epsilon() * scale);
+      },
+      shape);
+}
+
+Aabb obstacleBox(const Obstacle& o, const Pose& pose) noexcept {
+  return o.mesh ? transformed(o.mesh->bounds(), pose) : shapeWorldBox(o.shape, pose);
+}
+
+Pose poseAt(const Obstacle& o, double t) noexcept {
+  Pose p = o.pose;
+  if (o.moving()) p.t += t * o.velocity;
+  return p;
+}
+
+double maxAbs(const Aabb& b) noexcept {
+  return b.isEmpty() ? 0.0 : b.min.cwiseAbs().cwiseMax(b.max.cwiseAbs()).maxCoeff();
+}
+
+double bandOf(double scale, const Tolerances& tol) noexcept {
+  return 4.0 * std::max(tol.gjk_absolute, 64.0 * std::numeric_limits<double>::epsilon()) * scale;
+}
+
+bool obstacleIntersects(const Obstacle& o, const Pose& pose_o, const LinkGeometry& link, const Pose& pose,
+                        const Tolerances& tol, GeometryMode mode, double padding) noexcept {
+  return o.mesh ? meshesIntersect(*o.mesh, pose_o, link, pose, tol, mode, padding)
+                : shapeIntersectsLink(o.shape, pose_o, link, pose, tol, mode, padding);
+}
+
+// Voxels passing the hull test that the Mesh mode checks one by one (each against the triangles near
+// it); beyond this many, descending the two trees together is cheaper than a triangle-tree query each.
+constexpr int kFewVoxels = 4;
+
+// The running minimum of Environment::linkDistance, with the link as A.
+struct NearestSearch {
+  DistanceResult best;
+  double lower = std::numeric_limits<double>::infinity();  // min of the evaluated items' lower bounds
+  double limit;   // items certainly farther than this are skipped: min(cutoff, best / (1 + e))
+  double shrink;
+  bool failed = false;
+
+  NearestSearch(double cutoff, double relative_error) : limit(cutoff), shrink(1.0 / (1.0 + relative_error)) {
+    best.distance = cutoff;
+    best.lower_bound = cutoff;
+    best.status = Status::Separated;
+  }
+  // Returns true when the search can stop (contact, or a failure).
+  bool add(const DistanceResult& r) {
+    best.iterations += r.iterations;
+    if (isFailure(r.status)) {
+      failed = true;
+      return true;
+    }
+    lower = std::min(lower, r.lower_bound);
+    if (r.distance < best.distance) {
+      const int iterations = best.iterations;
+      best = r;
+      best.iterations = iterations;
+      limit = std::min(limit, r.distance * shrink);
+    }
+    return best.distance <= 0.0;
+  }
+};
+
+// A distance with A and B exchanged.
+DistanceResult swapped(DistanceResult r) noexcept {
+  std::swap(r.point_a, r.point_b);
+  r.normal = -r.normal;
+  return r;
+}
+
+}  // namespace
+
+Environment::Environment(std::vector<Obstacle> obstacles, std::shared_ptr<const OccupancyMap> map)
+    : obstacles_(std::move(obstacles)), map_(std::move(map)) {
+  std::vector<Aabb> boxes;
+  for (std::size_t i = 0; i < obstacles_.size(); ++i) {
+    const Obstacle& o = obstacles_[i];
+    if (!o.pose.isFinite()) throw std::invalid_argument("environment: obstacle '" + o.name + "' has a non-finite pose");
+    if (!o.velocity.allFinite())
+      throw std::invalid_argument("environment: obstacle '" + o.name + "' has a non-finite velocity");
+    if (o.moving()) {
+      moving_.push_back(static_cast<int>(i));
+      continue;
+    }
+    static_.push_back(static_cast<int>(i));
+    boxes.push_back(obstacleBox(o, o.pose));
+  }
+  has_moving_ = !moving_.empty();
+  static_tree_ = AabbTree(boxes);  // throws std::invalid_argument for a non-finite box
+  // Voxels lie on a grid: the median split is as good as the SAH there and builds several times faster.
+  if (map_ && !map_->occupied.empty()) voxel_tree_ = AabbTree(map_->occupied, {TreeSplit::Median, 2});
+  scale_ = std::max(maxAbs(static_tree_.bounds()), maxAbs(voxel_tree_.bounds()));
+}
+
+bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, GeometryMode mode,
+                                 double padding, double t, EnvironmentHit* hit,
+                                 EnvironmentCounters* counters) const noexcept {
+  if (hit) *hit = EnvironmentHit{};
+  if (!pose.isFinite() || !(padding >= 0.0) || !std::isfinite(padding) || !std::isfinite(t)) return true;
+  const auto report = [&](EnvironmentHit::Kind kind, int index) {
+    if (hit) {
+      hit->kind = kind;
+      hit->index = index;
+    }
+    return true;
+  };
+  const Aabb link_box = transformed(link.bounds(), pose);
+  const double slack = padding + bandOf(scale_ + maxAbs(link_box) + padding, tol);
+  const Aabb query = link_box.inflated(slack);
+
+  int found = -1;
+  static_tree_.query(query, [&](std::int32_t item) {
+    const int i = static_[item];
+    if (counters) ++counters->obstacle_tests;
+    if (!obstacleIntersects(obstacles_[i], obstacles_[i].pose, link, pose, tol, mode, padding)) return false;
+    found = i;
+    return true;
+  });
+  if (found >= 0) return report(EnvironmentHit::Kind::Obstacle, found);
+
+  // Moving obstacles are few by nature; shapeIntersectsLink's bounding-sphere test is their cull.
+  for (const int i : moving_) {
+    const Pose at = poseAt(obstacles_[i], t);
+    if (counters) ++counters->obstacle_tests;
+    if (!at.isFinite() || obstacleIntersects(obstacles_[i], at, link, pose, tol, mode, padding))
+      return report(EnvironmentHit::Kind::Obstacle, i);
+  }
+
+  if (voxel_tree_.empty()) return false;
+  const std::vector<Aabb>& voxels = map_->occupied;
+  // The link's box as an oriented box in the world (A = world, B = the link frame).
+  const detail::OrientedBoxTest obb(pose, slack, scale_ + maxAbs(link_box));
+  const detail::OrientedBoxTest::PlacedB placed_link = obb.place(link.bounds());
+  SimplexCache cache;
+  int passed[kFewVoxels];
+  int n_passed = 0;
+  bool many = false;
+  voxel_tree_.query(query, [&](std::int32_t v) {
+    double c[3], h[3];
+    detail::OrientedBoxTest::centerHalf(voxels[v], c, h);
+    if (obb.separated<false>(c, h, placed_link)) return false;
+    if (counters) ++counters->voxel_tests;
+    const Box box(Vec3(h[0], h[1], h[2]));
+    if (!shapeIntersectsLink(box, Pose::translation(Vec3(c[0], c[1], c[2])), link, pose, tol, GeometryMode::Hull,
+                             padding, &cache))
+      return false;
+    if (mode == GeometryMode::Hull || n_passed == kFewVoxels) {
+      found = v;
+      many = mode == GeometryMode::Mesh;
+      return true;
+    }
+    passed[n_passed++] = v;
+    return false;
+  });
+  if (mode == GeometryMode::Hull) return found >= 0 ? report(EnvironmentHit::Kind::Voxel, found) : false;
+
+  if (!many) {
+    for (int k = 0; k < n_passed; ++k) {
+      const Aabb& b = voxels[passed[k]];
+      if (counters) ++counters->voxel_tests;
+      if (shapeIntersectsLink(Box(b.halfExtents()), Pose::translation(b.center()), link, pose, tol, GeometryMode::Mesh,
+                              padding, &cache))
+        return report(EnvironmentHit::Kind::Voxel, passed[k]);
+    }
+    return false;
+  }
+
+  // Many voxels inside the hull: voxel tree (world) against triangle tree (link frame), then box–triangle
+  // GJK; then the link's primitives against the voxels near them.
+  const std::vector<Triangle>& tris = link.triangles();
+  found = -1;
+  forEachOverlap(
+      voxel_tree_, link.tree(), pose,
+      [&](std::int32_t v, std::int32_t j) {
+        if (counters) ++counters->voxel_tests;
+        const Aabb& b = voxels[v];
+        const Box box(b.halfExtents());
+        SimplexCache pair_cache;
+        if (!gjkIntersect(Margin<Box>{box, padding}, Pose::translation(b.center()), tris[j], pose, tol, pair_cache)
+                 .intersecting)
+          return false;
+        found = v;
+        return true;
+      },
+      slack);
+  if (found >= 0) return report(EnvironmentHit::Kind::Voxel, found);
+  for (const LinkGeometry::Primitive& p : link.primitives()) {
+    const Pose pose_p = pose * p.pose;
+    voxel_tree_.query(shapeWorldBox(p.shape, pose_p).inflated(slack), [&](std::int32_t v) {
+      if (counters) ++counters->voxel_tests;
+      const Aabb& b = voxels[v];
+      const Box box(b.halfExtents());
+      SimplexCache pair_cache;
+      const bool touching = std::visit(
+          [&](const auto& s) {
+            return gjkIntersect(Margin<Box>{box, padding}, Pose::translation(b.center()), s, pose_p, tol, pair_cache)
+                .intersecting;
+          },
+          p.shape);
+      if (touching) found = v;
+      return touching;
+    });
+    if (found >= 0) return report(EnvironmentHit::Kind::Voxel, found);
+  }
+  return false;
+}
+
+DistanceResult Environment::linkDistance(const LinkGeometry& link, const Pose& pose, const Tolerances& tol,
+                                         double cutoff, double t, double relative_error,
+                                         EnvironmentCounters* counters) const noexcept {
+  if (!pose.isFinite() || !std::isfinite(t) || !(cutoff >= 0.0) || !(relative_error >= 0.0) ||
+      !std::isfinite(relative_error)) {
+    DistanceResult r;
+    r.status = Status::InvalidInput;
+    return r;
+  }
+  NearestSearch search(cutoff, relative_error);
+  const Aabb link_box = transformed(link.bounds(), pose);
+
+  // One obstacle: the hull's lower bound first (one GJK), the exact geometry only when it may be nearer.
+  const auto visit = [&](const Obstacle& o, const Pose& pose_o) {
+    DistanceResult hull;
+    if (o.mesh) {
+      hull = gjkDistance(link.hull(), pose, o.mesh->hull(), pose_o, tol);
+    } else {
+      hull = std::visit([&](const auto& s) { return gjkDistance(link.hull(), pose, s, pose_o, tol); }, o.shape);
+    }
+    if (!isFailure(hull.status) && hull.lower_bound >= search.limit) return false;
+    if (counters) ++counters->distance_tests;
+    return search.add(o.mesh ? meshDistance(link, pose, *o.mesh, pose_o, tol, relative_error)
+                             : swapped(shapeLinkDistance(o.shape, pose_o, link, pose, tol, relative_error)));
+  };
+
+  bool stop = static_tree_.forEachWithin(link_box, search.limit, [&](std::int32_t item) {
+    const Obstacle& o = obstacles_[static_[item]];
+    return visit(o, o.pose);
+  });
+  for (std::size_t k = 0; k < moving_.size() && !stop; ++k) {
+    const Obstacle& o = obstacles_[moving_[k]];
+    const Pose at = poseAt(o, t);
+    if (!at.isFinite()) {
+      search.failed = true;
+      break;
+    }
+    if (boxDistance(obstacleBox(o, at), link_box) <= search.limit) stop = visit(o, at);
+  }
+  if (!stop && !search.failed && !voxel_tree_.empty()) {
+    const std::vector<Aabb>& voxels = map_->occupied;
+    // The link's box as an oriented box sees voxels much nearer than its world box admits.
+    const detail::OrientedBoxTest obb(pose, 0.0, scale_ + maxAbs(link_box));
+    voxel_tree_.forEachWithin(link_box, search.limit, [&](std::int32_t v) {
+      if (obb.gap(voxels[v], link.bounds()) >= search.limit) return false;
+      const Box box(voxels[v].halfExtents());
+      const Pose pose_v = Pose::translation(voxels[v].center());
+      const DistanceResult hull = gjkDistance(link.hull(), pose, box, pose_v, tol);
+      if (!isFailure(hull.status) && hull.lower_bound >= search.limit) return false;
+      if (counters) ++counters->distance_tests;
+      return search.add(swapped(shapeLinkDistance(box, pose_v, link, pose, tol, relative_error)));
+    });
+  }
+
+  DistanceResult r = search.best;
+  if (search.failed) {
+    r.status = Status::NotConverged;
+    r.distance = 0.0;
+    r.lower_bound = 0.0;
+    return r;
+  }
+  // Every item not evaluated was at least the final limit away.
+  r.lower_bound = std::min({search.lower, search.limit, r.distance});
+  return r;
+}
+
+}  // namespace clearway

@@ -1,0 +1,632 @@
+// The environment stage: OctoMap loading (boxes, unknown space, bad files) and link queries against
+// obstacles and voxels, checked against hand-computed answers, OctoMap's own leaf iteration, and brute
+// force over every voxel.
+#include <clearway/environment/environment.h>
+
+#include <octomap/ColorOcTree.h>
+#include <octomap/OcTree.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+namespace clearway {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A fresh folder per test, removed afterwards.
+class TempDir {
+ public:
+  TempDir() {
+    static int counter = 0;
+    path_ = fs::temp_directory_path() /
+            ("clearway_env_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  fs::path path_;
+};
+
+std::string readBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+void writeBytes(const std::string& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+// The message of the LoadError that loading `path` throws ("" when it loads).
+std::string loadErrorOf(const std::string& path, UnknownSpace unknown = UnknownSpace::Free) {
+  try {
+    loadOctomap(path, unknown);
+  } catch (const LoadError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+LinkGeometry primitiveLink(const Shape& shape, const Pose& origin = Pose()) {
+  CollisionElement e;
+  e.origin = origin;
+  e.primitive = shape;
+  return LinkGeometry(std::vector<CollisionElement>{e}, {});
+}
+
+// The closed surface of a box centred at the origin: 8 vertices, 12 triangles.
+TriangleMesh boxSurface(const Vec3& half) {
+  TriangleMesh m;
+  for (int i = 0; i < 8; ++i)
+    m.vertices.emplace_back((i & 1 ? 1 : -1) * half.x(), (i & 2 ? 1 : -1) * half.y(), (i & 4 ? 1 : -1) * half.z());
+  m.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                 {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  return m;
+}
+
+std::shared_ptr<const OccupancyMap> mapOf(std::vector<Aabb> boxes, double resolution = 0.1) {
+  auto map = std::make_shared<OccupancyMap>();
+  map->resolution = resolution;
+  map->occupied = std::move(boxes);
+  map->occupied_leaves = static_cast<int>(map->occupied.size());
+  for (const Aabb& b : map->occupied) map->known_bounds.merge(b);
+  return map;
+}
+
+Aabb cube(const Vec3& lo, double edge) { return Aabb::fromMinMax(lo, lo + Vec3::Constant(edge)); }
+
+double volume(const Aabb& b) { return b.extents().prod(); }
+
+const Tolerances kTol;
+constexpr double kPi = 3.14159265358979323846;
+constexpr GeometryMode kModes[] = {GeometryMode::Hull, GeometryMode::Mesh};
+
+// ---- Loading ------------------------------------------------------------------------------------------
+
+TEST(OctomapLoader, FinestVoxelBecomesOneBox) {
+  TempDir dir;
+  octomap::OcTree tree(0.1);
+  tree.updateNode(octomap::point3d(0.05f, 0.05f, 0.05f), true);
+  tree.writeBinary(dir.file("one.bt"));
+  const OccupancyMap map = loadOctomap(dir.file("one.bt"));
+  EXPECT_DOUBLE_EQ(map.resolution, 0.1);
+  ASSERT_EQ(map.occupied.size(), 1u);
+  EXPECT_EQ(map.occupied_leaves, 1);
+  EXPECT_EQ(map.unknown_boxes, 0);
+  EXPECT_TRUE(map.occupied[0].min.isApprox(Vec3(0, 0, 0), 1e-12));
+  EXPECT_NEAR((map.occupied[0].max - Vec3(0.1, 0.1, 0.1)).norm(), 0.0, 1e-12);
+  // The only observed cell is occupied: no unknown cell lies inside the known bounds.
+  EXPECT_EQ(loadOctomap(dir.file("one.bt"), UnknownSpace::Occupied).occupied.size(), 1u);
+}
+
+TEST(OctomapLoader, CoarseLeafBecomesOneBox) {
+  TempDir dir;
+  octomap::OcTree tree(0.1);
+  // 4×4×4 finest cells filling one depth-14 cube: OctoMap prunes them into a single 0.4 m leaf.
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j)
+      for (int k = 0; k < 4; ++k)
+        tree.updateNode(octomap::point3d(0.05f + 0.1f * i, 0.05f + 0.1f * j, 0.05f + 0.1f * k), true);
+  tree.writeBinary(dir.file("coarse.bt"));
+  const OccupancyMap map = loadOctomap(dir.file("coarse.bt"));
+  ASSERT_EQ(map.occupied.size(), 1u);
+  EXPECT_NEAR((map.occupied[0].min - Vec3(0, 0, 0)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((map.occupied[0].max - Vec3(0.4, 0.4, 0.4)).norm(), 0.0, 1e-12);
+
+  // A box link just touching the coarse leaf's +x face collides; 1e-6 m away it is free.
+  const Environment env({}, std::make_shared<const OccupancyMap>(map));
+  const LinkGeometry link = primitiveLink(Box(Vec3(0.05, 0.05, 0.05)));
+  for (const GeometryMode mode : kModes) {
+    EXPECT_TRUE(env.linkIntersects(link, Pose::translation(Vec3(0.45, 0.2, 0.2)), kTol, mode));
+    EXPECT_FALSE(env.linkIntersects(link, Pose::translation(Vec3(0.45 + 1e-6, 0.2, 0.2)), kTol, mode));
+  }
+}
+
+TEST(OctomapLoader, UnknownSpaceUnderBothPolicies) {
+  TempDir dir;
+  octomap::OcTree tree(0.1);
+  tree.updateNode(octomap::point3d(0.05f, 0.05f, 0.05f), true);   // occupied [0, 0.1]³
+  tree.updateNode(octomap::point3d(0.35f, 0.35f, 0.35f), false);  // free [0.3, 0.4]³
+  tree.writeBinary(dir.file("sparse.bt"));
+
+  const OccupancyMap free_map = loadOctomap(dir.file("sparse.bt"), UnknownSpace::Free);
+  EXPECT_EQ(free_map.occupied.size(), 1u);
+  EXPECT_EQ(free_map.unknown_boxes, 0);
+  EXPECT_NEAR((free_map.known_bounds.min - Vec3(0, 0, 0)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((free_map.known_bounds.max - Vec3(0.4, 0.4, 0.4)).norm(), 0.0, 1e-12);
+
+  const OccupancyMap occ = loadOctomap(dir.file("sparse.bt"), UnknownSpace::Occupied);
+  EXPECT_EQ(occ.occupied_leaves, 1);
+  ASSERT_EQ(static_cast<int>(occ.occupied.size()), 1 + occ.unknown_boxes);
+  // Unknown boxes fill the known bounds except the two observed cells, without overlapping, and are
+  // coarse: far fewer than the 62 finest cells they cover.
+  double unknown_volume = 0.0;
+  for (int i = 1; i < static_cast<int>(occ.occupied.size()); ++i) {
+    const Aabb& b = occ.occupied[i];
+    EXPECT_TRUE(occ.known_bounds.contains(b));
+    unknown_volume += volume(b);
+    for (int j = 0; j < i; ++j) {
+      const Aabb& c = occ.occupied[j];
+      const Vec3 overlap = b.max.cwiseMin(c.max) - b.min.cwiseMax(c.min);
+      EXPECT_FALSE((overlap.array() > 1e-12).all()) << "boxes " << i << " and " << j << " overlap";
+    }
+  }
+  EXPECT_NEAR(unknown_volume, 0.064 - 2 * 0.001, 1e-12);
+  EXPECT_LE(occ.unknown_boxes, 20);
+
+  // A small sphere in the unobserved middle collides only when unknown space counts as occupied; one
+  // in the observed free cell never does.
+  const LinkGeometry ball = primitiveLink(Sphere(0.02));
+  const Environment env_free({}, std::make_shared<const OccupancyMap>(free_map));
+  const Environment env_occ({}, std::make_shared<const OccupancyMap>(occ));
+  for (const GeometryMode mode : kModes) {
+    EXPECT_FALSE(env_free.linkIntersects(ball, Pose::translation(Vec3(0.2, 0.2, 0.2)), kTol, mode));
+    EXPECT_TRUE(env_occ.linkIntersects(ball, Pose::translation(Vec3(0.2, 0.2, 0.2)), kTol, mode));
+    EXPECT_FALSE(env_occ.linkIntersects(ball, Pose::translation(Vec3(0.35, 0.35, 0.35)), kTol, mode));
+    // Outside the known bounds unknown space stays free.
+    EXPECT_FALSE(env_occ.linkIntersects(ball, Pose::translation(Vec3(0.6, 0.2, 0.2)), kTol, mode));
+  }
+}
+
+TEST(OctomapLoader, EmptyMap) {
+  TempDir dir;
+  octomap::OcTree tree(0.05);
+  tree.writeBinary(dir.file("empty.bt"));
+  const OccupancyMap map = loadOctomap(dir.file("empty.bt"), UnknownSpace::Occupied);
+  EXPECT_DOUBLE_EQ(map.resolution, 0.05);
+  EXPECT_TRUE(map.occupied.empty());
+  EXPECT_TRUE(map.known_bounds.isEmpty());
+  const Environment env({}, std::make_shared<const OccupancyMap>(map));
+  EXPECT_TRUE(env.empty());
+  EnvironmentCounters counters;
+  EXPECT_FALSE(env.linkIntersects(primitiveLink(Sphere(1.0)), Pose(), kTol, GeometryMode::Mesh, 0.0, 0.0, nullptr,
+                                  &counters));
+  EXPECT_EQ(counters.voxel_tests, 0);
+}
+
+TEST(OctomapLoader, FullFormatRoundTripMatchesBinary) {
+  TempDir dir;
+  octomap::OcTree tree(0.05);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-0.5f, 0.5f);
+  for (int i = 0; i < 300; ++i) tree.updateNode(octomap::point3d(u(rng), u(rng), u(rng)), i % 3 != 0);
+  // writeBinary stores the maximum-likelihood, pruned tree: give the full file the same tree.
+  tree.toMaxLikelihood();
+  tree.prune();
+  ASSERT_TRUE(tree.write(dir.file("map.ot")));
+  ASSERT_TRUE(tree.writeBinary(dir.file("map.bt")));
+  for (const UnknownSpace unknown : {UnknownSpace::Free, UnknownSpace::Occupied}) {
+    const OccupancyMap full = loadOctomap(dir.file("map.ot"), unknown);
+    const OccupancyMap binary = loadOctomap(dir.file("map.bt"), unknown);
+    EXPECT_GT(full.occupied_leaves, 100);
+    EXPECT_EQ(full.occupied_leaves, binary.occupied_leaves);
+    EXPECT_EQ(full.unknown_boxes, binary.unknown_boxes);
+    ASSERT_EQ(full.occupied.size(), binary.occupied.size());
+    for (std::size_t i = 0; i < full.occupied.size(); ++i) {
+      EXPECT_EQ(full.occupied[i].min, binary.occupied[i].min);
+      EXPECT_EQ(full.occupied[i].max, binary.occupied[i].max);
+    }
+  }
+}
+
+TEST(OctomapLoader, RealMapMatchesOctomapLeafIteration) {
+  const std::string path = std::string(CLEARWAY_SHARED_DIR) + "/scenes/box_panda/box_panda_0001.bt";
+  if (!fs::exists(path)) GTEST_SKIP() << "shared scenes not found: " << path;
+  const OccupancyMap map = loadOctomap(path);
+  EXPECT_DOUBLE_EQ(map.resolution, 0.02);
+  EXPECT_GT(map.occupied.size(), 0u);
+  EXPECT_EQ(static_cast<int>(map.occupied.size()), map.occupied_leaves);
+
+  // OctoMap's own leaf iterator: the same number of occupied leaves, each with the same centre and size.
+  octomap::OcTree reference(0.1);
+  ASSERT_TRUE(reference.readBinary(path));
+  std::vector<std::pair<Vec3, double>> leaves;
+  for (auto it = reference.begin_leafs(); it != reference.end_leafs(); ++it)
+    if (reference.isNodeOccupied(*it))
+      leaves.emplace_back(Vec3(it.getX(), it.getY(), it.getZ()), it.getSize());
+  ASSERT_EQ(leaves.size(), map.occupied.size());
+  std::vector<std::pair<Vec3, double>> ours;
+  for (const Aabb& b : map.occupied) ours.emplace_back(b.center(), b.extents().x());
+  const auto less = [](const std::pair<Vec3, double>& a, const std::pair<Vec3, double>& b) {
+    return std::lexicographical_compare(a.first.data(), a.first.data() + 3, b.first.data(), b.first.data() + 3);
+  };
+  std::sort(leaves.begin(), leaves.end(), less);
+  std::sort(ours.begin(), ours.end(), less);
+  for (std::size_t i = 0; i < leaves.size(); ++i) {
+    EXPECT_LT((leaves[i].first - ours[i].first).norm(), 1e-5) << i;  // OctoMap reports centres as floats
+    EXPECT_NEAR(leaves[i].second, ours[i].second, 1e-9) << i;
+  }
+
+  const OccupancyMap occ = loadOctomap(path, UnknownSpace::Occupied);
+  EXPECT_EQ(occ.occupied_leaves, map.occupied_leaves);
+  EXPECT_EQ(static_cast<int>(occ.occupied.size()), occ.occupied_leaves + occ.unknown_boxes);
+}
+
+// ---- Bad input ----------------------------------------------------------------------------------------
+
+TEST(OctomapLoader, MissingFileAndWrongExtension) {
+  TempDir dir;
+  const std::string missing = dir.file("nope.bt");
+  EXPECT_EQ(loadErrorOf(missing), missing + ": OctoMap file not found");
+  writeBytes(dir.file("map.txt"), "hello\n");
+  EXPECT_EQ(loadErrorOf(dir.file("map.txt")), dir.file("map.txt") + ": unsupported OctoMap extension '.txt' (use .bt or .ot)");
+  EXPECT_NE(loadErrorOf(dir.file("")).find("not a regular file"), std::string::npos);
+}
+
+TEST(OctomapLoader, ForeignFiles) {
+  TempDir dir;
+  writeBytes(dir.file("text.bt"), "just some text\nwith lines\n");
+  EXPECT_EQ(loadErrorOf(dir.file("text.bt")),
+            dir.file("text.bt") + ": not an OctoMap file: the first line is not '# Octomap OcTree binary file'");
+  std::mt19937 rng(3);
+  std::string noise(4096, '\0');
+  for (char& c : noise) c = static_cast<char>(rng());
+  writeBytes(dir.file("noise.bt"), noise);
+  EXPECT_NE(loadErrorOf(dir.file("noise.bt")).find("not an OctoMap file"), std::string::npos);
+  writeBytes(dir.file("noise.ot"), noise);
+  EXPECT_NE(loadErrorOf(dir.file("noise.ot")).find("not an OctoMap file"), std::string::npos);
+  writeBytes(dir.file("empty.bt"), "");
+  EXPECT_EQ(loadErrorOf(dir.file("empty.bt")), dir.file("empty.bt") + ": empty file");
+
+  // A valid header followed by random node data: never a crash or a hang, always a LoadError.
+  for (int trial = 0; trial < 50; ++trial) {
+    std::string bytes = "# Octomap OcTree binary file\nid OcTree\nsize " + std::to_string(1 + rng() % 5000) +
+                        "\nres 0.05\ndata\n";
+    for (int i = 0; i < 3000; ++i) bytes += static_cast<char>(rng());
+    writeBytes(dir.file("garbage.bt"), bytes);
+    EXPECT_NE(loadErrorOf(dir.file("garbage.bt")), "") << trial;
+    std::string full = "# Octomap OcTree file\nid OcTree\nsize " + std::to_string(1 + rng() % 5000) + "\nres 0.05\ndata\n";
+    for (int i = 0; i < 3000; ++i) full += static_cast<char>(rng());
+    writeBytes(dir.file("garbage.ot"), full);
+    EXPECT_NE(loadErrorOf(dir.file("garbage.ot")), "") << trial;
+  }
+
+  // A full-format map named .bt (and the reverse) is named for what it is.
+  octomap::OcTree tree(0.1);
+  tree.updateNode(octomap::point3d(0.05f, 0.05f, 0.05f), true);
+  tree.write(dir.file("full.ot"));
+  fs::copy_file(dir.file("full.ot"), dir.file("full.bt"));
+  EXPECT_NE(loadErrorOf(dir.file("full.bt")).find("name it .ot"), std::string::npos);
+  tree.writeBinary(dir.file("binary.bt"));
+  fs::copy_file(dir.file("binary.bt"), dir.file("binary.ot"));
+  EXPECT_NE(loadErrorOf(dir.file("binary.ot")).find("name it .bt"), std::string::npos);
+}
+
+TEST(OctomapLoader, TruncatedFilesAlwaysThrow) {
+  TempDir dir;
+  octomap::OcTree tree(0.05);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (int i = 0; i < 500; ++i) tree.updateNode(octomap::point3d(u(rng), u(rng), u(rng)), i % 2 == 0);
+  tree.writeBinary(dir.file("whole.bt"));
+  tree.write(dir.file("whole.ot"));
+  for (const std::string ext : {".bt", ".ot"}) {
+    const std::string whole = readBytes(dir.file("whole" + ext));
+    ASSERT_GT(whole.size(), 1000u);
+    ASSERT_EQ(loadErrorOf(dir.file("whole" + ext)), "");
+    // Every cut inside the header and about 150 cuts through the node data.
+    const std::size_t step = std::max<std::size_t>(1, whole.size() / 150);
+    int tested = 0;
+    for (std::size_t len = 1; len < whole.size(); len += (len < 120 ? 1 : step)) {
+      writeBytes(dir.file("cut" + ext), whole.substr(0, len));
+      const std::string error = loadErrorOf(dir.file("cut" + ext));
+      ASSERT_NE(error, "") << ext << " cut at " << len << " of " << whole.size() << " loaded";
+      EXPECT_EQ(error.rfind(dir.file("cut" + ext) + ": ", 0), 0u) << error;
+      ++tested;
+    }
+    EXPECT_GT(tested, 200);
+    writeBytes(dir.file("half" + ext), whole.substr(0, whole.size() / 2));
+    EXPECT_NE(loadErrorOf(dir.file("half" + ext)).find("truncated"), std::string::npos);
+  }
+}
+
+TEST(OctomapLoader, TruncatedRealMap) {
+  const std::string path = std::string(CLEARWAY_SHARED_DIR) + "/scenes/box_panda/box_panda_0001.bt";
+  if (!fs::exists(path)) GTEST_SKIP() << "shared scenes not found: " << path;
+  TempDir dir;
+  const std::string whole = readBytes(path);
+  writeBytes(dir.file("cut.bt"), whole.substr(0, whole.size() - 1));
+  EXPECT_NE(loadErrorOf(dir.file("cut.bt")).find("truncated"), std::string::npos);
+  writeBytes(dir.file("cut.bt"), whole.substr(0, whole.size() / 3));
+  EXPECT_NE(loadErrorOf(dir.file("cut.bt")).find("truncated"), std::string::npos);
+}
+
+TEST(OctomapLoader, ColorOcTreeIsAClearError) {
+  // A .ot file stores its tree type; only OcTree is supported (a .bt holds plain occupancy whatever
+  // tree wrote it, so a ColorOcTree saved as .bt loads).
+  TempDir dir;
+  octomap::ColorOcTree tree(0.1);
+  tree.updateNode(octomap::point3d(0.05f, 0.05f, 0.05f), true);
+  ASSERT_TRUE(tree.write(dir.file("color.ot")));
+  EXPECT_EQ(loadErrorOf(dir.file("color.ot")),
+            dir.file("color.ot") +
+                ": an OctoMap of type 'ColorOcTree': only OcTree maps are supported (write the map as an OcTree, or as .bt)");
+  ASSERT_TRUE(tree.writeBinary(dir.file("color.bt")));
+  EXPECT_EQ(loadOctomap(dir.file("color.bt")).occupied.size(), 1u);
+}
+
+// ---- Queries ------------------------------------------------------------------------------------------
+
+TEST(Environment, TouchingVoxelFaceCollidesApartIsFree) {
+  const Environment env({}, mapOf({cube(Vec3(0, 0, 0), 0.1)}));
+  const LinkGeometry solid = primitiveLink(Box(Vec3(0.05, 0.05, 0.05)));
+  const LinkGeometry surface(boxSurface(Vec3(0.05, 0.05, 0.05)));
+  for (const LinkGeometry* link : {&solid, &surface})
+    for (const GeometryMode mode : kModes) {
+      EnvironmentHit hit;
+      EXPECT_TRUE(env.linkIntersects(*link, Pose::translation(Vec3(0.15, 0.05, 0.05)), kTol, mode, 0.0, 0.0, &hit));
+      EXPECT_EQ(hit.kind, EnvironmentHit::Kind::Voxel);
+      EXPECT_EQ(hit.index, 0);
+      EXPECT_FALSE(env.linkIntersects(*link, Pose::translation(Vec3(0.15 + 1e-6, 0.05, 0.05)), kTol, mode, 0.0, 0.0,
+                                      &hit));
+      EXPECT_EQ(hit.kind, EnvironmentHit::Kind::None);
+      // Padding reaches across the gap.
+      EXPECT_TRUE(env.linkIntersects(*link, Pose::translation(Vec3(0.15 + 1e-6, 0.05, 0.05)), kTol, mode, 2e-6));
+      // Edge to edge, rotated 45° about z: the link's corner touches the voxel's +x face.
+      const double r = 0.05 * std::sqrt(2.0);
+      Pose turned = Pose::fromQuaternion(0, 0, std::sin(kPi / 8), std::cos(kPi / 8), Vec3(0.1 + r, 0.05, 0.05));
+      EXPECT_TRUE(env.linkIntersects(*link, turned, kTol, mode));
+      turned.t.x() += 1e-6;
+      EXPECT_FALSE(env.linkIntersects(*link, turned, kTol, mode));
+    }
+}
+
+TEST(Environment, ObstacleInsideALink) {
+  // A small sphere strictly inside a link: a solid primitive link collides with it in both modes; a
+  // closed mesh is a surface (link_geometry.h), so only its hull collides and Mesh mode reports free.
+  Obstacle pebble;
+  pebble.name = "pebble";
+  pebble.shape = Sphere(0.01);
+  pebble.pose = Pose::translation(Vec3(0.1, 0.0, 0.0));
+  const Environment env({pebble});
+  const LinkGeometry solid = primitiveLink(Box(Vec3(0.5, 0.5, 0.5)));
+  const LinkGeometry surface(boxSurface(Vec3(0.5, 0.5, 0.5)));
+  EnvironmentHit hit;
+  EXPECT_TRUE(env.linkIntersects(solid, Pose(), kTol, GeometryMode::Hull));
+  EXPECT_TRUE(env.linkIntersects(solid, Pose(), kTol, GeometryMode::Mesh, 0.0, 0.0, &hit));
+  EXPECT_EQ(hit.kind, EnvironmentHit::Kind::Obstacle);
+  EXPECT_EQ(hit.index, 0);
+  EXPECT_TRUE(env.linkIntersects(surface, Pose(), kTol, GeometryMode::Hull));
+  EXPECT_FALSE(env.linkIntersects(surface, Pose(), kTol, GeometryMode::Mesh));
+  // Moved onto the surface, the mesh touches it.
+  // Moved so that a face crosses it, then touches it from either side, then clears it by 1e-6.
+  const auto at = [](double x) { return Pose::translation(Vec3(x, 0, 0)); };
+  EXPECT_TRUE(env.linkIntersects(surface, at(0.6), kTol, GeometryMode::Mesh));
+  EXPECT_TRUE(env.linkIntersects(surface, at(0.61), kTol, GeometryMode::Mesh));
+  EXPECT_FALSE(env.linkIntersects(surface, at(0.61 + 1e-6), kTol, GeometryMode::Mesh));
+  EXPECT_TRUE(env.linkIntersects(surface, at(-0.41), kTol, GeometryMode::Mesh));
+  EXPECT_FALSE(env.linkIntersects(surface, at(-0.41 - 1e-6), kTol, GeometryMode::Mesh));
+}
+
+TEST(Environment, ManyVoxelsInsideAMeshLink) {
+  // 27 voxels inside a closed mesh, none touching it: the hull overlaps them all (the tree-vs-tree
+  // path), yet in Mesh mode only a voxel crossing the surface counts.
+  std::vector<Aabb> voxels;
+  for (int i = -1; i <= 1; ++i)
+    for (int j = -1; j <= 1; ++j)
+      for (int k = -1; k <= 1; ++k) voxels.push_back(cube(Vec3(0.1 * i - 0.025, 0.1 * j - 0.025, 0.1 * k - 0.025), 0.05));
+  const LinkGeometry surface(boxSurface(Vec3(0.3, 0.3, 0.3)));
+  {
+    const Environment env({}, mapOf(voxels));
+    EnvironmentCounters counters;
+    EXPECT_TRUE(env.linkIntersects(surface, Pose(), kTol, GeometryMode::Hull));
+    EXPECT_FALSE(env.linkIntersects(surface, Pose(), kTol, GeometryMode::Mesh, 0.0, 0.0, nullptr, &counters));
+    EXPECT_GT(counters.voxel_tests, 4);
+    // 0.3 − 0.125 = 0.175: padding just short of the nearest voxel face, then just past it.
+    EXPECT_FALSE(env.linkIntersects(surface, Pose(), kTol, GeometryMode::Mesh, 0.175 - 1e-6));
+    EXPECT_TRUE(env.linkIntersects(surface, Pose(), kTol, GeometryMode::Mesh, 0.175 + 1e-6));
+  }
+  voxels.push_back(cube(Vec3(0.28, 0.0, 0.0), 0.05));  // crosses the +x face
+  const Environment env({}, mapOf(voxels));
+  EnvironmentHit hit;
+  EXPECT_TRUE(env.linkIntersects(surface, Pose(), kTol, GeometryMode::Mesh, 0.0, 0.0, &hit));
+  EXPECT_EQ(hit.kind, EnvironmentHit::Kind::Voxel);
+  EXPECT_EQ(hit.index, 27);
+}
+
+TEST(Environment, MovingObstacle) {
+  Obstacle ball;
+  ball.name = "ball";
+  ball.shape = Sphere(0.1);
+  ball.pose = Pose::translation(Vec3(2.0, 0.0, 0.0));
+  ball.velocity = Vec3(-1.5, 0.0, 0.0);
+  const Environment env({ball});
+  EXPECT_TRUE(env.hasMovingObstacles());
+  const LinkGeometry link = primitiveLink(Box(Vec3(0.5, 0.5, 0.5)));
+  EnvironmentHit hit;
+  EXPECT_FALSE(env.linkIntersects(link, Pose(), kTol, GeometryMode::Mesh, 0.0, 0.0, &hit));
+  EXPECT_TRUE(env.linkIntersects(link, Pose(), kTol, GeometryMode::Mesh, 0.0, 1.0, &hit));
+  EXPECT_EQ(hit.kind, EnvironmentHit::Kind::Obstacle);
+  // At t the ball's surface is at 1.9 − 1.5t: it touches the face x = 0.5 at t = 14/15.
+  EXPECT_FALSE(env.linkIntersects(link, Pose(), kTol, GeometryMode::Mesh, 0.0, 14.0 / 15.0 - 1e-6));
+  EXPECT_TRUE(env.linkIntersects(link, Pose(), kTol, GeometryMode::Mesh, 0.0, 14.0 / 15.0 + 1e-9));
+  const DistanceResult d = env.linkDistance(link, Pose(), kTol, INFINITY, 0.5);
+  EXPECT_NEAR(d.distance, 1.9 - 0.75 - 0.5, 1e-9);
+}
+
+TEST(Environment, CountersCountOnlyWhatRuns) {
+  Obstacle wall;
+  wall.name = "wall";
+  wall.shape = Box(Vec3(0.1, 1.0, 1.0));
+  wall.pose = Pose::translation(Vec3(1.0, 0.0, 0.0));
+  const LinkGeometry link = primitiveLink(Sphere(0.2));
+  {
+    const Environment env({wall});
+    EnvironmentCounters c;
+    EXPECT_FALSE(env.linkIntersects(link, Pose(), kTol, GeometryMode::Mesh, 0.0, 0.0, nullptr, &c));
+    EXPECT_EQ(c.obstacle_tests, 0);  // the boxes are apart: nothing exact ran
+    EXPECT_EQ(c.voxel_tests, 0);
+    EXPECT_TRUE(env.linkIntersects(link, Pose::translation(Vec3(0.75, 0, 0)), kTol, GeometryMode::Mesh, 0.0, 0.0,
+                                   nullptr, &c));
+    EXPECT_EQ(c.obstacle_tests, 1);
+    EXPECT_EQ(c.voxel_tests, 0);  // no map: zero voxel tests
+    env.linkDistance(link, Pose(), kTol, INFINITY, 0.0, 0.0, &c);
+    EXPECT_EQ(c.distance_tests, 1);
+  }
+  const Environment env({wall}, mapOf({cube(Vec3(-1.0, -0.05, -0.05), 0.1), cube(Vec3(-3.0, 0, 0), 0.1)}));
+  EnvironmentCounters c;
+  EXPECT_FALSE(env.linkIntersects(link, Pose(), kTol, GeometryMode::Mesh, 0.0, 0.0, nullptr, &c));
+  EXPECT_EQ(c.voxel_tests, 0);
+  EXPECT_TRUE(env.linkIntersects(link, Pose::translation(Vec3(-0.75, 0, 0)), kTol, GeometryMode::Mesh, 0.0, 0.0,
+                                 nullptr, &c));
+  EXPECT_EQ(c.voxel_tests, 2);  // the hull test, then the exact test of the one voxel near the link
+  EXPECT_EQ(c.obstacle_tests, 0);
+}
+
+TEST(Environment, NonFiniteInputIsAHit) {
+  const Environment env;
+  const LinkGeometry link = primitiveLink(Sphere(0.1));
+  Pose bad;
+  bad.t.x() = std::nan("");
+  EXPECT_TRUE(env.linkIntersects(link, bad, kTol, GeometryMode::Mesh));
+  EXPECT_TRUE(env.linkIntersects(link, Pose(), kTol, GeometryMode::Mesh, -1.0));
+  EXPECT_FALSE(env.linkIntersects(link, Pose(), kTol, GeometryMode::Mesh));
+  EXPECT_TRUE(env.linkDistance(link, bad, kTol).mayCollide());
+  Obstacle o;
+  o.shape = Sphere(1.0);
+  o.pose.t.y() = INFINITY;
+  EXPECT_THROW(Environment({o}), std::invalid_argument);
+  o.pose = Pose();
+  o.velocity.z() = std::nan("");
+  EXPECT_THROW(Environment({o}), std::invalid_argument);
+}
+
+TEST(Environment, DistanceAgainstAnalyticAnswers) {
+  Obstacle box;
+  box.name = "box";
+  box.shape = Box(Vec3(0.5, 0.5, 0.5));
+  const Environment env({box});
+  const LinkGeometry ball = primitiveLink(Sphere(0.1));
+
+  DistanceResult d = env.linkDistance(ball, Pose::translation(Vec3(1.0, 0.0, 0.0)), kTol);
+  EXPECT_NEAR(d.distance, 0.4, 1e-9);
+  EXPECT_LE(d.lower_bound, d.distance);
+  EXPECT_GE(d.lower_bound, 0.4 * (1 - 1e-6));
+  EXPECT_NEAR((d.point_a - Vec3(0.9, 0, 0)).norm(), 0.0, 1e-9);  // on the link
+  EXPECT_NEAR((d.point_b - Vec3(0.5, 0, 0)).norm(), 0.0, 1e-9);  // on the obstacle
+  EXPECT_NEAR((d.normal - Vec3(-1, 0, 0)).norm(), 0.0, 1e-9);    // from the link towards the obstacle
+
+  d = env.linkDistance(ball, Pose::translation(Vec3(1.0, 1.0, 1.0)), kTol);
+  EXPECT_NEAR(d.distance, 0.5 * std::sqrt(3.0) - 0.1, 1e-9);
+
+  d = env.linkDistance(ball, Pose::translation(Vec3(0.55, 0.0, 0.0)), kTol);
+  EXPECT_EQ(d.distance, 0.0);
+  EXPECT_TRUE(d.mayCollide());
+
+  // Beyond the cutoff: the cutoff itself, certified.
+  d = env.linkDistance(ball, Pose::translation(Vec3(1.0, 0.0, 0.0)), kTol, 0.25);
+  EXPECT_EQ(d.distance, 0.25);
+  EXPECT_EQ(d.lower_bound, 0.25);
+  EXPECT_EQ(d.status, Status::Separated);
+
+  // A mesh link against voxels: the nearest of two voxels, face to face.
+  const Environment voxels({}, mapOf({cube(Vec3(0, 0, 0), 0.1), cube(Vec3(0.0, 0.0, 1.0), 0.1)}));
+  const LinkGeometry surface(boxSurface(Vec3(0.05, 0.05, 0.05)));
+  d = voxels.linkDistance(surface, Pose::translation(Vec3(0.45, 0.05, 0.05)), kTol);
+  EXPECT_NEAR(d.distance, 0.3, 1e-9);
+  d = voxels.linkDistance(ball, Pose::translation(Vec3(0.05, 0.05, 0.6)), kTol);
+  EXPECT_NEAR(d.distance, 0.4 - 0.1, 1e-9);
+  // An empty world: nothing within any cutoff.
+  const Environment nothing;
+  EXPECT_EQ(nothing.linkDistance(ball, Pose(), kTol, 2.0).distance, 2.0);
+  EXPECT_TRUE(std::isinf(nothing.linkDistance(ball, Pose(), kTol).distance));
+}
+
+TEST(Environment, MeshObstacle) {
+  Obstacle crate;
+  crate.name = "crate";
+  crate.mesh = std::make_shared<const LinkGeometry>(boxSurface(Vec3(0.5, 0.5, 0.5)));
+  crate.pose = Pose::translation(Vec3(0, 0, 1));
+  const Environment env({crate});
+  const LinkGeometry ball = primitiveLink(Sphere(0.1));
+  EXPECT_TRUE(env.linkIntersects(ball, Pose::translation(Vec3(0, 0, 0.4)), kTol, GeometryMode::Mesh));
+  EXPECT_FALSE(env.linkIntersects(ball, Pose::translation(Vec3(0, 0, 0.4 - 1e-6)), kTol, GeometryMode::Mesh));
+  // Inside the crate's surface: only its hull is hit.
+  EXPECT_TRUE(env.linkIntersects(ball, Pose::translation(Vec3(0, 0, 1)), kTol, GeometryMode::Hull));
+  EXPECT_FALSE(env.linkIntersects(ball, Pose::translation(Vec3(0, 0, 1)), kTol, GeometryMode::Mesh));
+  EXPECT_NEAR(env.linkDistance(ball, Pose::translation(Vec3(0, 0, 0.2)), kTol).distance, 0.2, 1e-9);
+}
+
+// ---- Differential: every voxel by brute force -----------------------------------------------------------
+
+TEST(Environment, RandomLinksAgreeWithBruteForce) {
+  std::mt19937 rng(2024);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * unit(rng); };
+  std::vector<Aabb> voxels;
+  for (int i = 0; i < 150; ++i) {
+    const double edge = i % 10 == 0 ? 0.2 : 0.05;  // a few coarse leaves among the fine ones
+    const Vec3 lo(std::floor(uniform(-0.5, 0.5) / edge) * edge, std::floor(uniform(-0.5, 0.5) / edge) * edge,
+                  std::floor(uniform(-0.5, 0.5) / edge) * edge);
+    voxels.push_back(cube(lo, edge));
+  }
+  const Environment env({}, mapOf(voxels));
+  const auto randomPose = [&] {
+    const Eigen::Quaterniond q(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1), uniform(-1, 1));
+    Pose p;
+    p.R = q.normalized().toRotationMatrix();
+    p.t = Vec3(uniform(-0.7, 0.7), uniform(-0.7, 0.7), uniform(-0.7, 0.7));
+    return p;
+  };
+  int hits = 0, misses = 0, checked_distances = 0;
+  for (int trial = 0; trial < 240; ++trial) {
+    const Vec3 half(uniform(0.02, 0.3), uniform(0.02, 0.3), uniform(0.02, 0.3));
+    std::unique_ptr<LinkGeometry> link;
+    switch (trial % 3) {
+      case 0: link = std::make_unique<LinkGeometry>(primitiveLink(Box(half))); break;
+      case 1: link = std::make_unique<LinkGeometry>(primitiveLink(Sphere(half.x()), Pose::translation(half))); break;
+      default: link = std::make_unique<LinkGeometry>(boxSurface(half)); break;
+    }
+    const Pose pose = randomPose();
+    const double padding = trial % 4 == 0 ? uniform(0.0, 0.05) : 0.0;
+    for (const GeometryMode mode : kModes) {
+      bool brute = false;
+      for (const Aabb& v : voxels)
+        if (shapeIntersectsLink(Box(v.halfExtents()), Pose::translation(v.center()), *link, pose, kTol, mode, padding)) {
+          brute = true;
+          break;
+        }
+      EnvironmentHit hit;
+      const bool fast = env.linkIntersects(*link, pose, kTol, mode, padding, 0.0, &hit);
+      ASSERT_EQ(fast, brute) << "trial " << trial << " mode " << static_cast<int>(mode);
+      if (fast) {
+        ASSERT_EQ(hit.kind, EnvironmentHit::Kind::Voxel);
+        const Aabb& v = voxels[hit.index];
+        EXPECT_TRUE(
+            shapeIntersectsLink(Box(v.halfExtents()), Pose::translation(v.center()), *link, pose, kTol, mode, padding));
+      }
+      (fast ? hits : misses)++;
+    }
+    if (trial % 4 == 1) {
+      double nearest = INFINITY;
+      for (const Aabb& v : voxels)
+        nearest = std::min(nearest, shapeLinkDistance(Box(v.halfExtents()), Pose::translation(v.center()), *link, pose,
+                                                       kTol).distance);
+      const DistanceResult d = env.linkDistance(*link, pose, kTol);
+      EXPECT_NEAR(d.distance, nearest, 1e-9 + 1e-5 * nearest) << "trial " << trial;
+      EXPECT_LE(d.lower_bound, d.distance + 1e-12);
+      ++checked_distances;
+    }
+  }
+  // Both answers must be well represented for the comparison to mean anything.
+  EXPECT_GT(hits, 80);
+  EXPECT_GT(misses, 80);
+  EXPECT_GT(checked_distances, 50);
+}
+
+}  // namespace
+}  // namespace clearway
