@@ -3,6 +3,7 @@
 // line was bad (the others still ran), 2 on a usage error or an unreadable input.
 // A subcommand is a function of its own arguments; adding one is adding a row to kCommands.
 #include "query_file.h"
+#include "scene_commands.h"
 
 #include <cerrno>
 #include <cstring>
@@ -75,6 +76,7 @@ struct Command {
 };
 
 const Command kCommands[] = {
+    {"check", "classify joint vectors of a scene: free or which links collide", clearway::cli::checkCommand},
     {"query", "narrow-phase queries on shape pairs from a JSON Lines file", queryCommand},
 };
 

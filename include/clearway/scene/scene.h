@@ -1,0 +1,182 @@
+#pragma once
+// A planning scene: a robot (URDF, SRDF, the planned group, held joints, allowed pairs, padding), its
+// environment, and the effects it calls for. A scene computes only what it declares: without
+// `environment` no obstacle or voxel is looked at, without `clearance` no distance is computed, without
+// `moving` there is no time. Immutable once built; queries are thread-safe given one SceneContext per
+// thread (or through the convenience overloads, which keep one per thread themselves).
+#include <clearway/environment/environment.h>
+#include <clearway/kinematics/robot_model.h>
+#include <clearway/scene/collision_filter.h>
+#include <clearway/scene/self_collision.h>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace clearway {
+
+/// What a scene calls for (its `checks:` list).
+struct Effects {
+  bool self = false;         ///< robot link pairs against each other
+  bool environment = false;  ///< robot links against obstacles and the OctoMap
+  bool continuous = false;   ///< motions are certified segment by segment (motion/)
+  bool clearance = false;    ///< distances are computed (Scene::clearance)
+  bool moving = false;       ///< obstacles move with time
+  /// "self, environment, ..." in the order above.
+  std::string toString() const;
+};
+
+/// Why a state is not free.
+struct CollisionReport {
+  enum class Kind { None, Self, Environment, Invalid } kind = Kind::None;
+  int link = -1;        ///< the robot link (the first of the pair for Self)
+  int other_link = -1;  ///< Self: the second link
+  EnvironmentHit hit;   ///< Environment: what the link touched
+};
+
+/// Work done by queries of one context (cumulative), to show what a scene pays for what it asks.
+struct SceneCounters {
+  long long states = 0;         ///< isFree calls
+  long long invalid_states = 0; ///< states rejected before any geometry (NaN, out of bounds)
+  long long self_pair_tests = 0;
+  EnvironmentCounters environment;
+  long long clearance_queries = 0;
+};
+
+/// Per-thread scratch of scene queries. Made by Scene::makeContext; queries allocate nothing in it.
+struct SceneContext {
+  std::vector<double> q;       ///< the full joint vector (group values, held values, defaults)
+  std::vector<Pose> poses;     ///< world pose of every link
+  SelfCollisionContext self;
+  SceneCounters counters;
+};
+
+/// Everything a scene file says, after parsing and before loading anything (paths are absolute).
+struct SceneDescription {
+  std::string file;  ///< the scene file ("" for one built in code); errors name it
+  std::string name;
+  std::string urdf, srdf;
+  std::vector<std::string> group;                          ///< planned joints, in state order
+  std::vector<std::pair<std::string, double>> hold;        ///< other one-variable joints, fixed
+  std::vector<std::pair<std::string, std::string>> allow;  ///< extra link pairs never checked
+  double padding = 0.0;                                    ///< metres around every link
+  std::string octomap;                                     ///< "" when none
+  UnknownSpace unknown = UnknownSpace::Free;
+  struct ObstacleSpec {
+    std::string name;
+    Shape shape = Sphere(1.0);
+    std::string mesh_file;  ///< a mesh obstacle's file ("" for a shape)
+    Vec3 mesh_scale = Vec3::Ones();
+    Pose pose;
+    Vec3 velocity = Vec3::Zero();
+  };
+  std::vector<ObstacleSpec> obstacles;
+  Effects effects;
+  std::vector<double> start, goal;  ///< empty when the file gives none
+};
+
+/// Parses a scene file (DESIGN.md, "Scene files"). Throws LoadError(file, "key 'a.b'", reason) for an
+/// unknown key, a missing required key, a value of the wrong type or length, a non-finite number, an
+/// unknown check, or a file that is missing or not YAML.
+SceneDescription parseSceneFile(const std::string& path);
+
+/// The robot a description names (URDF, SRDF, meshes → trees and hulls). Throws LoadError.
+std::shared_ptr<const RobotGeometry> loadRobotGeometry(const SceneDescription& description);
+/// The environment a description names (obstacles, meshes, OctoMap). Throws LoadError.
+std::shared_ptr<const Environment> loadEnvironment(const SceneDescription& description);
+
+/// How a scene checks geometry (not part of the scene file: a choice of the caller).
+struct SceneOptions {
+  GeometryMode mode = GeometryMode::Mesh;
+  Tolerances tolerances;
+};
+
+class Scene {
+ public:
+  /// Loads the robot and environment a description names and checks that they fit together: every
+  /// group and hold joint exists, held joints are not in the group, allowed links exist, start and goal
+  /// have the group's length. Throws LoadError naming the scene file and key (or the robot file).
+  explicit Scene(const SceneDescription& description, const SceneOptions& options = {});
+  /// The scene with a robot already loaded (shared with other scenes) and an environment built in code.
+  Scene(const SceneDescription& description, std::shared_ptr<const RobotGeometry> robot,
+        std::shared_ptr<const Environment> environment, const SceneOptions& options = {});
+
+  /// parseSceneFile + the constructor.
+  static std::shared_ptr<const Scene> load(const std::string& path, const SceneOptions& options = {});
+
+  const SceneDescription& description() const noexcept { return description_; }
+  const std::string& name() const noexcept { return description_.name; }
+  const Effects& effects() const noexcept { return description_.effects; }
+  const RobotModel& robot() const noexcept { return geometry_->model(); }
+  const RobotGeometry& geometry() const noexcept { return *geometry_; }
+  const std::shared_ptr<const RobotGeometry>& geometryPtr() const noexcept { return geometry_; }
+  const Environment& environment() const noexcept { return *environment_; }
+  const SelfCollision& selfCollision() const noexcept { return self_; }
+  const CollisionFilter& filter() const noexcept { return filter_; }
+  const SceneOptions& options() const noexcept { return options_; }
+
+  /// The number of planned variables (the length of a state).
+  int dimension() const noexcept { return static_cast<int>(group_variables_.size()); }
+  /// Index in the robot's joint vector of each state entry.
+  const std::vector<int>& groupVariables() const noexcept { return group_variables_; }
+  /// Limits of each state entry (±infinity for continuous joints).
+  double lower(int i) const noexcept { return robot().variables()[group_variables_[i]].lower; }
+  double upper(int i) const noexcept { return robot().variables()[group_variables_[i]].upper; }
+  /// Links with geometry whose pose depends on the state (others never move, so self pairs among
+  /// them never change; they still meet obstacles).
+  const std::vector<int>& movingLinks() const noexcept { return moving_links_; }
+
+  /// Links checked against the environment at every state (static links are checked once, at construction).
+  const std::vector<int>& environmentLinks() const noexcept { return env_links_; }
+  /// Metres of padding around link i.
+  double linkPadding(int i) const noexcept { return link_padding_[i]; }
+  /// A collision no state can undo (between links that never move, or a static link and a static
+  /// obstacle), found at construction; kind None when there is none.
+  const CollisionReport& staticCollision() const noexcept { return static_collision_; }
+
+  /// A context for this scene (allocates: make one per thread and reuse it).
+  SceneContext makeContext() const;
+
+  /// Fills context.q (full joint vector) and context.poses from a state; no checks.
+  void computePoses(const double* state, SceneContext& context) const noexcept;
+
+  /// True when the state is within bounds and finite (then `why` is untouched), else false and `why`
+  /// names the entry, its value and the bound.
+  bool validState(const double* state, std::string* why = nullptr) const;
+
+  /// True when the state is valid and free of every declared collision effect at time t (t is used
+  /// only when the scene declares `moving`). `report` (optional) says what collided first.
+  bool isFree(const double* state, SceneContext& context, CollisionReport* report = nullptr,
+              double t = 0.0) const noexcept;
+  /// The same with this thread's own context.
+  bool isFree(const std::vector<double>& state, CollisionReport* report = nullptr, double t = 0.0) const;
+
+  /// The distance from the robot to the nearest declared hazard (environment and/or self), minus
+  /// padding; 0 when touching or colliding; NaN when the scene does not declare `clearance` or the
+  /// state is invalid. `lower_bound` (optional) receives a certified lower bound.
+  double clearance(const double* state, SceneContext& context, double* lower_bound = nullptr,
+                   double t = 0.0) const noexcept;
+
+  /// "link a / link b", "link / obstacle NAME", "link / voxel", "invalid state" for a report.
+  std::string describe(const CollisionReport& report) const;
+
+ private:
+  void init();
+  SceneContext& threadContext() const;
+
+  SceneDescription description_;
+  SceneOptions options_;
+  std::shared_ptr<const RobotGeometry> geometry_;
+  std::shared_ptr<const Environment> environment_;
+  CollisionFilter filter_;
+  SelfCollision self_;
+  std::vector<int> group_variables_;
+  std::vector<double> base_q_;  // held values and defaults; group entries overwritten per query
+  std::vector<int> moving_links_, env_links_;
+  std::vector<double> link_padding_;
+  CollisionReport static_collision_;  // a collision no state can undo (static links), found at construction
+  std::uint64_t serial_ = 0;  // identifies this scene's per-thread contexts
+};
+
+}  // namespace clearway

@@ -1,0 +1,94 @@
+#pragma once
+// Self-collision of a robot: every checked link pair (scene/collision_filter.h) tested with the link
+// geometries of shape/link_geometry.h at the link poses of one configuration. The checker is
+// immutable and shared by all threads; what changes from query to query (the separating axis of each
+// pair's hulls, the pair that collided last) lives in a SelfCollisionContext, one per thread.
+#include <clearway/kinematics/robot_model.h>
+#include <clearway/scene/collision_filter.h>
+#include <clearway/shape/link_geometry.h>
+#include <clearway/tolerances.h>
+
+#include <memory>
+#include <vector>
+
+namespace clearway {
+
+/// The collision geometry of every link of a robot (null for links without geometry). Immutable.
+class RobotGeometry {
+ public:
+  /// Builds each link's trees and hull from the model's collision elements. Throws ShapeError naming
+  /// the link when its geometry is unusable.
+  explicit RobotGeometry(std::shared_ptr<const RobotModel> model, const TreeBuildOptions& options = {});
+
+  const RobotModel& model() const noexcept { return *model_; }
+  const std::shared_ptr<const RobotModel>& modelPtr() const noexcept { return model_; }
+  /// Link i's geometry, or null when the link has no collision element.
+  const LinkGeometry* link(int i) const noexcept { return links_[i].get(); }
+  /// Links that have geometry, in link order.
+  const std::vector<int>& geometricLinks() const noexcept { return geometric_; }
+
+ private:
+  std::shared_ptr<const RobotModel> model_;
+  std::vector<std::unique_ptr<const LinkGeometry>> links_;
+  std::vector<int> geometric_;
+};
+
+/// Two links of one robot, a < b.
+struct LinkPair {
+  int a = -1, b = -1;
+  bool operator==(const LinkPair& o) const noexcept { return a == o.a && b == o.b; }
+};
+
+/// How self-collision is checked.
+struct SelfCollisionOptions {
+  GeometryMode mode = GeometryMode::Mesh;
+  Tolerances tolerances;
+  /// Metres added around each link (indexed by link; empty: none). A pair collides when its links are
+  /// within padding[a] + padding[b]. Must be finite and ≥ 0.
+  std::vector<double> link_padding;
+};
+
+/// Per-thread state of self-collision queries: one hull cache per pair and the pair that last collided.
+struct SelfCollisionContext {
+  std::vector<SimplexCache> pair_caches;
+  int last_hit = -1;
+  long long pair_tests = 0;  ///< pairs that reached the narrow phase (bounding spheres not apart), cumulative
+};
+
+/// Self-collision checker of one robot with one filter. Immutable; queries are thread-safe given one
+/// context per thread.
+class SelfCollision {
+ public:
+  /// Throws std::invalid_argument when padding has the wrong length or a negative or non-finite entry.
+  SelfCollision(std::shared_ptr<const RobotGeometry> geometry, const CollisionFilter& filter,
+                SelfCollisionOptions options = {});
+
+  const RobotGeometry& geometry() const noexcept { return *geometry_; }
+  /// The pairs checked, sorted.
+  const std::vector<LinkPair>& pairs() const noexcept { return pairs_; }
+  const SelfCollisionOptions& options() const noexcept { return options_; }
+  /// The padding of pair k (the sum of its links' paddings).
+  double pairPadding(int k) const noexcept { return pair_padding_[k]; }
+  /// A fresh context for this checker (allocates; make one per thread and reuse it).
+  SelfCollisionContext makeContext() const;
+
+  /// The first colliding pair at these world link poses (one per link), or nullptr when none collides.
+  /// The pair that collided in the previous query of this context is tried first (frame coherence).
+  /// Never "free" by accident: a non-finite pose collides.
+  const LinkPair* firstCollision(const Pose* link_poses, SelfCollisionContext& context) const noexcept;
+  /// Every colliding pair at these poses, appended to `out` in pair order.
+  void allCollisions(const Pose* link_poses, SelfCollisionContext& context, std::vector<LinkPair>& out) const;
+  /// True when pair index k collides at these poses.
+  bool pairCollides(int k, const Pose* link_poses, SelfCollisionContext& context) const noexcept;
+  /// The clearance of the closest checked pair (distance between exact geometries, minus padding; 0 when
+  /// touching); `pair` (optional) receives it. relative_error as in meshDistance. Infinity with no pairs.
+  DistanceResult minimumDistance(const Pose* link_poses, LinkPair* pair = nullptr, double relative_error = 0.0) const;
+
+ private:
+  std::shared_ptr<const RobotGeometry> geometry_;
+  std::vector<LinkPair> pairs_;
+  std::vector<double> pair_padding_;
+  SelfCollisionOptions options_;
+};
+
+}  // namespace clearway

@@ -1,0 +1,365 @@
+#include <clearway/scene/scene.h>
+
+#include <clearway/kinematics/forward_kinematics.h>
+#include <clearway/load/robot_loader.h>
+
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+namespace clearway {
+
+namespace {
+
+std::atomic<std::uint64_t> g_next_serial{1};
+
+}  // namespace
+
+std::shared_ptr<const RobotGeometry> loadRobotGeometry(const SceneDescription& d) {
+  auto model = std::make_shared<const RobotModel>(loadRobot(d.urdf, d.srdf));
+  return std::make_shared<const RobotGeometry>(std::move(model));
+}
+
+std::shared_ptr<const Environment> loadEnvironment(const SceneDescription& d) {
+  std::vector<Obstacle> obstacles;
+  for (std::size_t i = 0; i < d.obstacles.size(); ++i) {
+    const SceneDescription::ObstacleSpec& s = d.obstacles[i];
+    Obstacle o;
+    o.name = s.name;
+    o.shape = s.shape;
+    o.pose = s.pose;
+    o.velocity = s.velocity;
+    if (!s.mesh_file.empty()) {
+      std::vector<std::string> warnings;
+      const TriangleMesh mesh = loadMesh(s.mesh_file, s.mesh_scale, &warnings);
+      try {
+        o.mesh = std::make_shared<const LinkGeometry>(mesh);
+      } catch (const std::exception& e) {
+        throw LoadError(d.file, "key 'environment.obstacles[" + std::to_string(i) + "].mesh'", e.what());
+      }
+    }
+    obstacles.push_back(std::move(o));
+  }
+  std::shared_ptr<const OccupancyMap> map;
+  if (!d.octomap.empty()) map = std::make_shared<const OccupancyMap>(loadOctomap(d.octomap, d.unknown));
+  return std::make_shared<const Environment>(std::move(obstacles), std::move(map));
+}
+
+Scene::Scene(const SceneDescription& description, const SceneOptions& options)
+    : Scene(description, loadRobotGeometry(description), loadEnvironment(description), options) {}
+
+Scene::Scene(const SceneDescription& description, std::shared_ptr<const RobotGeometry> robot,
+             std::shared_ptr<const Environment> environment, const SceneOptions& options)
+    : description_(description),
+      options_(options),
+      geometry_(std::move(robot)),
+      environment_(environment ? std::move(environment) : std::make_shared<const Environment>()),
+      filter_(geometry_->model()),
+      self_(geometry_, filter_),
+      serial_(g_next_serial++) {
+  init();
+}
+
+std::shared_ptr<const Scene> Scene::load(const std::string& path, const SceneOptions& options) {
+  return std::make_shared<const Scene>(parseSceneFile(path), options);
+}
+
+void Scene::init() {
+  const RobotModel& model = geometry_->model();
+  const std::string& file = description_.file;
+  auto fail = [&](const std::string& key, const std::string& reason) {
+    throw LoadError(file, "key '" + key + "'", reason);
+  };
+
+  // Group and held joints → entries of the robot's joint vector.
+  const int nv = model.variableCount();
+  std::vector<char> taken(nv, 0);
+  for (std::size_t i = 0; i < description_.group.size(); ++i) {
+    const std::string key = "robot.group[" + std::to_string(i) + "]";
+    const std::string& name = description_.group[i];
+    const int j = model.jointIndex(name);
+    if (j < 0) fail(key, "joint '" + name + "' is not in robot '" + model.name() + "' (" + description_.urdf + ")");
+    const Joint& joint = model.joint(j);
+    if (joint.first_variable < 0)
+      fail(key, "joint '" + name + "' is " + (joint.isMimic() ? "a mimic" : "fixed") + ": it has no value to plan");
+    for (int k = 0; k < jointVariableCount(joint.type); ++k) {
+      const int v = joint.first_variable + k;
+      if (taken[v]) fail(key, "joint '" + name + "' is listed twice");
+      taken[v] = 1;
+      group_variables_.push_back(v);
+    }
+  }
+  base_q_.assign(nv, 0.0);
+  for (int v = 0; v < nv; ++v) {
+    const JointVariable& var = model.variables()[v];
+    // MoveIt's default: zero when the limits allow it, else the middle of the limits.
+    if (!(var.lower <= 0.0 && 0.0 <= var.upper) && std::isfinite(var.lower) && std::isfinite(var.upper))
+      base_q_[v] = 0.5 * (var.lower + var.upper);
+    if (var.name.size() > 3 && var.name.compare(var.name.size() - 3, 3, "/qw") == 0) base_q_[v] = 1.0;
+  }
+  std::vector<std::pair<int, double>> mimic_holds;
+  for (const auto& [name, value] : description_.hold) {
+    const std::string key = "robot.hold." + name;
+    const int j = model.jointIndex(name);
+    if (j < 0) fail(key, "joint '" + name + "' is not in robot '" + model.name() + "'");
+    const Joint& joint = model.joint(j);
+    if (joint.type == JointType::Fixed) {
+      // A fixed joint has no value; MoveIt's converters still list it at 0, which says nothing.
+      if (value != 0.0) fail(key, "joint '" + name + "' is fixed: it cannot be held at " + std::to_string(value));
+      continue;
+    }
+    if (joint.isMimic()) {
+      mimic_holds.emplace_back(j, value);  // checked below, once the leader's value is known
+      continue;
+    }
+    if (joint.first_variable < 0 || jointVariableCount(joint.type) != 1)
+      fail(key, "joint '" + name + "' does not have exactly one value to hold");
+    if (taken[joint.first_variable]) fail(key, "joint '" + name + "' is in the group: it cannot also be held");
+    base_q_[joint.first_variable] = value;  // without clamping, as MoveIt applies a held state
+  }
+  // A mimic joint follows its leader; a held value for it is accepted when it says the same.
+  for (const auto& [j, value] : mimic_holds) {
+    const Joint& joint = model.joint(j);
+    const Joint& leader = model.joint(joint.mimic.joint);
+    const std::string key = "robot.hold." + joint.name;
+    if (taken[leader.first_variable])
+      fail(key, "joint '" + joint.name + "' mimics '" + leader.name + "', which is in the group");
+    const double follows = joint.mimic.multiplier * base_q_[leader.first_variable] + joint.mimic.offset;
+    if (std::abs(follows - value) > 1e-9 * std::max(1.0, std::abs(value)))
+      fail(key, "joint '" + joint.name + "' mimics '" + leader.name + "' and so is " + std::to_string(follows) +
+                    ", not " + std::to_string(value));
+  }
+  const std::size_t n = group_variables_.size();
+  if (!description_.start.empty() && description_.start.size() != n)
+    fail("start", "has " + std::to_string(description_.start.size()) + " values for " + std::to_string(n) + " group variables");
+  if (!description_.goal.empty() && description_.goal.size() != n)
+    fail("goal", "has " + std::to_string(description_.goal.size()) + " values for " + std::to_string(n) + " group variables");
+
+  // Allowed pairs. The self checker is rebuilt with them (and with the pairs that can never move
+  // relative to each other, which are checked once here instead of at every state).
+  for (std::size_t i = 0; i < description_.allow.size(); ++i) {
+    const auto& [a, b] = description_.allow[i];
+    const std::string key = "robot.allow[" + std::to_string(i) + "]";
+    const int la = model.linkIndex(a), lb = model.linkIndex(b);
+    if (la < 0) fail(key, "link '" + a + "' is not in robot '" + model.name() + "'");
+    if (lb < 0) fail(key, "link '" + b + "' is not in robot '" + model.name() + "'");
+    if (la == lb) fail(key, "a link paired with itself");
+    filter_.disable(la, lb, "allowed by scene");
+  }
+
+  // A link moves with the state when a group variable (or a mimic of one) lies on its chain.
+  std::vector<char> moves(model.linkCount(), 0);
+  std::vector<char> joint_moves(model.jointCount(), 0);
+  for (int j = 0; j < model.jointCount(); ++j) {
+    const Joint& joint = model.joint(j);
+    const Joint& owner = joint.isMimic() ? model.joint(joint.mimic.joint) : joint;
+    for (int k = 0; k < jointVariableCount(owner.type) && owner.first_variable >= 0; ++k)
+      if (taken[owner.first_variable + k]) joint_moves[j] = 1;
+  }
+  for (int i = 1; i < model.linkCount(); ++i) {
+    const int j = model.link(i).parent_joint;
+    moves[i] = moves[model.parentLink(i)] || joint_moves[j];
+  }
+  for (int i : geometry_->geometricLinks()) {
+    if (moves[i]) moving_links_.push_back(i);
+    // Static links meet static obstacles the same way at every state: checked once below.
+    if (moves[i] || environment_->hasMovingObstacles()) env_links_.push_back(i);
+  }
+
+  link_padding_.assign(model.linkCount(), description_.padding);
+  CollisionFilter moving_filter = filter_;
+  std::vector<std::pair<int, int>> static_pairs;
+  for (const auto& [a, b] : filter_.enabledPairs())
+    if (!moves[a] && !moves[b]) {
+      static_pairs.emplace_back(a, b);
+      moving_filter.disable(a, b, "never moves");
+    }
+  SelfCollisionOptions so;
+  so.mode = options_.mode;
+  so.tolerances = options_.tolerances;
+  so.link_padding = link_padding_;
+  self_ = SelfCollision(geometry_, moving_filter, so);
+
+  // The parts of the scene that no state changes: decided once, reported at every state.
+  std::vector<Pose> poses(model.linkCount());
+  computeLinkPoses(model, base_q_.data(), poses.data());
+  if (description_.effects.self)
+    for (const auto& [a, b] : static_pairs)
+      if (meshesIntersect(*geometry_->link(a), poses[a], *geometry_->link(b), poses[b], options_.tolerances,
+                          options_.mode, link_padding_[a] + link_padding_[b])) {
+        static_collision_.kind = CollisionReport::Kind::Self;
+        static_collision_.link = a;
+        static_collision_.other_link = b;
+        break;
+      }
+  if (description_.effects.environment && static_collision_.kind == CollisionReport::Kind::None &&
+      !environment_->hasMovingObstacles())
+    for (int i : geometry_->geometricLinks()) {
+      if (moves[i]) continue;
+      EnvironmentHit hit;
+      if (environment_->linkIntersects(*geometry_->link(i), poses[i], options_.tolerances, options_.mode,
+                                       link_padding_[i], 0.0, &hit)) {
+        static_collision_.kind = CollisionReport::Kind::Environment;
+        static_collision_.link = i;
+        static_collision_.hit = hit;
+        break;
+      }
+    }
+}
+
+SceneContext Scene::makeContext() const {
+  SceneContext c;
+  c.q = base_q_;
+  c.poses.resize(robot().linkCount());
+  c.self = self_.makeContext();
+  return c;
+}
+
+void Scene::computePoses(const double* state, SceneContext& ctx) const noexcept {
+  for (std::size_t i = 0; i < group_variables_.size(); ++i) ctx.q[group_variables_[i]] = state[i];
+  computeLinkPoses(robot(), ctx.q.data(), ctx.poses.data());
+}
+
+bool Scene::validState(const double* state, std::string* why) const {
+  const RobotModel& model = robot();
+  for (std::size_t i = 0; i < group_variables_.size(); ++i) {
+    const JointVariable& var = model.variables()[group_variables_[i]];
+    const double x = state[i];
+    if (!std::isfinite(x)) {
+      if (why) *why = "state[" + std::to_string(i) + "] (" + var.name + ") is not finite";
+      return false;
+    }
+    if (x < var.lower - kJointLimitTolerance || x > var.upper + kJointLimitTolerance) {
+      if (why)
+        *why = "state[" + std::to_string(i) + "] (" + var.name + ") = " + std::to_string(x) + " is outside [" +
+               std::to_string(var.lower) + ", " + std::to_string(var.upper) + "]";
+      return false;
+    }
+  }
+  return true;
+}
+
+bool Scene::isFree(const double* state, SceneContext& ctx, CollisionReport* report, double t) const noexcept {
+  ++ctx.counters.states;
+  CollisionReport local;
+  CollisionReport& r = report ? *report : local;
+  r = CollisionReport{};
+  bool valid = true;
+  for (std::size_t i = 0; i < group_variables_.size() && valid; ++i) {
+    const JointVariable& var = robot().variables()[group_variables_[i]];
+    // Written so that a NaN fails.
+    valid = state[i] >= var.lower - kJointLimitTolerance && state[i] <= var.upper + kJointLimitTolerance;
+  }
+  if (!valid) {
+    ++ctx.counters.invalid_states;
+    r.kind = CollisionReport::Kind::Invalid;
+    return false;
+  }
+  if (static_collision_.kind != CollisionReport::Kind::None) {
+    r = static_collision_;
+    return false;
+  }
+  const Effects& fx = description_.effects;
+  if (!fx.self && !fx.environment) return true;
+  computePoses(state, ctx);
+  if (fx.environment && !environment_->empty()) {
+    const double time = fx.moving ? t : 0.0;
+    for (int i : env_links_) {
+      EnvironmentHit hit;
+      if (environment_->linkIntersects(*geometry_->link(i), ctx.poses[i], options_.tolerances, options_.mode,
+                                       link_padding_[i], time, &hit, &ctx.counters.environment)) {
+        r.kind = CollisionReport::Kind::Environment;
+        r.link = i;
+        r.hit = hit;
+        return false;
+      }
+    }
+  }
+  if (fx.self) {
+    const long long before = ctx.self.pair_tests;
+    const LinkPair* hit = self_.firstCollision(ctx.poses.data(), ctx.self);
+    ctx.counters.self_pair_tests += ctx.self.pair_tests - before;
+    if (hit) {
+      r.kind = CollisionReport::Kind::Self;
+      r.link = hit->a;
+      r.other_link = hit->b;
+      return false;
+    }
+  }
+  return true;
+}
+
+bool Scene::isFree(const std::vector<double>& state, CollisionReport* report, double t) const {
+  if (static_cast<int>(state.size()) != dimension()) {
+    if (report) {
+      *report = CollisionReport{};
+      report->kind = CollisionReport::Kind::Invalid;
+    }
+    return false;
+  }
+  return isFree(state.data(), threadContext(), report, t);
+}
+
+SceneContext& Scene::threadContext() const {
+  // Keyed by serial, not address: a new scene at a freed scene's address must not inherit its caches.
+  thread_local std::unordered_map<std::uint64_t, SceneContext> contexts;
+  auto it = contexts.find(serial_);
+  if (it == contexts.end()) it = contexts.emplace(serial_, makeContext()).first;
+  return it->second;
+}
+
+double Scene::clearance(const double* state, SceneContext& ctx, double* lower_bound, double t) const noexcept {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const Effects& fx = description_.effects;
+  if (!fx.clearance) return nan;
+  bool valid = true;
+  for (std::size_t i = 0; i < group_variables_.size() && valid; ++i) {
+    const JointVariable& var = robot().variables()[group_variables_[i]];
+    valid = state[i] >= var.lower - kJointLimitTolerance && state[i] <= var.upper + kJointLimitTolerance;
+  }
+  if (!valid) return nan;
+  ++ctx.counters.clearance_queries;
+  computePoses(state, ctx);
+  double best = std::numeric_limits<double>::infinity(), lower = best;
+  if (fx.environment && !environment_->empty()) {
+    const double time = fx.moving ? t : 0.0;
+    for (int i : geometry_->geometricLinks()) {
+      const DistanceResult d = environment_->linkDistance(*geometry_->link(i), ctx.poses[i], options_.tolerances,
+                                                          best + link_padding_[i], time, 0.0, &ctx.counters.environment);
+      if (isFailure(d.status)) {
+        best = lower = 0.0;
+        break;
+      }
+      best = std::min(best, std::max(0.0, d.distance - link_padding_[i]));
+      lower = std::min(lower, std::max(0.0, d.lower_bound - link_padding_[i]));
+    }
+  }
+  if (fx.self && best > 0.0) {
+    const DistanceResult d = self_.minimumDistance(ctx.poses.data());
+    if (isFailure(d.status)) {
+      best = lower = 0.0;
+    } else {
+      best = std::min(best, d.distance);
+      lower = std::min(lower, d.lower_bound);
+    }
+  }
+  if (lower_bound) *lower_bound = lower;
+  return best;
+}
+
+std::string Scene::describe(const CollisionReport& r) const {
+  const RobotModel& model = robot();
+  switch (r.kind) {
+    case CollisionReport::Kind::None: return "free";
+    case CollisionReport::Kind::Invalid: return "invalid state";
+    case CollisionReport::Kind::Self: return model.link(r.link).name + " " + model.link(r.other_link).name;
+    case CollisionReport::Kind::Environment:
+      if (r.hit.kind == EnvironmentHit::Kind::Obstacle)
+        return model.link(r.link).name + " " + environment_->obstacles()[r.hit.index].name;
+      return model.link(r.link).name + " octomap";
+  }
+  return "?";
+}
+
+}  // namespace clearway

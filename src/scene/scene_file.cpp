@@ -1,0 +1,243 @@
+// The scene file (DESIGN.md, "Scene files"): YAML in, a SceneDescription out, every error naming the
+// file and the key. Strict: an unknown key is an error, because a misspelt `padding` silently ignored
+// is a collision silently missed.
+#include <clearway/scene/scene.h>
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <filesystem>
+#include <set>
+
+namespace clearway {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+class Parser {
+ public:
+  explicit Parser(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const std::string& key, const std::string& reason) const {
+    throw LoadError(file_, key.empty() ? "" : "key '" + key + "'", reason);
+  }
+  std::string where(const YAML::Node& n) const {
+    const YAML::Mark m = n.Mark();
+    return m.line >= 0 ? " (line " + std::to_string(m.line + 1) + ")" : "";
+  }
+
+  void requireMap(const YAML::Node& n, const std::string& key, const std::set<std::string>& allowed) const {
+    if (!n.IsMap()) fail(key, "expected a mapping" + where(n));
+    for (const auto& kv : n) {
+      const std::string k = kv.first.as<std::string>();
+      if (!allowed.count(k)) fail(key.empty() ? k : key + "." + k, "unknown key" + where(kv.first));
+    }
+  }
+
+  double number(const YAML::Node& n, const std::string& key) const {
+    if (!n.IsScalar()) fail(key, "expected a number" + where(n));
+    double v = 0.0;
+    const std::string s = n.Scalar();
+    // yaml-cpp reads ".nan" and ".inf"; a plain "nan" too. Either way: not a usable number.
+    if (!YAML::convert<double>::decode(n, v)) fail(key, "'" + s + "' is not a number" + where(n));
+    if (!std::isfinite(v)) fail(key, "'" + s + "' is not a finite number" + where(n));
+    return v;
+  }
+  std::string text(const YAML::Node& n, const std::string& key) const {
+    if (!n.IsScalar() || n.Scalar().empty()) fail(key, "expected a non-empty string" + where(n));
+    return n.Scalar();
+  }
+  std::vector<double> numbers(const YAML::Node& n, const std::string& key, int length = -1) const {
+    if (!n.IsSequence()) fail(key, "expected a list of numbers" + where(n));
+    if (length >= 0 && static_cast<int>(n.size()) != length)
+      fail(key, "expected " + std::to_string(length) + " numbers, got " + std::to_string(n.size()) + where(n));
+    std::vector<double> v;
+    for (std::size_t i = 0; i < n.size(); ++i) v.push_back(number(n[i], key + "[" + std::to_string(i) + "]"));
+    return v;
+  }
+  Vec3 vec3(const YAML::Node& n, const std::string& key) const {
+    const std::vector<double> v = numbers(n, key, 3);
+    return {v[0], v[1], v[2]};
+  }
+  std::vector<std::string> names(const YAML::Node& n, const std::string& key) const {
+    if (!n.IsSequence()) fail(key, "expected a list of names" + where(n));
+    std::vector<std::string> v;
+    for (std::size_t i = 0; i < n.size(); ++i) v.push_back(text(n[i], key + "[" + std::to_string(i) + "]"));
+    return v;
+  }
+  // A path relative to the scene file's folder.
+  std::string path(const YAML::Node& n, const std::string& key) const {
+    const fs::path p = text(n, key);
+    const fs::path full = p.is_absolute() ? p : fs::path(file_).parent_path() / p;
+    std::error_code ec;
+    if (!fs::is_regular_file(full, ec)) fail(key, "file not found: " + full.string() + where(n));
+    return full.lexically_normal().string();
+  }
+
+  Pose pose(const YAML::Node& n, const std::string& key) const {
+    requireMap(n, key, {"position", "orientation"});
+    Vec3 t = Vec3::Zero();
+    if (n["position"]) t = vec3(n["position"], key + ".position");
+    if (!n["orientation"]) return Pose::translation(t);
+    const std::vector<double> q = numbers(n["orientation"], key + ".orientation", 4);
+    const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    if (!(norm > 1e-6)) fail(key + ".orientation", "a zero quaternion is not a rotation" + where(n));
+    if (std::abs(norm - 1.0) > 1e-3)
+      fail(key + ".orientation", "quaternion (x, y, z, w) has norm " + std::to_string(norm) + ", not 1" + where(n));
+    return Pose::fromQuaternion(q[0], q[1], q[2], q[3], t);
+  }
+
+  void obstacle(const YAML::Node& n, const std::string& key, SceneDescription& d) const {
+    requireMap(n, key, {"name", "box", "sphere", "cylinder", "capsule", "mesh", "pose", "velocity"});
+    SceneDescription::ObstacleSpec o;
+    o.name = n["name"] ? text(n["name"], key + ".name") : key;
+    int kinds = 0;
+    try {
+      if (const YAML::Node b = n["box"]) {
+        ++kinds;
+        requireMap(b, key + ".box", {"size"});
+        if (!b["size"]) fail(key + ".box.size", "missing");
+        o.shape = Box(0.5 * vec3(b["size"], key + ".box.size"));
+      }
+      if (const YAML::Node s = n["sphere"]) {
+        ++kinds;
+        requireMap(s, key + ".sphere", {"radius"});
+        if (!s["radius"]) fail(key + ".sphere.radius", "missing");
+        o.shape = Sphere(number(s["radius"], key + ".sphere.radius"));
+      }
+      for (const char* kind : {"cylinder", "capsule"}) {
+        const YAML::Node c = n[kind];
+        if (!c) continue;
+        ++kinds;
+        const std::string k = key + "." + kind;
+        requireMap(c, k, {"radius", "length"});
+        if (!c["radius"]) fail(k + ".radius", "missing");
+        if (!c["length"]) fail(k + ".length", "missing");
+        const double r = number(c["radius"], k + ".radius"), h = 0.5 * number(c["length"], k + ".length");
+        if (std::string(kind) == "cylinder") o.shape = Cylinder(r, h);
+        else o.shape = Capsule(r, h);
+      }
+      if (const YAML::Node m = n["mesh"]) {
+        ++kinds;
+        requireMap(m, key + ".mesh", {"file", "scale"});
+        if (!m["file"]) fail(key + ".mesh.file", "missing");
+        o.mesh_file = path(m["file"], key + ".mesh.file");
+        if (m["scale"]) {
+          if (m["scale"].IsScalar()) o.mesh_scale = Vec3::Constant(number(m["scale"], key + ".mesh.scale"));
+          else o.mesh_scale = vec3(m["scale"], key + ".mesh.scale");
+        }
+      }
+    } catch (const ShapeError& e) {
+      fail(key, e.what() + where(n));
+    }
+    if (kinds != 1) fail(key, "an obstacle needs exactly one of box, sphere, cylinder, capsule, mesh" + where(n));
+    if (n["pose"]) o.pose = pose(n["pose"], key + ".pose");
+    if (n["velocity"]) o.velocity = vec3(n["velocity"], key + ".velocity");
+    d.obstacles.push_back(std::move(o));
+  }
+
+  SceneDescription parse() const {
+    YAML::Node root;
+    std::error_code ec;
+    if (!fs::is_regular_file(file_, ec)) fail("", "scene file not found");
+    try {
+      root = YAML::LoadFile(file_);
+    } catch (const YAML::Exception& e) {
+      fail("", std::string("not valid YAML: ") + e.what());
+    }
+    SceneDescription d;
+    d.file = file_;
+    requireMap(root, "", {"format", "name", "source", "robot", "environment", "checks", "start", "goal"});
+    if (!root["format"]) fail("format", "missing (this reader knows format 1)");
+    if (number(root["format"], "format") != 1.0) fail("format", "unsupported format " + root["format"].Scalar() + " (this reader knows 1)");
+    d.name = root["name"] ? text(root["name"], "name") : fs::path(file_).stem().string();
+
+    const YAML::Node robot = root["robot"];
+    if (!robot) fail("robot", "missing");
+    requireMap(robot, "robot", {"urdf", "srdf", "group", "hold", "allow", "padding"});
+    if (!robot["urdf"]) fail("robot.urdf", "missing");
+    d.urdf = path(robot["urdf"], "robot.urdf");
+    if (robot["srdf"] && !robot["srdf"].IsNull()) d.srdf = path(robot["srdf"], "robot.srdf");
+    if (!robot["group"]) fail("robot.group", "missing");
+    d.group = names(robot["group"], "robot.group");
+    if (d.group.empty()) fail("robot.group", "an empty group has nothing to plan");
+    if (const YAML::Node h = robot["hold"]; h && !h.IsNull()) {
+      if (!h.IsMap()) fail("robot.hold", "expected a mapping of joint: value" + where(h));
+      for (const auto& kv : h) {
+        const std::string j = kv.first.as<std::string>();
+        d.hold.emplace_back(j, number(kv.second, "robot.hold." + j));
+      }
+    }
+    if (const YAML::Node a = robot["allow"]; a && !a.IsNull()) {
+      if (!a.IsSequence()) fail("robot.allow", "expected a list of [link, link] pairs" + where(a));
+      for (std::size_t i = 0; i < a.size(); ++i) {
+        const std::string k = "robot.allow[" + std::to_string(i) + "]";
+        const std::vector<std::string> p = names(a[i], k);
+        if (p.size() != 2) fail(k, "expected 2 link names, got " + std::to_string(p.size()) + where(a[i]));
+        d.allow.emplace_back(p[0], p[1]);
+      }
+    }
+    if (robot["padding"]) {
+      d.padding = number(robot["padding"], "robot.padding");
+      if (d.padding < 0.0) fail("robot.padding", "must be >= 0" + where(robot["padding"]));
+    }
+
+    if (const YAML::Node env = root["environment"]; env && !env.IsNull()) {
+      requireMap(env, "environment", {"octomap", "unknown", "obstacles"});
+      if (env["octomap"]) d.octomap = path(env["octomap"], "environment.octomap");
+      if (env["unknown"]) {
+        const std::string u = text(env["unknown"], "environment.unknown");
+        if (u == "free") d.unknown = UnknownSpace::Free;
+        else if (u == "occupied") d.unknown = UnknownSpace::Occupied;
+        else fail("environment.unknown", "'" + u + "' is neither free nor occupied" + where(env["unknown"]));
+      }
+      if (const YAML::Node obs = env["obstacles"]; obs && !obs.IsNull()) {
+        if (!obs.IsSequence()) fail("environment.obstacles", "expected a list" + where(obs));
+        for (std::size_t i = 0; i < obs.size(); ++i)
+          obstacle(obs[i], "environment.obstacles[" + std::to_string(i) + "]", d);
+      }
+    }
+
+    if (!root["checks"]) fail("checks", "missing: say what the scene needs (self, environment, ...)");
+    for (const std::string& c : names(root["checks"], "checks")) {
+      if (c == "self") d.effects.self = true;
+      else if (c == "environment") d.effects.environment = true;
+      else if (c == "continuous") d.effects.continuous = true;
+      else if (c == "clearance") d.effects.clearance = true;
+      else if (c == "moving") d.effects.moving = true;
+      else fail("checks", "unknown check '" + c + "' (self, environment, continuous, clearance, moving)");
+    }
+    bool any_moving = false;
+    for (const auto& o : d.obstacles) any_moving = any_moving || o.velocity != Vec3::Zero();
+    if (any_moving && !d.effects.moving)
+      fail("checks", "an obstacle has a velocity but 'moving' is not among the checks");
+
+    const int n = static_cast<int>(d.group.size());
+    if (root["start"]) d.start = numbers(root["start"], "start", n);
+    if (root["goal"]) d.goal = numbers(root["goal"], "goal", n);
+    return d;
+  }
+
+ private:
+  std::string file_;
+};
+
+}  // namespace
+
+SceneDescription parseSceneFile(const std::string& path) { return Parser(path).parse(); }
+
+std::string Effects::toString() const {
+  std::string s;
+  auto add = [&](bool on, const char* name) {
+    if (on) s += (s.empty() ? "" : ", ") + std::string(name);
+  };
+  add(self, "self");
+  add(environment, "environment");
+  add(continuous, "continuous");
+  add(clearance, "clearance");
+  add(moving, "moving");
+  return s;
+}
+
+}  // namespace clearway

@@ -1,0 +1,108 @@
+#include <clearway/scene/self_collision.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace clearway {
+
+RobotGeometry::RobotGeometry(std::shared_ptr<const RobotModel> model, const TreeBuildOptions& options)
+    : model_(std::move(model)) {
+  if (!model_) throw std::invalid_argument("RobotGeometry: null robot model");
+  links_.resize(model_->linkCount());
+  for (int i = 0; i < model_->linkCount(); ++i) {
+    const Link& link = model_->link(i);
+    if (link.collisions.empty()) continue;
+    try {
+      links_[i] = std::make_unique<const LinkGeometry>(link.collisions, model_->meshes(), options);
+    } catch (const std::exception& e) {
+      throw ShapeError("robot '" + model_->name() + "': link '" + link.name + "': " + e.what());
+    }
+    geometric_.push_back(i);
+  }
+}
+
+SelfCollision::SelfCollision(std::shared_ptr<const RobotGeometry> geometry, const CollisionFilter& filter,
+                             SelfCollisionOptions options)
+    : geometry_(std::move(geometry)), options_(std::move(options)) {
+  if (!geometry_) throw std::invalid_argument("SelfCollision: null robot geometry");
+  const int n = geometry_->model().linkCount();
+  if (filter.linkCount() != n)
+    throw std::invalid_argument("SelfCollision: the filter was made for a robot of " +
+                                std::to_string(filter.linkCount()) + " links, not " + std::to_string(n));
+  std::vector<double>& pad = options_.link_padding;
+  if (pad.empty()) pad.assign(n, 0.0);
+  if (static_cast<int>(pad.size()) != n)
+    throw std::invalid_argument("SelfCollision: link_padding has " + std::to_string(pad.size()) +
+                                " entries for " + std::to_string(n) + " links");
+  for (int i = 0; i < n; ++i)
+    if (!(pad[i] >= 0.0) || !std::isfinite(pad[i]))
+      throw std::invalid_argument("SelfCollision: link_padding of link '" + geometry_->model().link(i).name +
+                                  "' is " + std::to_string(pad[i]) + ": must be finite and >= 0");
+  for (const auto& [a, b] : filter.enabledPairs()) {
+    if (!geometry_->link(a) || !geometry_->link(b)) continue;
+    pairs_.push_back({a, b});
+    pair_padding_.push_back(pad[a] + pad[b]);
+  }
+}
+
+SelfCollisionContext SelfCollision::makeContext() const {
+  SelfCollisionContext c;
+  c.pair_caches.resize(pairs_.size());
+  return c;
+}
+
+bool SelfCollision::pairCollides(int k, const Pose* poses, SelfCollisionContext& ctx) const noexcept {
+  const LinkPair& p = pairs_[k];
+  ++ctx.pair_tests;
+  SimplexCache* cache = k < static_cast<int>(ctx.pair_caches.size()) ? &ctx.pair_caches[k] : nullptr;
+  return meshesIntersect(*geometry_->link(p.a), poses[p.a], *geometry_->link(p.b), poses[p.b], options_.tolerances,
+                         options_.mode, pair_padding_[k], cache);
+}
+
+const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionContext& ctx) const noexcept {
+  const int n = static_cast<int>(pairs_.size());
+  // A pair that collided a moment ago probably still does: trying it first ends most colliding queries
+  // of a planner exploring near an obstacle after one pair test.
+  if (ctx.last_hit >= 0 && ctx.last_hit < n && pairCollides(ctx.last_hit, poses, ctx)) return &pairs_[ctx.last_hit];
+  for (int k = 0; k < n; ++k) {
+    if (k == ctx.last_hit) continue;
+    if (pairCollides(k, poses, ctx)) {
+      ctx.last_hit = k;
+      return &pairs_[k];
+    }
+  }
+  ctx.last_hit = -1;
+  return nullptr;
+}
+
+void SelfCollision::allCollisions(const Pose* poses, SelfCollisionContext& ctx, std::vector<LinkPair>& out) const {
+  for (int k = 0; k < static_cast<int>(pairs_.size()); ++k)
+    if (pairCollides(k, poses, ctx)) out.push_back(pairs_[k]);
+}
+
+DistanceResult SelfCollision::minimumDistance(const Pose* poses, LinkPair* pair, double relative_error) const {
+  DistanceResult best;
+  best.distance = best.lower_bound = std::numeric_limits<double>::infinity();
+  best.status = Status::Separated;
+  double lower = best.lower_bound;  // the minimum's lower bound is the least of all pairs' lower bounds
+  for (int k = 0; k < static_cast<int>(pairs_.size()); ++k) {
+    const LinkPair& p = pairs_[k];
+    DistanceResult r = meshDistance(*geometry_->link(p.a), poses[p.a], *geometry_->link(p.b), poses[p.b],
+                                    options_.tolerances, relative_error);
+    if (isFailure(r.status)) return r;
+    r.distance = std::max(0.0, r.distance - pair_padding_[k]);
+    r.lower_bound = std::max(0.0, r.lower_bound - pair_padding_[k]);
+    lower = std::min(lower, r.lower_bound);
+    if (r.distance < best.distance) {
+      best = r;
+      if (pair) *pair = p;
+    }
+  }
+  best.lower_bound = lower;
+  return best;
+}
+
+}  // namespace clearway

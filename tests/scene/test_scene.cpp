@@ -1,0 +1,263 @@
+// Scenes: the file format (every error names the file and the key), the effects a scene declares
+// (and the work it does not do), and the shared MotionBenchMaker problems.
+#include <clearway/scene/scene.h>
+
+#include "load/robot_files.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <random>
+#include <thread>
+
+namespace clearway {
+namespace {
+
+using test::TempDir;
+
+std::string sharedScenes() { return std::string(CLEARWAY_SHARED_DIR) + "/scenes"; }
+
+#define CLEARWAY_SHARED_SCENES_OR_SKIP()                                                             \
+  if (!std::filesystem::is_directory(sharedScenes()) || test::sharedRobot("panda/panda.urdf").empty()) \
+  GTEST_SKIP() << "shared scenes not found at " << sharedScenes() << " (see DATA.md)"
+
+// A scene of the planar arm (robots/planar_arm) with a box obstacle; `extra` replaces parts.
+std::string planarScene(const std::string& checks = "[self, environment]", const std::string& obstacles =
+                            "    - {name: wall, box: {size: [0.1, 2, 1]}, pose: {position: [1.2, 0, 0]}}\n",
+                        const std::string& robot_extra = "", const std::string& tail = "") {
+  return "format: 1\nname: planar\nrobot:\n  urdf: " + test::sourceRobot("planar_arm/planar_arm.urdf") +
+         "\n  group: [shoulder, elbow]\n" + robot_extra + "environment:\n  obstacles:\n" + obstacles +
+         "checks: " + checks + "\nstart: [1.5, 0]\ngoal: [-1.5, 0]\n" + tail;
+}
+
+TEST(SceneFile, ParsesEveryKey) {
+  TempDir dir;
+  const std::string path = dir.write("s.yaml", planarScene("[self, environment]",
+      "    - {name: ball, sphere: {radius: 0.1}, pose: {position: [0, 1, 0]}, velocity: [0, -1, 0]}\n"));
+  // A moving obstacle needs `moving` among the checks.
+  EXPECT_LOAD_ERROR(parseSceneFile(path), path, "key 'checks'", "velocity");
+  const std::string ok = dir.write("ok.yaml", planarScene("[self, environment, clearance, moving, continuous]",
+      "    - {name: wall, box: {size: [0.1, 2, 1]}, pose: {position: [1.2, 0, 0], orientation: [0, 0, 0, 1]}}\n"
+      "    - {name: ball, sphere: {radius: 0.1}, pose: {position: [0, 1, 0]}, velocity: [0, -1, 0]}\n"
+      "    - {name: can, cylinder: {radius: 0.1, length: 0.4}}\n"
+      "    - {name: pill, capsule: {radius: 0.1, length: 0.4}}\n",
+      "  padding: 0.01\n  allow: [[base_link, link2]]\n"));
+  const SceneDescription d = parseSceneFile(ok);
+  EXPECT_EQ(d.name, "planar");
+  EXPECT_EQ(d.group, (std::vector<std::string>{"shoulder", "elbow"}));
+  EXPECT_EQ(d.padding, 0.01);
+  ASSERT_EQ(d.allow.size(), 1u);
+  EXPECT_EQ(d.allow[0].second, "link2");
+  ASSERT_EQ(d.obstacles.size(), 4u);
+  EXPECT_EQ(std::get<Box>(d.obstacles[0].shape).half, Vec3(0.05, 1, 0.5));
+  EXPECT_EQ(d.obstacles[0].pose.t, Vec3(1.2, 0, 0));
+  EXPECT_EQ(d.obstacles[1].velocity, Vec3(0, -1, 0));
+  EXPECT_EQ(std::get<Cylinder>(d.obstacles[2].shape).h, 0.2);
+  EXPECT_EQ(std::get<Capsule>(d.obstacles[3].shape).r, 0.1);
+  EXPECT_TRUE(d.effects.self && d.effects.environment && d.effects.clearance && d.effects.moving && d.effects.continuous);
+  EXPECT_EQ(d.start, (std::vector<double>{1.5, 0}));
+}
+
+TEST(SceneFile, BadInputNamesFileAndKey) {
+  TempDir dir;
+  struct Case {
+    std::string text, key, reason;
+  };
+  const std::string good = planarScene();
+  auto replaced = [&](const std::string& from, const std::string& to) {
+    std::string s = good;
+    const auto at = s.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return s.replace(at, from.size(), to);
+  };
+  const Case cases[] = {
+      {replaced("checks:", "colour: red\nchecks:"), "key 'colour'", "unknown key"},
+      {replaced("  group:", "  paddin: 0.1\n  group:"), "key 'robot.paddin'", "unknown key"},
+      {replaced("planar_arm.urdf", "nowhere.urdf"), "key 'robot.urdf'", "file not found"},
+      {replaced("start: [1.5, 0]", "start: [1.5, 0, 3]"), "key 'start'", "expected 2 numbers, got 3"},
+      {replaced("goal: [-1.5, 0]", "goal: [-1.5, .nan]"), "key 'goal[1]'", "not a finite number"},
+      {replaced("goal: [-1.5, 0]", "goal: [-1.5, zero]"), "key 'goal[1]'", "not a number"},
+      {replaced("[self, environment]", "[self, gravity]"), "key 'checks'", "unknown check 'gravity'"},
+      {replaced("size: [0.1, 2, 1]", "size: [0.1, 2]"), "key 'environment.obstacles[0].box.size'", "expected 3 numbers"},
+      {replaced("size: [0.1, 2, 1]", "size: [0.1, -2, 1]"), "key 'environment.obstacles[0]'", "half extent"},
+      {replaced("box: {size: [0.1, 2, 1]}", "cone: {radius: 1}"), "key 'environment.obstacles[0].cone'", "unknown key"},
+      {replaced("position: [1.2, 0, 0]}", "position: [1.2, 0, 0], orientation: [0, 0, 0, 2]}"),
+       "key 'environment.obstacles[0].pose.orientation'", "norm"},
+      {replaced("format: 1", "format: 2"), "key 'format'", "unsupported format"},
+      {"format: 1\nrobot: [\n", "", "not valid YAML"},
+      {replaced("environment:\n  obstacles:", "environment:\n  octomap: missing.bt\n  obstacles:"),
+       "key 'environment.octomap'", "file not found"},
+  };
+  for (const Case& c : cases) {
+    const std::string path = dir.write("bad.yaml", c.text);
+    EXPECT_LOAD_ERROR(parseSceneFile(path), path, c.key, c.reason);
+  }
+  const std::string missing = dir.path("absent.yaml");
+  EXPECT_LOAD_ERROR(parseSceneFile(missing), missing, "", "not found");
+}
+
+TEST(Scene, BadRobotReferencesNameTheKey) {
+  TempDir dir;
+  struct Case {
+    std::string robot_extra, group, key, reason;
+  };
+  const Case cases[] = {
+      {"", "[shoulder, wrist]", "key 'robot.group[1]'", "joint 'wrist' is not in robot"},
+      {"", "[shoulder, tool_joint]", "key 'robot.group[1]'", "fixed"},
+      {"  hold: {shoulder: 0.3}\n", "[shoulder, elbow]", "key 'robot.hold.shoulder'", "in the group"},
+      {"  allow: [[base_link, hand]]\n", "[shoulder, elbow]", "key 'robot.allow[0]'", "link 'hand' is not in robot"},
+  };
+  for (const Case& c : cases) {
+    std::string text = planarScene("[self]", "", c.robot_extra);
+    text.replace(text.find("[shoulder, elbow]"), 17, c.group);
+    const std::string path = dir.write("bad.yaml", text);
+    EXPECT_LOAD_ERROR(Scene(parseSceneFile(path)), path, c.key, c.reason);
+  }
+}
+
+TEST(Scene, PlanarArmAgainstAWall) {
+  TempDir dir;
+  // The wall's near face is at x = 1.15; link2 (a cylinder from the elbow at x = 1 to x = 1.5) reaches
+  // into it at q = 0. Pointing along y (q = (π/2, 0)), the robot is 1.05 from the wall (the base box's
+  // face at x = 0.1), and link2 (y from 1.0 to 1.5) is 0.9 from the base box (y ≤ 0.1): self counts too.
+  const auto scene = Scene::load(dir.write("s.yaml", planarScene("[self, environment, clearance]")));
+  EXPECT_EQ(scene->dimension(), 2);
+  CollisionReport r;
+  EXPECT_FALSE(scene->isFree({0.0, 0.0}, &r));
+  EXPECT_EQ(r.kind, CollisionReport::Kind::Environment);
+  EXPECT_EQ(scene->describe(r), "link2 wall");
+  EXPECT_TRUE(scene->isFree({M_PI / 2, 0.0}, &r));
+  EXPECT_EQ(r.kind, CollisionReport::Kind::None);
+  SceneContext ctx = scene->makeContext();
+  const double up[2] = {M_PI / 2, 0.0};
+  double lower = -1;
+  EXPECT_NEAR(scene->clearance(up, ctx, &lower), 0.9, 1e-6);
+  EXPECT_LE(lower, 0.9 + 1e-12);
+  EXPECT_GE(lower, 0.9 * (1 - 1e-5));
+  // Reaching the wall exactly: the elbow at 0.65 from the wall... touching is a collision.
+  const double into[2] = {0.0, 0.0};
+  EXPECT_EQ(scene->clearance(into, ctx), 0.0);
+}
+
+TEST(Scene, InvalidStatesAreNeverFree) {
+  TempDir dir;
+  const auto scene = Scene::load(dir.write("s.yaml", planarScene("[self]", "")));
+  CollisionReport r;
+  EXPECT_TRUE(scene->isFree({0.5, 2.5}, &r));  // on the limit
+  EXPECT_FALSE(scene->isFree({0.5, 2.6}, &r));
+  EXPECT_EQ(r.kind, CollisionReport::Kind::Invalid);
+  EXPECT_FALSE(scene->isFree({std::nan(""), 0.0}, &r));
+  EXPECT_EQ(r.kind, CollisionReport::Kind::Invalid);
+  EXPECT_FALSE(scene->isFree({0.5}, &r));
+  EXPECT_EQ(r.kind, CollisionReport::Kind::Invalid);
+  std::string why;
+  const double bad[2] = {0.5, 2.6};
+  EXPECT_FALSE(scene->validState(bad, &why));
+  EXPECT_NE(why.find("elbow"), std::string::npos) << why;
+}
+
+// What a scene does not declare, it does not compute: counted, per effect.
+TEST(Scene, UndeclaredEffectsCostNothing) {
+  TempDir dir;
+  std::mt19937_64 rng(5);
+  std::vector<std::array<double, 2>> states(200);
+  for (auto& s : states)
+    s = {std::uniform_real_distribution<double>(-3.1, 3.1)(rng), std::uniform_real_distribution<double>(-2.5, 2.5)(rng)};
+  const std::string wall =
+      "    - {name: wall, box: {size: [0.1, 2, 1]}, pose: {position: [1.2, 0, 0]}}\n"
+      "    - {name: post, cylinder: {radius: 0.1, length: 1}, pose: {position: [-1.2, 0, 0]}}\n";
+  for (const std::string checks : {"[self]", "[environment]", "[self, environment]", "[self, environment, clearance]"}) {
+    const auto scene = Scene::load(dir.write("s.yaml", planarScene(checks, wall)));
+    SceneContext ctx = scene->makeContext();
+    int colliding = 0;
+    for (const auto& s : states) colliding += !scene->isFree(s.data(), ctx);
+    const double c = scene->clearance(states[0].data(), ctx);
+    const SceneCounters& n = ctx.counters;
+    SCOPED_TRACE(checks);
+    EXPECT_EQ(n.states, 200);
+    const bool env = scene->effects().environment, self = scene->effects().self;
+    EXPECT_EQ(n.environment.obstacle_tests > 0, env);
+    EXPECT_EQ(n.environment.voxel_tests, 0);  // no map
+    EXPECT_EQ(colliding > 0, env) << "the planar arm cannot collide with itself";
+    // The planar arm's only non-adjacent pair (base, link2) never moves close: its tests stop at the
+    // bounding spheres, so self shows as checked pairs only when declared.
+    if (!self) EXPECT_EQ(n.self_pair_tests, 0);
+    if (scene->effects().clearance) {
+      EXPECT_GE(c, 0.0);
+      EXPECT_GT(n.environment.distance_tests, 0);
+    } else {
+      EXPECT_TRUE(std::isnan(c));
+      EXPECT_EQ(n.environment.distance_tests, 0);
+      EXPECT_EQ(n.clearance_queries, 0);
+    }
+  }
+}
+
+TEST(Scene, ThreadsShareOneScene) {
+  TempDir dir;
+  const auto scene = Scene::load(dir.write("s.yaml", planarScene()));
+  std::mt19937_64 rng(9);
+  std::vector<std::vector<double>> states(500);
+  for (auto& s : states)
+    s = {std::uniform_real_distribution<double>(-3.1, 3.1)(rng), std::uniform_real_distribution<double>(-2.5, 2.5)(rng)};
+  std::vector<char> serial(states.size()), parallel(states.size());
+  for (std::size_t i = 0; i < states.size(); ++i) serial[i] = scene->isFree(states[i]);
+  auto run = [&](std::size_t begin) {
+    for (std::size_t i = begin; i < states.size(); i += 2) parallel[i] = scene->isFree(states[i]);
+  };
+  std::thread a(run, 0), b(run, 1);
+  a.join();
+  b.join();
+  EXPECT_EQ(serial, parallel);
+}
+
+// Every start and goal of the shared problems is classified, and the primitive and OctoMap forms
+// agree except where a link is within the map's voxel margin of an obstacle.
+TEST(Scene, SharedProblemsStartAndGoal) {
+  CLEARWAY_SHARED_SCENES_OR_SKIP();
+  int problems = 0, free_states = 0, agree = 0, margin = 0;
+  std::map<std::string, std::shared_ptr<const RobotGeometry>> robots;  // each robot loaded once
+  auto load = [&](const std::string& path) {
+    const SceneDescription d = parseSceneFile(path);
+    auto& g = robots[d.urdf];
+    if (!g) g = loadRobotGeometry(d);
+    return std::make_shared<const Scene>(d, g, loadEnvironment(d));
+  };
+  for (const auto& family : std::filesystem::directory_iterator(sharedScenes())) {
+    if (!family.is_directory()) continue;
+    for (const auto& f : std::filesystem::directory_iterator(family.path())) {
+      const std::string p = f.path().string();
+      if (f.path().extension() != ".yaml" || p.find(".octomap.") != std::string::npos) continue;
+      std::string mp = p;
+      mp.replace(mp.size() - 5, 5, ".octomap.yaml");
+      const auto prim = load(p);
+      const auto map = load(mp);
+      ++problems;
+      SceneDescription padded_d = parseSceneFile(p);
+      padded_d.padding = 0.035;  // a voxel diagonal (0.0346 m) and rounding
+      const Scene padded(padded_d, prim->geometryPtr(), std::make_shared<Environment>(prim->environment()));
+      for (const auto* q : {&prim->description().start, &prim->description().goal}) {
+        const bool a = prim->isFree(*q), b = map->isFree(*q);
+        free_states += a;
+        if (a == b) {
+          ++agree;
+        } else {
+          ++margin;
+          // Disagreement is allowed only within the margin: then the padded primitive scene collides.
+          EXPECT_FALSE(padded.isFree(*q)) << p << ": primitive " << a << ", octomap " << b;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(problems, 60);
+  EXPECT_GT(free_states, 60) << "most starts and goals of MotionBenchMaker problems are valid";
+  std::printf("%d problems: %d of %d start/goal states free; primitive and OctoMap forms agree on %d, "
+              "differ within the voxel margin on %d\n", problems, free_states, 2 * problems, agree, margin);
+}
+
+}  // namespace
+}  // namespace clearway

@@ -1,0 +1,269 @@
+// Self-collision: the filter, an analytic robot built in code, and the Panda and UR5 against brute
+// force over triangle pairs on random configurations.
+#include <clearway/kinematics/forward_kinematics.h>
+#include <clearway/load/robot_loader.h>
+#include <clearway/scene/self_collision.h>
+
+#include "load/robot_files.h"
+#include "tree/mesh_reference.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <thread>
+
+namespace clearway {
+namespace {
+
+// A base bar lying along x from 0.5 to 1.5, a hub (sphere) turning about z at the origin, and an arm
+// bar from 0.2 to 1.0 fixed to the hub: base and arm are not adjacent (the hub between them has
+// geometry), so the pair is checked, and they meet when the arm swings over the base bar.
+std::shared_ptr<const RobotModel> scissors(double arm_width = 0.1) {
+  std::vector<Link> links(3);
+  links[0].name = "base";
+  links[0].collisions.push_back({Pose::translation(Vec3(1.0, 0, 0)), Shape(Box(Vec3(0.5, 0.05, 0.05))), -1});
+  links[1].name = "hub";
+  links[1].parent_joint = 0;
+  links[1].collisions.push_back({Pose(), Shape(Sphere(0.05)), -1});
+  links[2].name = "arm";
+  links[2].parent_joint = 1;
+  links[2].collisions.push_back({Pose::translation(Vec3(0.6, 0, 0)), Shape(Box(Vec3(0.4, arm_width / 2, 0.05))), -1});
+  std::vector<Joint> joints(2);
+  joints[0].name = "swing";
+  joints[0].type = JointType::Revolute;
+  joints[0].parent_link = 0;
+  joints[0].child_link = 1;
+  joints[0].axis = Vec3::UnitZ();
+  joints[0].lower = -M_PI;
+  joints[0].upper = M_PI;
+  joints[1].name = "weld";
+  joints[1].type = JointType::Fixed;
+  joints[1].parent_link = 1;
+  joints[1].child_link = 2;
+  return std::make_shared<const RobotModel>("scissors", std::move(links), std::move(joints), std::vector<TriangleMesh>{});
+}
+
+// 2D reference: do the rectangles [x0, x1] × [−w, w] (base) and the arm's [0.2, 1.0] × [−a, a] turned
+// by θ intersect? Separating axis theorem over the 4 edge normals, in plain trigonometry.
+bool rectanglesMeet(double theta, double half_arm_width) {
+  const double c = std::cos(theta), s = std::sin(theta);
+  auto corners = [&](bool arm) {
+    std::vector<std::pair<double, double>> p;
+    if (!arm) return std::vector<std::pair<double, double>>{{0.5, -0.05}, {1.5, -0.05}, {1.5, 0.05}, {0.5, 0.05}};
+    for (auto [x, y] : {std::pair{0.2, -half_arm_width}, {1.0, -half_arm_width}, {1.0, half_arm_width}, {0.2, half_arm_width}})
+      p.emplace_back(c * x - s * y, s * x + c * y);
+    return p;
+  };
+  const auto a = corners(false), b = corners(true);
+  const std::pair<double, double> axes[4] = {{1, 0}, {0, 1}, {c, s}, {-s, c}};
+  for (const auto& [ux, uy] : axes) {
+    double amin = 1e9, amax = -1e9, bmin = 1e9, bmax = -1e9;
+    for (auto [x, y] : a) amin = std::min(amin, ux * x + uy * y), amax = std::max(amax, ux * x + uy * y);
+    for (auto [x, y] : b) bmin = std::min(bmin, ux * x + uy * y), bmax = std::max(bmax, ux * x + uy * y);
+    if (amax < bmin || bmax < amin) return false;
+  }
+  return true;
+}
+
+TEST(CollisionFilter, AdjacentSrdfAndGeometryless) {
+  const auto model = scissors();
+  CollisionFilter f(*model);
+  EXPECT_FALSE(f.enabled(0, 1));
+  EXPECT_EQ(f.reason(0, 1), "Adjacent");
+  EXPECT_FALSE(f.enabled(1, 2));
+  EXPECT_TRUE(f.enabled(0, 2));
+  EXPECT_EQ(f.reason(0, 2), "");
+  f.disable(2, 0, "allowed by scene");
+  EXPECT_FALSE(f.enabled(0, 2));
+  EXPECT_EQ(f.reason(0, 2), "allowed by scene");
+  EXPECT_TRUE(f.enabledPairs().empty());
+  EXPECT_THROW(f.disable(0, 0, "x"), std::out_of_range);
+  EXPECT_THROW(f.disable(0, 7, "x"), std::out_of_range);
+}
+
+TEST(CollisionFilter, PandaHonoursSrdf) {
+  CLEARWAY_SHARED_ROBOT_OR_SKIP(urdf, "panda/panda.urdf");
+  const RobotModel panda = loadRobot(urdf, test::sharedRobot("panda/panda.srdf"));
+  const CollisionFilter f(panda);
+  ASSERT_FALSE(panda.disabledCollisions().empty());
+  for (const DisabledCollision& d : panda.disabledCollisions()) EXPECT_FALSE(f.enabled(d.link_a, d.link_b));
+  for (const auto& [a, b] : adjacentLinkPairs(panda)) EXPECT_EQ(f.reason(a, b), "Adjacent");
+  // panda_link0 has no joint to panda_link2, and the SRDF does not disable... whatever it says, every
+  // enabled pair has geometry on both sides.
+  for (const auto& [a, b] : f.enabledPairs()) {
+    EXPECT_FALSE(panda.link(a).collisions.empty());
+    EXPECT_FALSE(panda.link(b).collisions.empty());
+  }
+}
+
+TEST(SelfCollision, ScissorsMatchesTheAnalyticAnswer) {
+  const auto model = scissors();
+  auto geometry = std::make_shared<const RobotGeometry>(model);
+  const SelfCollision checker(geometry, CollisionFilter(*model));
+  ASSERT_EQ(checker.pairs().size(), 1u);
+  SelfCollisionContext ctx = checker.makeContext();
+  std::vector<Pose> poses(3);
+  int collide = 0, free = 0;
+  for (int i = 0; i <= 3600; ++i) {
+    const double theta = -M_PI + 2 * M_PI * i / 3600.0;
+    // Stay away from the exact touching angle, where rounding may decide.
+    bool near_boundary = false;
+    for (double d : {-1e-7, 1e-7}) near_boundary |= rectanglesMeet(theta + d, 0.05) != rectanglesMeet(theta, 0.05);
+    if (near_boundary) continue;
+    computeLinkPoses(*model, &theta, poses.data());
+    const bool expected = rectanglesMeet(theta, 0.05);
+    EXPECT_EQ(checker.firstCollision(poses.data(), ctx) != nullptr, expected) << "theta " << theta;
+    (expected ? collide : free)++;
+  }
+  EXPECT_GT(collide, 50);
+  EXPECT_GT(free, 2000);
+}
+
+TEST(SelfCollision, PaddingWidensTheContact) {
+  const auto model = scissors();
+  auto geometry = std::make_shared<const RobotGeometry>(model);
+  // At θ = π/2 the arm points along y: its near corner (x = −0.05 … 0.05, y = 0.2) is 0.15 from the base
+  // bar's top face (y = 0.05) along y, but the bar starts at x = 0.5: the gap is the corner distance
+  // from (0.05, 0.2) to (0.5, 0.05) = √(0.45² + 0.15²).
+  const double gap = std::hypot(0.45, 0.15);
+  const double theta = M_PI / 2;
+  std::vector<Pose> poses(3);
+  computeLinkPoses(*model, &theta, poses.data());
+  for (const double pad : {gap * 0.49, gap * 0.51}) {
+    SelfCollisionOptions o;
+    o.link_padding = {pad, 0.0, pad};
+    const SelfCollision checker(geometry, CollisionFilter(*model), o);
+    SelfCollisionContext ctx = checker.makeContext();
+    EXPECT_EQ(checker.firstCollision(poses.data(), ctx) != nullptr, 2 * pad > gap) << pad;
+    LinkPair pair;
+    const DistanceResult d = checker.minimumDistance(poses.data(), &pair);
+    EXPECT_NEAR(d.distance, std::max(0.0, gap - 2 * pad), 1e-9);
+    EXPECT_EQ(pair, (LinkPair{0, 2}));
+  }
+  SelfCollisionOptions bad;
+  bad.link_padding = {0.0, -1.0, 0.0};
+  EXPECT_THROW(SelfCollision(geometry, CollisionFilter(*model), bad), std::invalid_argument);
+  bad.link_padding = {0.0};
+  EXPECT_THROW(SelfCollision(geometry, CollisionFilter(*model), bad), std::invalid_argument);
+}
+
+TEST(SelfCollision, NonFinitePoseCollides) {
+  const auto model = scissors();
+  const SelfCollision checker(std::make_shared<const RobotGeometry>(model), CollisionFilter(*model));
+  SelfCollisionContext ctx = checker.makeContext();
+  const double theta = std::nan("");
+  std::vector<Pose> poses(3);
+  computeLinkPoses(*model, &theta, poses.data());
+  EXPECT_NE(checker.firstCollision(poses.data(), ctx), nullptr);
+}
+
+// The brute-force mesh of one link (its mesh elements in the link frame).
+TriangleMesh linkMesh(const RobotModel& m, int link) {
+  TriangleMesh out;
+  for (const CollisionElement& e : m.link(link).collisions) {
+    if (e.mesh < 0) continue;
+    const TriangleMesh& src = m.meshes()[e.mesh];
+    const auto base = static_cast<std::int32_t>(out.vertices.size());
+    for (const Vec3& v : src.vertices) out.vertices.push_back(e.origin * v);
+    for (auto t : src.triangles) out.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+  }
+  return out;
+}
+
+std::vector<double> randomState(const RobotModel& m, std::mt19937_64& rng) {
+  std::vector<double> q(m.variableCount());
+  for (int v = 0; v < m.variableCount(); ++v) {
+    const JointVariable& var = m.variables()[v];
+    const double lo = std::isfinite(var.lower) ? var.lower : -M_PI, hi = std::isfinite(var.upper) ? var.upper : M_PI;
+    q[v] = std::uniform_real_distribution<double>(lo, hi)(rng);
+  }
+  return q;
+}
+
+// Mesh mode against brute force over every triangle pair (only where the hulls overlap: elsewhere the
+// hull containment, tested in tests/tree, already proves "free"); hull mode never free where mesh collides.
+void differential(const std::string& urdf, const std::string& srdf, int states, std::uint64_t seed) {
+  auto model = std::make_shared<const RobotModel>(loadRobot(urdf, srdf));
+  // The triangle brute force knows meshes only: pairs with a primitive link are compared with hull mode
+  // alone here (primitives against triangles are tested in tests/tree).
+  std::vector<char> mesh_only(model->linkCount(), 1);
+  for (int i = 0; i < model->linkCount(); ++i)
+    for (const CollisionElement& e : model->link(i).collisions) mesh_only[i] &= e.mesh >= 0;
+  auto geometry = std::make_shared<const RobotGeometry>(model);
+  const CollisionFilter filter(*model);
+  SelfCollisionOptions hull_options;
+  hull_options.mode = GeometryMode::Hull;
+  const SelfCollision mesh(geometry, filter), hull(geometry, filter, hull_options);
+  SelfCollisionContext mctx = mesh.makeContext(), hctx = hull.makeContext();
+  std::vector<TriangleMesh> meshes(model->linkCount());
+  for (int i : geometry->geometricLinks()) meshes[i] = linkMesh(*model, i);
+  std::mt19937_64 rng(seed);
+  std::vector<Pose> poses(model->linkCount());
+  int colliding = 0, free = 0, band = 0, disagreements = 0;
+  for (int s = 0; s < states; ++s) {
+    const std::vector<double> q = randomState(*model, rng);
+    computeLinkPoses(*model, q.data(), poses.data());
+    std::vector<LinkPair> mesh_hits, hull_hits;
+    mesh.allCollisions(poses.data(), mctx, mesh_hits);
+    hull.allCollisions(poses.data(), hctx, hull_hits);
+    EXPECT_EQ(mesh.firstCollision(poses.data(), mctx) != nullptr, !mesh_hits.empty());
+    for (const LinkPair& p : mesh_hits)
+      EXPECT_NE(std::find(hull_hits.begin(), hull_hits.end(), p), hull_hits.end()) << "hull free, mesh collides";
+    bool any_collide = false, any_band = false;
+    for (const LinkPair& p : hull_hits) {
+      if (!mesh_only[p.a] || !mesh_only[p.b]) continue;
+      const double band_width = 1e-9;
+      const tree_ref::Verdict v = tree_ref::classify(tree_ref::place(meshes[p.a], poses[p.a]),
+                                                     tree_ref::place(meshes[p.b], poses[p.b]), 0.0, band_width);
+      const bool said = std::find(mesh_hits.begin(), mesh_hits.end(), p) != mesh_hits.end();
+      if (v == tree_ref::Verdict::Band) { any_band = true; continue; }
+      if (said != (v == tree_ref::Verdict::Collide)) {
+        ++disagreements;
+        ADD_FAILURE() << "state " << s << " pair " << model->link(p.a).name << "/" << model->link(p.b).name
+                      << ": mesh mode says " << said;
+      }
+      any_collide |= v == tree_ref::Verdict::Collide;
+    }
+    (any_collide ? colliding : any_band ? band : free)++;
+  }
+  EXPECT_EQ(disagreements, 0);
+  std::printf("%d states: %d colliding, %d free, %d in the band\n", states, colliding, free, band);
+  EXPECT_GT(colliding, states / 50) << "too few colliding states to test anything";
+  EXPECT_GT(free, states / 5);
+  EXPECT_LE(band, states / 20);
+}
+
+TEST(SelfCollision, PandaMeshModeMatchesBruteForce) {
+  CLEARWAY_SHARED_ROBOT_OR_SKIP(urdf, "panda/panda.urdf");
+  // Without the SRDF: more pairs checked, more contacts to get right.
+  differential(urdf, "", 2000, 7);
+}
+
+TEST(SelfCollision, Arm6MeshModeMatchesBruteForce) {
+  differential(test::sourceRobot("arm6/arm6.urdf"), "", 2000, 8);
+}
+
+TEST(SelfCollision, ContextsMakeThreadsIndependent) {
+  CLEARWAY_SHARED_ROBOT_OR_SKIP(urdf, "panda/panda.urdf");
+  auto model = std::make_shared<const RobotModel>(loadRobot(urdf, test::sharedRobot("panda/panda.srdf")));
+  const SelfCollision checker(std::make_shared<const RobotGeometry>(model), CollisionFilter(*model));
+  std::mt19937_64 rng(3);
+  std::vector<std::vector<Pose>> states(400, std::vector<Pose>(model->linkCount()));
+  for (auto& poses : states) computeLinkPoses(*model, randomState(*model, rng).data(), poses.data());
+  std::vector<char> serial(states.size()), parallel(states.size());
+  SelfCollisionContext ctx = checker.makeContext();
+  for (std::size_t i = 0; i < states.size(); ++i) serial[i] = checker.firstCollision(states[i].data(), ctx) != nullptr;
+  auto run = [&](std::size_t begin) {
+    SelfCollisionContext c = checker.makeContext();
+    for (std::size_t i = begin; i < states.size(); i += 2) parallel[i] = checker.firstCollision(states[i].data(), c) != nullptr;
+  };
+  std::thread a(run, 0), b(run, 1);
+  a.join();
+  b.join();
+  EXPECT_EQ(serial, parallel);
+  EXPECT_GT(std::count(serial.begin(), serial.end(), 1), 0);
+}
+
+}  // namespace
+}  // namespace clearway
