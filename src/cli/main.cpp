@@ -76,6 +76,7 @@ struct Command {
 };
 
 const Command kCommands[] = {
+    {"plan", "plan start -> goal on a scene with OMPL (a bundled scene when none is given)", clearway::cli::planCommand},
     {"check", "classify joint vectors of a scene: free or which links collide", clearway::cli::checkCommand},
     {"query", "narrow-phase queries on shape pairs from a JSON Lines file", queryCommand},
 };

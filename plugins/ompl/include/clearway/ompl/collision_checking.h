@@ -1,0 +1,96 @@
+#pragma once
+// Clearway inside OMPL: a state space made from a scene's group, a StateValidityChecker and a
+// continuous MotionValidator. Both are thread-safe (OMPL's parallel planners and PRM's second thread
+// call them at once): every thread gets its own scratch, and the counters are atomic.
+//
+// The namespace is clearway, not clearway::ompl: inside a clearway::ompl, `ompl::base` would resolve
+// to clearway::ompl::base.
+#include <clearway/motion/motion.h>
+#include <clearway/scene/scene.h>
+
+#include <ompl/base/MotionValidator.h>
+#include <ompl/base/SpaceInformation.h>
+#include <ompl/base/StateValidityChecker.h>
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+
+namespace clearway {
+
+/// The OMPL state space of a scene's group: bounded joints are real-vector dimensions with the joint
+/// limits; continuous joints are SO(2). All bounded: one RealVectorStateSpace; otherwise a compound
+/// space with one subspace per state entry, in state order.
+ompl::base::StateSpacePtr makeStateSpace(const Scene& scene);
+
+/// Converts between OMPL states of makeStateSpace(scene) and Clearway state vectors, allocation-free.
+class StateMap {
+ public:
+  explicit StateMap(const Scene& scene);
+  /// Writes the state's scene-dimension values to out.
+  void toVector(const ompl::base::State* state, double* out) const noexcept;
+  /// Writes the values into an OMPL state.
+  void fromVector(const double* values, ompl::base::State* state) const noexcept;
+  /// After toVector of the two ends: shifts continuous entries of `to` so that the segment turns the
+  /// short way, as OMPL's SO(2) interpolation does.
+  void unwrap(const double* from, double* to) const noexcept;
+  int dimension() const noexcept { return static_cast<int>(continuous_.size()); }
+
+ private:
+  bool compound_ = false;
+  std::vector<char> continuous_;
+};
+
+/// Counters readable by benchmarks (all cumulative).
+struct CheckerCounters {
+  std::atomic<std::uint64_t> states{0}, motions{0}, nanoseconds{0};
+};
+
+/// ompl::base::StateValidityChecker over a Scene: isValid is Scene::isFree; clearance is
+/// Scene::clearance when the scene declares `clearance` (otherwise OMPL's default, 0).
+class ValidityChecker : public ompl::base::StateValidityChecker {
+ public:
+  ValidityChecker(const ompl::base::SpaceInformationPtr& si, std::shared_ptr<const Scene> scene);
+  bool isValid(const ompl::base::State* state) const override;
+  double clearance(const ompl::base::State* state) const override;
+  const CheckerCounters& counters() const noexcept { return counters_; }
+  const Scene& scene() const noexcept { return *scene_; }
+
+ private:
+  std::shared_ptr<const Scene> scene_;
+  StateMap map_;
+  std::uint64_t serial_;
+  mutable CheckerCounters counters_;
+};
+
+/// ompl::base::MotionValidator that checks the whole segment (MotionMode::Certified: no tunnelling).
+/// checkMotion(s1, s2, lastValid) reports the fraction of the last valid state before first contact and
+/// writes that state when lastValid.first is given.
+class ContinuousMotionValidator : public ompl::base::MotionValidator {
+ public:
+  ContinuousMotionValidator(const ompl::base::SpaceInformationPtr& si, std::shared_ptr<const Scene> scene,
+                            MotionOptions options = {});
+  bool checkMotion(const ompl::base::State* s1, const ompl::base::State* s2) const override;
+  bool checkMotion(const ompl::base::State* s1, const ompl::base::State* s2,
+                   std::pair<ompl::base::State*, double>& lastValid) const override;
+  const CheckerCounters& counters() const noexcept { return counters_; }
+  /// The last result this thread computed (for tools that want the contact).
+  MotionResult check(const ompl::base::State* s1, const ompl::base::State* s2) const;
+
+ private:
+  MotionChecker checker_;
+  StateMap map_;
+  std::uint64_t serial_;
+  mutable CheckerCounters counters_;
+};
+
+/// Installs a ValidityChecker and a ContinuousMotionValidator on si (whose space must be
+/// makeStateSpace(*scene) or equal to it) and calls si->setup(). Returns them for their counters.
+struct CollisionChecking {
+  std::shared_ptr<ValidityChecker> validity;
+  std::shared_ptr<ContinuousMotionValidator> motion;
+};
+CollisionChecking setupCollisionChecking(const ompl::base::SpaceInformationPtr& si, std::shared_ptr<const Scene> scene,
+                                         MotionOptions options = {});
+
+}  // namespace clearway

@@ -1,0 +1,245 @@
+// `clearway plan [SCENE] [--planner NAME] [--time S] [--seed N] [--no-simplify]`: plans start → goal
+// with OMPL on a scene, simplifies, re-validates the final path with the certified motion check, and
+// prints the path (one state per line) and the checker's statistics.
+#include "scene_commands.h"
+
+#include <clearway/ompl/collision_checking.h>
+
+#include <ompl/base/goals/GoalState.h>
+#include <ompl/geometric/PathGeometric.h>
+#include <ompl/geometric/SimpleSetup.h>
+#include <ompl/geometric/planners/est/BiEST.h>
+#include <ompl/geometric/planners/est/EST.h>
+#include <ompl/geometric/planners/kpiece/BKPIECE1.h>
+#include <ompl/geometric/planners/kpiece/KPIECE1.h>
+#include <ompl/geometric/planners/kpiece/LBKPIECE1.h>
+#include <ompl/geometric/planners/prm/LazyPRM.h>
+#include <ompl/geometric/planners/prm/PRM.h>
+#include <ompl/geometric/planners/prm/PRMstar.h>
+#include <ompl/geometric/planners/rrt/BiTRRT.h>
+#include <ompl/geometric/planners/rrt/LazyRRT.h>
+#include <ompl/geometric/planners/rrt/RRT.h>
+#include <ompl/geometric/planners/rrt/RRTConnect.h>
+#include <ompl/geometric/planners/rrt/RRTstar.h>
+#include <ompl/geometric/planners/rrt/pRRT.h>
+#include <ompl/geometric/planners/sbl/SBL.h>
+#include <ompl/geometric/planners/sbl/pSBL.h>
+#include <ompl/util/Console.h>
+#include <ompl/util/RandomNumbers.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <iostream>
+#include <map>
+
+#ifndef CLEARWAY_DEFAULT_SCENE
+#define CLEARWAY_DEFAULT_SCENE "robots/scenes/arm6_wall.yaml"
+#endif
+
+namespace clearway::cli {
+
+namespace {
+
+namespace ob = ompl::base;
+namespace og = ompl::geometric;
+
+constexpr int kExitOk = 0, kExitNoPath = 1, kExitUsage = 2;
+
+const char* const kPlanUsage =
+    "usage: clearway plan [SCENE] [--planner NAME] [--time SECONDS] [--seed N] [--mode mesh|hull]\n"
+    "                     [--no-simplify]\n"
+    "\n"
+    "Plans from the scene's start to its goal with an OMPL geometric planner (RRTConnect by default)\n"
+    "using Clearway's validity checker and certified motion validator; simplifies the path and checks\n"
+    "it again, segment by segment, with the certified check. Prints the path, one state per line, on\n"
+    "stdout ('path N' then N lines) and the statistics on stderr. Without SCENE it plans on the bundled\n"
+    "scene " CLEARWAY_DEFAULT_SCENE ".\n"
+    "Planners: RRTConnect RRT RRTstar LazyRRT BiTRRT pRRT PRM PRMstar LazyPRM KPIECE1 BKPIECE1 LBKPIECE1\n"
+    "EST BiEST SBL pSBL.\n"
+    "Exit status: 0 with a valid path, 1 when no valid path was found in time, 2 on bad input.\n";
+
+using PlannerMaker = std::function<ob::PlannerPtr(const ob::SpaceInformationPtr&)>;
+
+const std::map<std::string, PlannerMaker>& planners() {
+  static const std::map<std::string, PlannerMaker> m = {
+      {"RRTConnect", [](auto si) { return std::make_shared<og::RRTConnect>(si); }},
+      {"RRT", [](auto si) { return std::make_shared<og::RRT>(si); }},
+      {"RRTstar", [](auto si) { return std::make_shared<og::RRTstar>(si); }},
+      {"LazyRRT", [](auto si) { return std::make_shared<og::LazyRRT>(si); }},
+      {"BiTRRT", [](auto si) { return std::make_shared<og::BiTRRT>(si); }},
+      {"pRRT", [](auto si) { return std::make_shared<og::pRRT>(si); }},
+      {"PRM", [](auto si) { return std::make_shared<og::PRM>(si); }},
+      {"PRMstar", [](auto si) { return std::make_shared<og::PRMstar>(si); }},
+      {"LazyPRM", [](auto si) { return std::make_shared<og::LazyPRM>(si); }},
+      {"KPIECE1", [](auto si) { return std::make_shared<og::KPIECE1>(si); }},
+      {"BKPIECE1", [](auto si) { return std::make_shared<og::BKPIECE1>(si); }},
+      {"LBKPIECE1", [](auto si) { return std::make_shared<og::LBKPIECE1>(si); }},
+      {"EST", [](auto si) { return std::make_shared<og::EST>(si); }},
+      {"BiEST", [](auto si) { return std::make_shared<og::BiEST>(si); }},
+      {"SBL", [](auto si) { return std::make_shared<og::SBL>(si); }},
+      {"pSBL", [](auto si) { return std::make_shared<og::pSBL>(si); }},
+  };
+  return m;
+}
+
+// The bundled scene, found from the working directory or from the binary's source tree.
+std::string defaultScene() {
+  if (std::filesystem::exists(CLEARWAY_DEFAULT_SCENE)) return CLEARWAY_DEFAULT_SCENE;
+#ifdef CLEARWAY_SOURCE_DIR
+  const std::string p = std::string(CLEARWAY_SOURCE_DIR) + "/" + CLEARWAY_DEFAULT_SCENE;
+  if (std::filesystem::exists(p)) return p;
+#endif
+  return CLEARWAY_DEFAULT_SCENE;
+}
+
+bool parseDouble(const std::string& s, double& out) {
+  char* end = nullptr;
+  out = std::strtod(s.c_str(), &end);
+  return !s.empty() && *end == '\0' && std::isfinite(out);
+}
+
+}  // namespace
+
+int planCommand(const std::vector<std::string>& args) {
+  std::string scene_path, planner_name = "RRTConnect";
+  double time_limit = 10.0, seed = -1;
+  bool simplify = true;
+  SceneOptions options;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    const bool has_value = i + 1 < args.size();
+    if (a == "-h" || a == "--help") {
+      std::cout << kPlanUsage;
+      return kExitOk;
+    } else if (a == "--planner" && has_value) {
+      planner_name = args[++i];
+    } else if (a == "--time" && has_value) {
+      if (!parseDouble(args[++i], time_limit) || time_limit <= 0) {
+        std::cerr << "clearway plan: --time needs a positive number of seconds, got '" << args[i] << "'\n";
+        return kExitUsage;
+      }
+    } else if (a == "--seed" && has_value) {
+      if (!parseDouble(args[++i], seed) || seed < 0 || seed != std::floor(seed)) {
+        std::cerr << "clearway plan: --seed needs a non-negative integer, got '" << args[i] << "'\n";
+        return kExitUsage;
+      }
+    } else if (a == "--mode" && has_value) {
+      const std::string m = args[++i];
+      if (m == "mesh") options.mode = GeometryMode::Mesh;
+      else if (m == "hull") options.mode = GeometryMode::Hull;
+      else {
+        std::cerr << "clearway plan: unknown mode '" << m << "' (mesh or hull)\n";
+        return kExitUsage;
+      }
+    } else if (a == "--no-simplify") {
+      simplify = false;
+    } else if (scene_path.empty() && !a.empty() && a[0] != '-') {
+      scene_path = a;
+    } else {
+      std::cerr << "clearway plan: unexpected argument '" << a << "'\n" << kPlanUsage;
+      return kExitUsage;
+    }
+  }
+  const auto maker = planners().find(planner_name);
+  if (maker == planners().end()) {
+    std::cerr << "clearway plan: unknown planner '" << planner_name << "'\n" << kPlanUsage;
+    return kExitUsage;
+  }
+  if (scene_path.empty()) scene_path = defaultScene();
+
+  std::shared_ptr<const Scene> scene;
+  try {
+    scene = Scene::load(scene_path, options);
+  } catch (const std::exception& e) {
+    std::cerr << "clearway plan: " << e.what() << "\n";
+    return kExitUsage;
+  }
+  const SceneDescription& d = scene->description();
+  if (d.start.empty() || d.goal.empty()) {
+    std::cerr << "clearway plan: " << scene_path << ": the scene needs a start and a goal\n";
+    return kExitUsage;
+  }
+  for (const auto* q : {&d.start, &d.goal}) {
+    std::string why;
+    CollisionReport r;
+    const char* which = q == &d.start ? "start" : "goal";
+    if (!scene->validState(q->data(), &why)) {
+      std::cerr << "clearway plan: " << scene_path << ": " << which << ": " << why << "\n";
+      return kExitUsage;
+    }
+    if (!scene->isFree(*q, &r)) {
+      std::cerr << "clearway plan: " << scene_path << ": " << which << " is in collision: " << scene->describe(r) << "\n";
+      return kExitNoPath;
+    }
+  }
+
+  if (seed >= 0) ompl::RNG::setSeed(static_cast<std::uint_fast32_t>(seed));
+  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+  const ob::StateSpacePtr space = makeStateSpace(*scene);
+  og::SimpleSetup setup(space);
+  const CollisionChecking checking = setupCollisionChecking(setup.getSpaceInformation(), scene);
+  const StateMap map(*scene);
+  ob::ScopedState<> start(space), goal(space);
+  map.fromVector(d.start.data(), start.get());
+  map.fromVector(d.goal.data(), goal.get());
+  setup.setStartAndGoalStates(start, goal);
+  setup.setPlanner(maker->second(setup.getSpaceInformation()));
+
+  std::cerr << "scene " << scene->name() << " (" << scene_path << "): robot " << scene->robot().name() << ", "
+            << scene->dimension() << " joints, " << scene->selfCollision().pairs().size() << " self pairs, "
+            << scene->environment().obstacles().size() << " obstacles"
+            << (scene->environment().map() ? ", an OctoMap" : "") << "; checks: " << scene->effects().toString()
+            << "\n";
+  const auto t0 = std::chrono::steady_clock::now();
+  const ob::PlannerStatus status = setup.solve(time_limit);
+  const double solve_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (status != ob::PlannerStatus::EXACT_SOLUTION) {
+    std::cerr << "clearway plan: " << planner_name << " found no path in " << time_limit << " s (" << status.asString()
+              << ")\n";
+    return kExitNoPath;
+  }
+  const auto states_before = checking.validity->counters().states.load();
+  const auto motions_before = checking.motion->counters().motions.load();
+  double simplify_s = 0.0;
+  if (simplify) {
+    const auto t1 = std::chrono::steady_clock::now();
+    setup.simplifySolution();
+    simplify_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+  }
+  og::PathGeometric& path = setup.getSolutionPath();
+
+  // The final path, segment by segment, with the certified check: what we print is what we certify.
+  bool certified = true;
+  for (std::size_t i = 0; i + 1 < path.getStateCount(); ++i)
+    if (!checking.motion->check(path.getState(i), path.getState(i + 1)).free) {
+      std::cerr << "clearway plan: segment " << i << " of the final path is not certified free\n";
+      certified = false;
+    }
+
+  std::vector<double> q(scene->dimension());
+  std::printf("path %zu\n", path.getStateCount());
+  for (std::size_t i = 0; i < path.getStateCount(); ++i) {
+    map.toVector(path.getState(i), q.data());
+    for (int k = 0; k < scene->dimension(); ++k) std::printf(k ? " %.9g" : "%.9g", q[k]);
+    std::printf("\n");
+  }
+  const auto& vc = checking.validity->counters();
+  const auto& mc = checking.motion->counters();
+  std::fprintf(stderr,
+               "planner %s: solved in %.3f s, simplified in %.3f s; %zu states, length %.4f; certified: %s\n"
+               "checker: %llu states (%.2f us each), %llu motions (%.2f us each); during simplification: %llu "
+               "states, %llu motions\n",
+               planner_name.c_str(), solve_s, simplify_s, path.getStateCount(), path.length(),
+               certified ? "yes" : "NO", static_cast<unsigned long long>(vc.states.load()),
+               vc.states ? 1e-3 * vc.nanoseconds.load() / vc.states.load() : 0.0,
+               static_cast<unsigned long long>(mc.motions.load()),
+               mc.motions ? 1e-3 * mc.nanoseconds.load() / mc.motions.load() : 0.0,
+               static_cast<unsigned long long>(vc.states.load() - states_before),
+               static_cast<unsigned long long>(mc.motions.load() - motions_before));
+  std::fflush(stdout);
+  return certified ? kExitOk : kExitNoPath;
+}
+
+}  // namespace clearway::cli
