@@ -247,7 +247,7 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
 
 DistanceResult Environment::linkDistance(const LinkGeometry& link, const Pose& pose, const Tolerances& tol,
                                          double cutoff, double t, double relative_error,
-                                         EnvironmentCounters* counters) const noexcept {
+                                         EnvironmentCounters* counters, GeometryMode mode) const noexcept {
   if (!pose.isFinite() || !std::isfinite(t) || !(cutoff >= 0.0) || !(relative_error >= 0.0) ||
       !std::isfinite(relative_error)) {
     DistanceResult r;
@@ -266,6 +266,7 @@ DistanceResult Environment::linkDistance(const LinkGeometry& link, const Pose& p
       hull = std::visit([&](const auto& s) { return gjkDistance(link.hull(), pose, s, pose_o, tol); }, o.shape);
     }
     if (!isFailure(hull.status) && hull.lower_bound >= search.limit) return false;
+    if (mode == GeometryMode::Hull) return search.add(hull);
     if (counters) ++counters->distance_tests;
     return search.add(o.mesh ? meshDistance(link, pose, *o.mesh, pose_o, tol, relative_error)
                              : swapped(shapeLinkDistance(o.shape, pose_o, link, pose, tol, relative_error)));
@@ -294,6 +295,7 @@ DistanceResult Environment::linkDistance(const LinkGeometry& link, const Pose& p
       const Pose pose_v = Pose::translation(voxels[v].center());
       const DistanceResult hull = gjkDistance(link.hull(), pose, box, pose_v, tol);
       if (!isFailure(hull.status) && hull.lower_bound >= search.limit) return false;
+      if (mode == GeometryMode::Hull) return search.add(hull);
       if (counters) ++counters->distance_tests;
       return search.add(swapped(shapeLinkDistance(box, pose_v, link, pose, tol, relative_error)));
     });

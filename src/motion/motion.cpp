@@ -98,6 +98,7 @@ namespace clearway {
 
 // ---- MotionChecker ------------------------------------------------------------------------------------
 
+
 MotionChecker::MotionChecker(std::shared_ptr<const Scene> scene, MotionOptions options)
     : scene_(std::move(scene)), options_(options), bound_(*scene_) {
   if (!(options_.contact_distance > 0.0) || !std::isfinite(options_.contact_distance))
@@ -230,10 +231,17 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
         } else {
           const int link = env_links[k - n_self];
           const double pad = sc.linkPadding(link);
-          const DistanceResult e = sc.environment().linkDistance(
-              *geometry.link(link), poses[link], tol, remaining + pad + contact, 0.0, options_.distance_relative_error,
-              &ctx.scene.counters.environment);
-          d = isFailure(e.status) ? 0.0 : e.lower_bound - pad;
+          const double cutoff = remaining + pad + contact;
+          // As for pairs: the hull's distance first, the exact geometry only when the hull comes close.
+          const DistanceResult h = sc.environment().linkDistance(*geometry.link(link), poses[link], tol, cutoff, 0.0, 0.0,
+                                                                 &ctx.scene.counters.environment, GeometryMode::Hull);
+          d = isFailure(h.status) ? 0.0 : h.lower_bound - pad;
+          if (d <= contact && !hull_mode && !isFailure(h.status)) {
+            const DistanceResult e = sc.environment().linkDistance(*geometry.link(link), poses[link], tol, cutoff, 0.0,
+                                                                   options_.distance_relative_error,
+                                                                   &ctx.scene.counters.environment);
+            d = isFailure(e.status) ? 0.0 : e.lower_bound - pad;
+          }
           if (d <= contact) {
             r.report.kind = CollisionReport::Kind::Environment;
             r.report.link = link;

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -524,4 +525,77 @@ TEST(QueryTool, ExitCodes) {
   EXPECT_MENTIONS(r.out, "query");
   EXPECT_EQ(runTool("query --help").exit_code, 0);
 }
+
+// ---- clearway plan and clearway check on the bundled scene.
+
+std::string bundledScene() { return std::string("'") + CLEARWAY_SOURCE_DIR + "/robots/scenes/arm6_wall.yaml'"; }
+
+TEST(PlanTool, PlansTheBundledSceneWithoutArguments) {
+  // From any working directory: the default scene is found through the source tree.
+  const ToolRun r = runTool("plan --seed 3 --time 30");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::istringstream out(r.out);
+  std::string word;
+  int n = 0;
+  out >> word >> n;
+  EXPECT_EQ(word, "path");
+  EXPECT_GE(n, 3) << "the wall blocks the straight line";
+  int values = 0;
+  for (double v; out >> v;) ++values;
+  EXPECT_EQ(values, 6 * n);
+  EXPECT_MENTIONS(r.err, "certified: yes");
+}
+
+TEST(PlanTool, BadInput) {
+  ToolRun r = runTool("plan " + bundledScene() + " --planner Teleport");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_MENTIONS(r.err, "Teleport");
+  r = runTool("plan /nonexistent/scene.yaml");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_MENTIONS(r.err, "/nonexistent/scene.yaml");
+  EXPECT_EQ(runTool("plan " + bundledScene() + " --time -1").exit_code, 2);
+  EXPECT_EQ(runTool("plan " + bundledScene() + " --mode fuzzy").exit_code, 2);
+  // A start in collision: no path (exit 1), and the links are named.
+  const std::string dir = testing::TempDir() + "clearway_plan_" + std::to_string(::getpid());
+  std::filesystem::create_directories(dir);
+  std::ifstream in(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/arm6_wall.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string s = text.str();
+  s.replace(s.find("urdf: ../arm6"), 13, std::string("urdf: ") + CLEARWAY_SOURCE_DIR + "/robots/arm6");
+  s.replace(s.find("srdf: ../arm6"), 13, std::string("srdf: ") + CLEARWAY_SOURCE_DIR + "/robots/arm6");
+  s.replace(s.find("start: ["), 8, "start: [0, 1.7, 0.5, 0, 0, 0]\nold_start: [");  // into the floor
+  s = s.substr(0, s.find("\nold_start")) + s.substr(s.find("\ngoal:"));
+  std::ofstream(dir + "/floor.yaml") << s;
+  r = runTool("plan '" + dir + "/floor.yaml'");
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_MENTIONS(r.err, "start is in collision");
+  EXPECT_MENTIONS(r.err, "floor");
+  std::filesystem::remove_all(dir);
+}
+
+TEST(CheckTool, ClassifiesStates) {
+  const std::string file = testing::TempDir() + "clearway_check_" + std::to_string(::getpid()) + ".txt";
+  std::ofstream(file) << "# start, goal, into the floor, a bad line, out of bounds\n"
+                         "0 -0.6 -1.2 -1.34 0 0\n0, 0.6, 1.2, 1.34, 0, 0\n0 1.7 0.5 0 0 0\n0 1 x\n0 0 0 0 0 99\n";
+  ToolRun r = runTool("check " + bundledScene() + " --states '" + file + "'");
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  std::istringstream out(r.out);
+  std::vector<std::string> lines;
+  for (std::string l; std::getline(out, l);) lines.push_back(l);
+  ASSERT_EQ(lines.size(), 5u) << r.out;
+  EXPECT_EQ(lines[0], "free");
+  EXPECT_EQ(lines[1], "free");
+  EXPECT_EQ(lines[2].rfind("collision ", 0), 0u) << lines[2];
+  EXPECT_NE(lines[2].find("floor"), std::string::npos) << lines[2];
+  EXPECT_EQ(lines[3].rfind("error ", 0), 0u) << lines[3];
+  EXPECT_EQ(lines[4].rfind("error ", 0), 0u) << lines[4];
+  EXPECT_NE(lines[4].find("wrist_3_joint"), std::string::npos) << lines[4];
+  r = runTool("check " + bundledScene());
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_MENTIONS(r.out, "start: free");
+  EXPECT_EQ(runTool("check").exit_code, 2);
+  EXPECT_EQ(runTool("check /nonexistent.yaml").exit_code, 2);
+}
+
 #endif

@@ -84,9 +84,12 @@ class Environment {
   /// lower_bound certified). Only obstacles within `cutoff` are examined: beyond it the result is
   /// {distance = lower_bound = cutoff, status Separated}. relative_error as in meshDistance. The link is A:
   /// point_a on the link, point_b on the obstacle or voxel, normal from the link towards it (world frame).
+  /// GeometryMode::Hull measures from the link's convex hull (and a mesh obstacle's hull) instead: one
+  /// GJK call per item, a lower bound on the exact distance.
   DistanceResult linkDistance(const LinkGeometry& link, const Pose& pose, const Tolerances& tol,
                               double cutoff = std::numeric_limits<double>::infinity(), double t = 0.0,
-                              double relative_error = 0.0, EnvironmentCounters* counters = nullptr) const noexcept;
+                              double relative_error = 0.0, EnvironmentCounters* counters = nullptr,
+                              GeometryMode mode = GeometryMode::Mesh) const noexcept;
 
  private:
   std::vector<Obstacle> obstacles_;

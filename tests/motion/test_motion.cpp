@@ -1,0 +1,320 @@
+// Continuous motion checks: the certified mode never tunnels (thin walls, thin posts, analytic contact
+// parameters), agrees with dense sampling on real robots and scenes, and refuses bad input.
+#include <clearway/motion/motion.h>
+
+#include "load/robot_files.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <random>
+#include <thread>
+
+namespace clearway {
+namespace {
+
+using test::TempDir;
+
+// A box on a prismatic joint along x (travel ±1 m), and a body that can also turn about z.
+const char* kSliderUrdf = R"(<?xml version="1.0"?>
+<robot name="slider">
+  <link name="base"/>
+  <link name="carriage"/>
+  <link name="block">
+    <collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>
+  </link>
+  <joint name="slide" type="prismatic">
+    <parent link="base"/><child link="carriage"/>
+    <axis xyz="1 0 0"/>
+    <limit lower="-1" upper="1" velocity="1" effort="1"/>
+  </joint>
+  <joint name="turn" type="revolute">
+    <parent link="carriage"/><child link="block"/>
+    <axis xyz="0 0 1"/>
+    <limit lower="-3.2" upper="3.2" velocity="1" effort="1"/>
+  </joint>
+</robot>
+)";
+
+std::shared_ptr<const Scene> sliderScene(const TempDir& dir, const std::string& obstacles) {
+  const std::string urdf = dir.write("slider.urdf", kSliderUrdf);
+  const std::string scene = dir.write("slider.yaml", "format: 1\nname: slider\nrobot:\n  urdf: " + urdf +
+                                                         "\n  group: [slide, turn]\nenvironment:\n  obstacles:\n" +
+                                                         obstacles + "checks: [environment, continuous]\n"
+                                                         "start: [-1, 0]\ngoal: [1, 0]\n");
+  return Scene::load(scene);
+}
+
+// The planar arm (robots/planar_arm) with the given obstacles.
+std::shared_ptr<const Scene> planarScene(const TempDir& dir, const std::string& obstacles,
+                                         const std::string& checks = "[self, environment, continuous]") {
+  const std::string scene = dir.write("planar.yaml", "format: 1\nname: planar\nrobot:\n  urdf: " +
+                                                         test::sourceRobot("planar_arm/planar_arm.urdf") +
+                                                         "\n  group: [shoulder, elbow]\nenvironment:\n  obstacles:\n" +
+                                                         obstacles + "checks: " + checks + "\nstart: [1.5, 0]\ngoal: [-1.5, 0]\n");
+  return Scene::load(scene);
+}
+
+MotionOptions sampled(double resolution) {
+  MotionOptions o;
+  o.mode = MotionMode::Sampled;
+  o.resolution = resolution;
+  return o;
+}
+
+TEST(MotionBound, BoundsTheMotionOfEveryPoint) {
+  // The planar arm: the tip of link2 (1.5 m out) moves at most 1.5·|Δq1| + 0.5·|Δq2|; random steps
+  // must never move a corner of a link farther than the bound says.
+  TempDir dir;
+  const auto scene = planarScene(dir, "    - {name: far, sphere: {radius: 0.1}, pose: {position: [5, 5, 0]}}\n");
+  const MotionBound bound(*scene);
+  const int link2 = scene->robot().linkIndex("link2");
+  const int link1 = scene->robot().linkIndex("link1");
+  ASSERT_GE(link2, 0);
+  // The elbow's reach is the farthest point of link2's (circumscribed) hull from the elbow.
+  EXPECT_GE(bound.linkCoefficient(link2, 1), std::hypot(0.5, 0.05));
+  EXPECT_LE(bound.linkCoefficient(link2, 1), 0.51);
+  EXPECT_GE(bound.linkCoefficient(link2, 0), 1.5);
+  EXPECT_EQ(bound.linkCoefficient(link1, 1), 0.0);  // the elbow does not move link1
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  SceneContext c0 = scene->makeContext(), c1 = scene->makeContext();
+  for (int trial = 0; trial < 500; ++trial) {
+    const double q0[2] = {u(rng), u(rng) * 1.2}, dq[2] = {u(rng) * 0.3, u(rng) * 0.3};
+    const double q1[2] = {q0[0] + dq[0], q0[1] + dq[1]};
+    scene->computePoses(q0, c0);
+    scene->computePoses(q1, c1);
+    // The corners of link2's bounding cylinder (end points on its surface).
+    for (const Vec3 p : {Vec3(0.5, 0.05, 0), Vec3(0, -0.05, 0.05), Vec3(0.5, 0, -0.05)}) {
+      const double moved = (c1.poses[link2] * p - c0.poses[link2] * p).norm();
+      EXPECT_LE(moved, bound.link(link2, dq) + 1e-12);
+    }
+    // The pair bound: link2's motion relative to link1 depends on the elbow only.
+    EXPECT_NEAR(bound.pair(link1, link2, dq), bound.linkCoefficient(link2, 1) * std::abs(dq[1]), 1e-12);
+  }
+}
+
+TEST(MotionCertified, ThinWallIsNeverTunnelled) {
+  // A 1 mm wall at x = 0: the 0.1 m block slides from x = −1 to x = 1. Sampling at 0.25 steps over it;
+  // the certified check finds the contact at s = (1 − 0.0505) / 2, within contact_distance.
+  TempDir dir;
+  const auto scene =
+      sliderScene(dir, "    - {name: wall, box: {size: [0.001, 2, 2]}, pose: {position: [0, 0, 0]}}\n");
+  const double q0[2] = {-1, 0}, q1[2] = {1, 0};
+  const MotionChecker coarse(scene, sampled(0.3));
+  MotionContext cc = coarse.makeContext();
+  EXPECT_TRUE(coarse.check(q0, q1, cc).free) << "the test needs a resolution that tunnels";
+
+  const MotionChecker certified(scene);
+  MotionContext ctx = certified.makeContext();
+  const MotionResult r = certified.check(q0, q1, ctx);
+  ASSERT_FALSE(r.free);
+  EXPECT_FALSE(r.capped);
+  EXPECT_EQ(r.report.kind, CollisionReport::Kind::Environment);
+  const double touch = (1.0 - 0.0505) / 2.0;                                // distance 0
+  const double near = (1.0 - 0.0505 - certified.options().contact_distance) / 2.0;  // distance = contact
+  EXPECT_LE(r.first_contact, touch + 1e-9);
+  EXPECT_GE(r.first_contact, near - 1e-9);
+  EXPECT_LE(r.last_valid, r.first_contact);
+  double q[2];
+  certified.interpolate(q0, q1, r.last_valid, q);
+  EXPECT_TRUE(scene->isFree(std::vector<double>(q, q + 2)));
+  // Few steps: the block is far from the wall most of the way.
+  EXPECT_LT(r.steps, 200);
+
+  // Turning while sliding (the block's corners sweep wider) is caught as well, and sooner.
+  const double t1[2] = {1, 3.0};
+  const MotionResult turning = certified.check(q0, t1, ctx);
+  EXPECT_FALSE(turning.free);
+  EXPECT_LE(turning.first_contact, touch + 1e-9);
+
+  // Sliding away from the wall is free, and every end of the certified segment agrees with sampling.
+  const double a0[2] = {-1, 0}, a1[2] = {-0.2, 2.0};
+  EXPECT_TRUE(certified.check(a0, a1, ctx).free);
+  const MotionChecker fine(scene, sampled(1e-3));
+  MotionContext fc = fine.makeContext();
+  EXPECT_TRUE(fine.check(a0, a1, fc).free);
+}
+
+TEST(MotionCertified, ThinPostAnalyticContact) {
+  // A post of radius 5 mm at (1.4, 0) and the planar arm's link2 (radius 0.05, along the arm from 1.0
+  // to 1.5 m) turning through it: the distance is 1.4·|sin q1| − 0.055, so contact is at
+  // q1 = asin(0.055 / 1.4). With OMPL's default resolution the sampled check steps over the post.
+  TempDir dir;
+  const auto scene = planarScene(
+      dir, "    - {name: post, cylinder: {radius: 0.005, length: 1}, pose: {position: [1.4, 0, 0]}}\n");
+  const double q0[2] = {1.55, 0}, q1[2] = {-1.45, 0};
+  const MotionChecker coarse(scene, sampled(0.3));
+  MotionContext cc = coarse.makeContext();
+  EXPECT_TRUE(coarse.check(q0, q1, cc).free) << "the test needs a resolution that tunnels";
+
+  const MotionChecker certified(scene);
+  MotionContext ctx = certified.makeContext();
+  const MotionResult r = certified.check(q0, q1, ctx);
+  ASSERT_FALSE(r.free);
+  EXPECT_EQ(r.report.kind, CollisionReport::Kind::Environment);
+  EXPECT_EQ(r.report.link, scene->robot().linkIndex("link2"));
+  auto s_at = [&](double distance) { return (1.55 - std::asin((0.055 + distance) / 1.4)) / 3.0; };
+  EXPECT_LE(r.first_contact, s_at(0.0) + 1e-9);
+  EXPECT_GE(r.first_contact, s_at(certified.options().contact_distance) - 1e-9);
+
+  // The reverse direction meets the post from the other side, at the mirrored parameter.
+  const MotionResult back = certified.check(q1, q0, ctx);
+  ASSERT_FALSE(back.free);
+  const double back_touch = (1.45 - std::asin(0.055 / 1.4)) / 3.0;
+  EXPECT_LE(back.first_contact, back_touch + 1e-9);
+  EXPECT_GE(back.first_contact, back_touch - 1e-3 / 1.4 / 3.0 * 2);
+}
+
+TEST(MotionCertified, RandomSegmentsNeverMissWhatDenseSamplingFinds) {
+  // The planar arm among two posts: random segments between free states. Dense sampling finding a
+  // collision means the certified check must find one, no later along the segment.
+  TempDir dir;
+  const auto scene = planarScene(dir,
+                                 "    - {name: post, cylinder: {radius: 0.03, length: 1}, pose: {position: [0, 1.2, 0]}}\n"
+                                 "    - {name: rod, box: {size: [0.02, 0.02, 1]}, pose: {position: [-0.9, -0.9, 0]}}\n");
+  const MotionChecker certified(scene);
+  MotionContext ctx = certified.makeContext();
+  const MotionChecker fine(scene, sampled(2e-3));
+  MotionContext fc = fine.makeContext();
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> s1(-3.1, 3.1), s2(-2.5, 2.5);
+  int collide = 0, free = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const double q0[2] = {s1(rng), s2(rng)}, q1[2] = {s1(rng), s2(rng)};
+    if (!scene->isFree(std::vector<double>(q0, q0 + 2)) || !scene->isFree(std::vector<double>(q1, q1 + 2))) continue;
+    const MotionResult c = certified.check(q0, q1, ctx);
+    const MotionResult d = fine.check(q0, q1, fc);
+    if (!d.free) {
+      EXPECT_FALSE(c.free) << "trial " << trial << ": certified missed a collision sampling found";
+      EXPECT_LE(c.first_contact, d.first_contact + 1e-9);
+    }
+    (c.free ? free : collide)++;
+  }
+  EXPECT_GT(collide, 20);
+  EXPECT_GT(free, 20);
+}
+
+TEST(MotionCertified, BadInput) {
+  TempDir dir;
+  const auto scene =
+      sliderScene(dir, "    - {name: wall, box: {size: [0.001, 2, 2]}, pose: {position: [0, 0, 0]}}\n");
+  const MotionChecker certified(scene);
+  MotionContext ctx = certified.makeContext();
+  const double ok[2] = {-1, 0};
+  for (const double bad : {std::nan(""), std::numeric_limits<double>::infinity(), 5.0}) {
+    const double q[2] = {-0.5, bad};
+    const double p[2] = {bad, 0};
+    for (const MotionChecker* m : {&certified}) {
+      EXPECT_FALSE(m->check(ok, q, ctx).free) << bad;
+      EXPECT_FALSE(m->check(q, ok, ctx).free) << bad;
+      const MotionResult r = m->check(ok, p, ctx);
+      EXPECT_FALSE(r.free) << bad;
+    }
+  }
+  const MotionChecker coarse(scene, sampled(0.01));
+  MotionContext cc = coarse.makeContext();
+  const double nan_end[2] = {std::nan(""), 0};
+  EXPECT_FALSE(coarse.check(ok, nan_end, cc).free);
+  EXPECT_FALSE(coarse.check(nan_end, ok, cc).free);
+  // Options out of range are refused when the checker is made.
+  for (auto edit : std::vector<void (*)(MotionOptions&)>{
+           [](MotionOptions& o) { o.contact_distance = 0; }, [](MotionOptions& o) { o.contact_distance = NAN; },
+           [](MotionOptions& o) { o.resolution = -1; }, [](MotionOptions& o) { o.max_queries = 0; },
+           [](MotionOptions& o) { o.distance_relative_error = -0.1; }}) {
+    MotionOptions o;
+    edit(o);
+    EXPECT_THROW(MotionChecker(scene, o), std::invalid_argument);
+  }
+  // A query cap that is reached reports a collision, never a free segment.
+  MotionOptions capped;
+  capped.max_queries = 1;
+  const MotionChecker tight(scene, capped);
+  MotionContext tc = tight.makeContext();
+  const double far[2] = {0.5, 0};
+  const double from[2] = {-0.9, 0};
+  const MotionResult r = tight.check(from, far, tc);
+  EXPECT_FALSE(r.free);
+  EXPECT_TRUE(r.capped);
+}
+
+// The shared Panda and UR5 problems: segments from the start towards random states. Dense sampling
+// (1e-3 rad) finding a collision means the certified check must find one no later; the certified check
+// reporting a contact that sampling does not see is allowed only where the robot is truly within
+// contact_distance (clearance measured at the contact parameter).
+TEST(MotionCertified, SharedProblemsAgreeWithDenseSampling) {
+  const std::string root = std::string(CLEARWAY_SHARED_DIR) + "/scenes";
+  if (!std::filesystem::is_directory(root) || test::sharedRobot("panda/panda.urdf").empty())
+    GTEST_SKIP() << "shared scenes not found at " << root << " (see DATA.md)";
+  int segments = 0, both_free = 0, both_hit = 0, certified_only = 0;
+  std::mt19937 rng(3);
+  for (const char* name : {"bookshelf_small_panda/bookshelf_small_panda_0001.yaml", "box_ur5/box_ur5_0002.yaml",
+                           "cage_panda/cage_panda_0003.yaml"}) {
+    SceneDescription d = parseSceneFile(root + "/" + name);
+    d.effects.clearance = true;  // to measure the clearance where the certified check stops
+    const auto scene = std::make_shared<const Scene>(d);
+    const MotionChecker certified(scene);
+    MotionOptions dense = sampled(1e-3);
+    const MotionChecker fine(scene, dense);
+    MotionContext c = certified.makeContext(), f = fine.makeContext();
+    const int n = scene->dimension();
+    std::vector<double> q1(n), mid(n);
+    for (int trial = 0; trial < 40; ++trial) {
+      const std::vector<double>& q0 = trial % 2 ? d.start : d.goal;
+      for (int i = 0; i < n; ++i) {
+        std::uniform_real_distribution<double> u(-0.6, 0.6);
+        q1[i] = std::clamp(q0[i] + u(rng), scene->lower(i), scene->upper(i));
+      }
+      if (!scene->isFree(q1)) continue;
+      ++segments;
+      const MotionResult a = certified.check(q0.data(), q1.data(), c);
+      const MotionResult b = fine.check(q0.data(), q1.data(), f);
+      EXPECT_FALSE(a.capped) << name << " trial " << trial;
+      if (!b.free) {
+        EXPECT_FALSE(a.free) << name << " trial " << trial << ": certified missed what sampling found";
+        EXPECT_LE(a.first_contact, b.first_contact + 1e-9) << name << " trial " << trial;
+        ++both_hit;
+      } else if (a.free) {
+        ++both_free;
+      } else {
+        ++certified_only;
+        certified.interpolate(q0.data(), q1.data(), a.first_contact, mid.data());
+        const double clearance = scene->clearance(mid.data(), c.scene);
+        EXPECT_LE(clearance, certified.options().contact_distance * 1.5 + 1e-6)
+            << name << " trial " << trial << " at s = " << a.first_contact;
+      }
+    }
+  }
+  std::printf("%d segments: %d free, %d collide (both), %d within contact_distance (certified only)\n", segments,
+              both_free, both_hit, certified_only);
+  EXPECT_GT(segments, 60);
+  EXPECT_GT(both_free, 10);
+  EXPECT_GT(both_hit, 10);
+}
+
+TEST(MotionCertified, ThreadsShareOneChecker) {
+  TempDir dir;
+  const auto scene = planarScene(
+      dir, "    - {name: post, cylinder: {radius: 0.005, length: 1}, pose: {position: [1.4, 0, 0]}}\n");
+  const MotionChecker certified(scene);
+  const double q0[2] = {1.55, 0}, q1[2] = {-1.45, 0};
+  MotionContext ctx = certified.makeContext();
+  const MotionResult expected = certified.check(q0, q1, ctx);
+  std::vector<std::thread> threads;
+  std::vector<int> wrong(4, 0);
+  for (int t = 0; t < 4; ++t)
+    threads.emplace_back([&, t] {
+      MotionContext mine = certified.makeContext();
+      for (int k = 0; k < 50; ++k) {
+        const MotionResult r = certified.check(q0, q1, mine);
+        wrong[t] += r.free != expected.free || r.first_contact != expected.first_contact;
+      }
+    });
+  for (auto& th : threads) th.join();
+  for (int t = 0; t < 4; ++t) EXPECT_EQ(wrong[t], 0);
+}
+
+}  // namespace
+}  // namespace clearway

@@ -1,0 +1,217 @@
+// The OMPL plugin: state spaces (bounded joints and SO(2)), the validity checker agreeing with the
+// scene, the continuous motion validator's lastValid, planning end to end on the bundled scene, and
+// many threads on one checker.
+#include <clearway/ompl/collision_checking.h>
+
+#include "load/robot_files.h"
+
+#include <ompl/base/spaces/RealVectorStateSpace.h>
+#include <ompl/base/spaces/SO2StateSpace.h>
+#include <ompl/geometric/SimpleSetup.h>
+#include <ompl/geometric/planners/prm/PRM.h>
+#include <ompl/geometric/planners/rrt/RRTConnect.h>
+#include <ompl/util/Console.h>
+#include <ompl/util/RandomNumbers.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <thread>
+
+namespace clearway {
+namespace {
+
+namespace ob = ompl::base;
+namespace og = ompl::geometric;
+using test::TempDir;
+
+// One link (a 1 m bar) on a continuous joint, and a post at angle π: the short way from 3 to −3 rad
+// passes the post, the long way does not.
+const char* kSpinnerUrdf = R"(<?xml version="1.0"?>
+<robot name="spinner">
+  <link name="base"/>
+  <link name="bar">
+    <collision><origin xyz="0.5 0 0"/><geometry><box size="1 0.05 0.05"/></geometry></collision>
+  </link>
+  <link name="slider_link"/>
+  <joint name="spin" type="continuous">
+    <parent link="base"/><child link="bar"/><axis xyz="0 0 1"/>
+  </joint>
+  <joint name="lift" type="prismatic">
+    <parent link="base"/><child link="slider_link"/><axis xyz="0 0 1"/>
+    <limit lower="0" upper="0.5" velocity="1" effort="1"/>
+  </joint>
+</robot>
+)";
+
+std::shared_ptr<const Scene> spinnerScene(const TempDir& dir) {
+  const std::string urdf = dir.write("spinner.urdf", kSpinnerUrdf);
+  return Scene::load(dir.write("spinner.yaml", "format: 1\nname: spinner\nrobot:\n  urdf: " + urdf +
+                                                   "\n  group: [spin, lift]\nenvironment:\n  obstacles:\n"
+                                                   "    - {name: post, cylinder: {radius: 0.02, length: 1}, "
+                                                   "pose: {position: [-0.8, 0, 0]}}\n"
+                                                   "checks: [environment, continuous]\nstart: [3, 0]\ngoal: [-3, 0]\n"));
+}
+
+std::string bundledScene() { return std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/arm6_wall.yaml"; }
+
+TEST(OmplPlugin, StateSpaces) {
+  TempDir dir;
+  const auto spinner = spinnerScene(dir);
+  const ob::StateSpacePtr space = makeStateSpace(*spinner);
+  ASSERT_TRUE(space->isCompound());
+  auto* compound = space->as<ob::CompoundStateSpace>();
+  ASSERT_EQ(compound->getSubspaceCount(), 2u);
+  EXPECT_NE(dynamic_cast<ob::SO2StateSpace*>(compound->getSubspace(0).get()), nullptr);
+  const auto* lift = dynamic_cast<ob::RealVectorStateSpace*>(compound->getSubspace(1).get());
+  ASSERT_NE(lift, nullptr);
+  EXPECT_EQ(lift->getBounds().low[0], 0.0);
+  EXPECT_EQ(lift->getBounds().high[0], 0.5);
+
+  const StateMap map(*spinner);
+  ob::ScopedState<> s(space);
+  const double v[2] = {3.5, 0.25};  // 3.5 rad wraps into SO(2)'s range
+  map.fromVector(v, s.get());
+  double back[2];
+  map.toVector(s.get(), back);
+  EXPECT_NEAR(back[0], 3.5 - 2 * M_PI, 1e-12);
+  EXPECT_EQ(back[1], 0.25);
+  double from[2] = {3.0, 0}, to[2] = {-3.0, 0};
+  map.unwrap(from, to);
+  EXPECT_NEAR(to[0], 2 * M_PI - 3.0, 1e-12);  // the short way, through π
+
+  const auto arm = Scene::load(bundledScene());
+  const ob::StateSpacePtr real = makeStateSpace(*arm);
+  ASSERT_EQ(real->getType(), ob::STATE_SPACE_REAL_VECTOR);
+  EXPECT_EQ(real->getDimension(), 6u);
+  EXPECT_EQ(real->as<ob::RealVectorStateSpace>()->getDimensionName(0), "shoulder_pan_joint");
+}
+
+TEST(OmplPlugin, ValidityCheckerAgreesWithTheScene) {
+  const auto scene = Scene::load(bundledScene());
+  auto si = std::make_shared<ob::SpaceInformation>(makeStateSpace(*scene));
+  const CollisionChecking c = setupCollisionChecking(si, scene);
+  const StateMap map(*scene);
+  ob::ScopedState<> s(si->getStateSpace());
+  auto sampler = si->allocStateSampler();
+  std::vector<double> q(scene->dimension());
+  int valid = 0;
+  for (int i = 0; i < 500; ++i) {
+    sampler->sampleUniform(s.get());
+    map.toVector(s.get(), q.data());
+    const bool expected = scene->isFree(q);
+    EXPECT_EQ(si->isValid(s.get()), expected);
+    valid += expected;
+  }
+  EXPECT_GT(valid, 50);
+  EXPECT_LT(valid, 450);
+  EXPECT_GE(c.validity->counters().states.load(), 500u);
+  // Without `clearance` in the scene, OMPL is told that there is none to ask for.
+  EXPECT_EQ(c.validity->getSpecs().clearanceComputationType, ob::StateValidityCheckerSpecs::NONE);
+}
+
+TEST(OmplPlugin, MotionValidatorTakesTheShortWayAndReportsLastValid) {
+  TempDir dir;
+  const auto scene = spinnerScene(dir);
+  auto si = std::make_shared<ob::SpaceInformation>(makeStateSpace(*scene));
+  si->setStateValidityCheckingResolution(0.5);  // coarse: the sampled check would step over the post
+  const CollisionChecking c = setupCollisionChecking(si, scene);
+  const StateMap map(*scene);
+  ob::ScopedState<> a(si->getStateSpace()), b(si->getStateSpace()), last(si->getStateSpace());
+  const double qa[2] = {3.0, 0}, qb[2] = {-3.0, 0};
+  map.fromVector(qa, a.get());
+  map.fromVector(qb, b.get());
+  ASSERT_TRUE(si->isValid(a.get()));
+  ASSERT_TRUE(si->isValid(b.get()));
+  EXPECT_FALSE(si->checkMotion(a.get(), b.get()));
+  std::pair<ob::State*, double> lv(last.get(), -1.0);
+  ASSERT_FALSE(si->checkMotion(a.get(), b.get(), lv));
+  // The bar's far end (1 m, half-width 0.025) meets the post (0.8 m, radius 0.02) where
+  // 0.8·sin(π − θ) = 0.045: θ = π − asin(0.045 / 0.8); the segment runs 3 → 2π − 3.
+  const double theta = M_PI - std::asin(0.045 / 0.8);
+  const double s_touch = (theta - 3.0) / (2 * M_PI - 6.0);
+  EXPECT_GT(lv.second, 0.0);
+  EXPECT_LE(lv.second, s_touch + 1e-9);
+  EXPECT_GE(lv.second, s_touch - 0.01);
+  EXPECT_TRUE(si->isValid(last.get()));
+  // The long way round (through 0) is free: split it in two short segments.
+  ob::ScopedState<> zero(si->getStateSpace());
+  const double q0[2] = {0.0, 0.3};
+  map.fromVector(q0, zero.get());
+  EXPECT_TRUE(si->checkMotion(a.get(), zero.get()));
+  EXPECT_TRUE(si->checkMotion(zero.get(), b.get()));
+  EXPECT_EQ(c.motion->counters().motions.load(), 4u);
+}
+
+// Plans on the bundled scene with RRTConnect and checks the path independently: every segment
+// certified free, and dense samples along it valid.
+TEST(OmplPlugin, PlansOnTheBundledScene) {
+  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+  ompl::RNG::setSeed(42);
+  const auto scene = Scene::load(bundledScene());
+  og::SimpleSetup setup(makeStateSpace(*scene));
+  const CollisionChecking c = setupCollisionChecking(setup.getSpaceInformation(), scene);
+  const StateMap map(*scene);
+  ob::ScopedState<> start(setup.getStateSpace()), goal(setup.getStateSpace());
+  map.fromVector(scene->description().start.data(), start.get());
+  map.fromVector(scene->description().goal.data(), goal.get());
+  setup.setStartAndGoalStates(start, goal);
+  setup.setPlanner(std::make_shared<og::RRTConnect>(setup.getSpaceInformation()));
+  ASSERT_EQ(setup.solve(60.0), ob::PlannerStatus::EXACT_SOLUTION);
+  setup.simplifySolution();
+  og::PathGeometric& path = setup.getSolutionPath();
+  ASSERT_GE(path.getStateCount(), 2u);
+  // The straight line is blocked by the wall: the planner had to find a way round.
+  EXPECT_FALSE(setup.getSpaceInformation()->checkMotion(start.get(), goal.get()));
+  const MotionChecker certified(scene);
+  MotionOptions dense;
+  dense.mode = MotionMode::Sampled;
+  dense.resolution = 2e-3;
+  const MotionChecker sampled(scene, dense);
+  MotionContext cc = certified.makeContext(), sc = sampled.makeContext();
+  std::vector<double> q0(scene->dimension()), q1(scene->dimension());
+  for (std::size_t i = 0; i + 1 < path.getStateCount(); ++i) {
+    map.toVector(path.getState(i), q0.data());
+    map.toVector(path.getState(i + 1), q1.data());
+    EXPECT_TRUE(certified.check(q0.data(), q1.data(), cc).free) << "segment " << i;
+    EXPECT_TRUE(sampled.check(q0.data(), q1.data(), sc).free) << "segment " << i;
+  }
+  EXPECT_GT(c.motion->counters().motions.load(), 0u);
+}
+
+// PRM grows its roadmap in a second thread while the first one queries: the checkers are shared.
+TEST(OmplPlugin, ThreadsShareTheCheckers) {
+  const auto scene = Scene::load(bundledScene());
+  auto si = std::make_shared<ob::SpaceInformation>(makeStateSpace(*scene));
+  setupCollisionChecking(si, scene);
+  const StateMap map(*scene);
+  // Serial answers first.
+  constexpr int kStates = 200;
+  std::vector<ob::State*> states(kStates + 1);
+  auto sampler = si->allocStateSampler();
+  for (auto& s : states) {
+    s = si->allocState();
+    sampler->sampleUniform(s);
+  }
+  std::vector<char> valid(kStates), motion(kStates);
+  for (int i = 0; i < kStates; ++i) {
+    valid[i] = si->isValid(states[i]);
+    motion[i] = si->checkMotion(states[i], states[i + 1]);
+  }
+  std::vector<int> wrong(4, 0);
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 4; ++t)
+    threads.emplace_back([&, t] {
+      for (int i = t; i < kStates; i += 2) {
+        wrong[t] += si->isValid(states[i]) != static_cast<bool>(valid[i]);
+        wrong[t] += si->checkMotion(states[i], states[i + 1]) != static_cast<bool>(motion[i]);
+      }
+    });
+  for (auto& th : threads) th.join();
+  for (int t = 0; t < 4; ++t) EXPECT_EQ(wrong[t], 0) << "thread " << t;
+  for (auto* s : states) si->freeState(s);
+}
+
+}  // namespace
+}  // namespace clearway
