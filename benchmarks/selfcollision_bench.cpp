@@ -13,6 +13,8 @@
 #include <clearway/load/robot_loader.h>
 #include <clearway/scene/self_collision.h>
 
+#include "fcl_robot.h"
+
 #include <fcl/fcl.h>
 
 #include <algorithm>
@@ -22,6 +24,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -39,60 +42,6 @@ double threadSeconds() {
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
   return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
-
-fcl::Transform3d toFcl(const cw::Pose& p) {
-  fcl::Transform3d t = fcl::Transform3d::Identity();
-  t.linear() = p.R;
-  t.translation() = p.t;
-  return t;
-}
-
-// One FCL object per collision element; a link is the list of its elements' objects.
-template <class BV>
-struct FclRobot {
-  std::vector<std::vector<std::shared_ptr<fcl::CollisionGeometryd>>> geometry;  // per link
-  std::vector<std::vector<cw::Pose>> origins;                                   // per link, per element
-
-  explicit FclRobot(const cw::RobotModel& m) : geometry(m.linkCount()), origins(m.linkCount()) {
-    for (int i = 0; i < m.linkCount(); ++i)
-      for (const cw::CollisionElement& e : m.link(i).collisions) {
-        origins[i].push_back(e.origin);
-        if (e.mesh >= 0) {
-          const cw::TriangleMesh& mesh = m.meshes()[e.mesh];
-          auto model = std::make_shared<fcl::BVHModel<BV>>();
-          std::vector<fcl::Triangle> tris;
-          for (const auto& t : mesh.triangles) tris.emplace_back(t[0], t[1], t[2]);
-          model->beginModel();
-          model->addSubModel(mesh.vertices, tris);
-          model->endModel();
-          geometry[i].push_back(model);
-        } else {
-          geometry[i].push_back(std::visit(
-              [](const auto& s) -> std::shared_ptr<fcl::CollisionGeometryd> {
-                using S = std::decay_t<decltype(s)>;
-                if constexpr (std::is_same_v<S, cw::Box>) return std::make_shared<fcl::Boxd>(2.0 * s.half);
-                else if constexpr (std::is_same_v<S, cw::Sphere>) return std::make_shared<fcl::Sphered>(s.r);
-                else if constexpr (std::is_same_v<S, cw::Cylinder>) return std::make_shared<fcl::Cylinderd>(s.r, 2.0 * s.h);
-                else if constexpr (std::is_same_v<S, cw::Capsule>) return std::make_shared<fcl::Capsuled>(s.r, 2.0 * s.h);
-                else throw std::runtime_error("unsupported primitive for FCL");
-              },
-              *e.primitive));
-        }
-      }
-  }
-
-  bool pairCollides(int a, int b, const cw::Pose* poses) const {
-    fcl::CollisionRequestd request;  // one contact, no contact data: a boolean query
-    for (std::size_t i = 0; i < geometry[a].size(); ++i)
-      for (std::size_t j = 0; j < geometry[b].size(); ++j) {
-        fcl::CollisionResultd result;
-        const fcl::CollisionObjectd oa(geometry[a][i], toFcl(poses[a] * origins[a][i]));
-        const fcl::CollisionObjectd ob(geometry[b][j], toFcl(poses[b] * origins[b][j]));
-        if (fcl::collide(&oa, &ob, request, result) > 0) return true;
-      }
-    return false;
-  }
-};
 
 struct Row {
   std::string robot, method;
@@ -125,8 +74,8 @@ void benchRobot(const std::string& name, const std::string& urdf, const std::str
   hull_options.mode = cw::GeometryMode::Hull;
   const cw::SelfCollision mesh(geometry, filter), hull(geometry, filter, hull_options);
   const auto t1 = std::chrono::steady_clock::now();
-  const FclRobot<fcl::OBBRSSd> obbrss(*model);
-  const FclRobot<fcl::OBBd> obb(*model);
+  const cw::bench::FclRobot<fcl::OBBRSSd> obbrss(*model);
+  const cw::bench::FclRobot<fcl::OBBd> obb(*model);
   const double fcl_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
   std::printf("%s: %d links, %zu checked pairs, %zu triangles; load (URDF + meshes + trees + hulls) %.1f ms, "
               "FCL BVH build (both) %.1f ms\n",
@@ -176,6 +125,9 @@ void benchRobot(const std::string& name, const std::string& urdf, const std::str
   add("clearway-hull", t_hull, v_hull);
   add("fcl-obbrss", t_obbrss, v_obbrss);
   add("fcl-obb", t_obb, v_obb);
+  int hull_free_mesh_hit = 0;  // hull mode is conservative: it must never say free where mesh collides
+  for (int s = 0; s < n; ++s) hull_free_mesh_hit += v_mesh[s] && !v_hull[s];
+  std::printf("  %s: hull said free where mesh collides: %d states (must be 0)\n", name.c_str(), hull_free_mesh_hit);
   for (int s = 0; s < n; ++s)
     if (v_mesh[s] != v_obbrss[s]) {
       std::printf("  disagreement at state %d: clearway-mesh %d, fcl-obbrss %d\n", s, v_mesh[s], v_obbrss[s]);

@@ -171,12 +171,42 @@ template <class S>
 bool shapeIntersectsTriangles(const S& s, const Pose& shape_in_link, const LinkGeometry& link, const Tolerances& tol,
                               double padding, double slack) noexcept {
   if (link.triangles().empty()) return false;
+  // Nodes are tested against the shape's world box (cheap) and then against its own box as an oriented
+  // box (SAT lite; full SAT for single triangles): a large primitive turned against the link's frame,
+  // such as a pedestal beside an arm, would otherwise reach every triangle its world box covers.
   const Aabb box = shapeBox(s, shape_in_link).inflated(slack);
+  const Aabb own = shapeBox(s, Pose::identity()).inflated(slack);
+  const double scale = link.boundingRadius() + shape_in_link.t.norm() + own.min.cwiseAbs().cwiseMax(own.max.cwiseAbs()).norm();
+  const detail::OrientedBoxTest test(shape_in_link, 0.0, scale);
+  const detail::OrientedBoxTest::PlacedB placed = test.place(own);
   const std::vector<Triangle>& tris = link.triangles();
-  return link.tree().query(box, [&](std::int32_t i) {
-    SimplexCache cache;
-    return gjkIntersect(Padded<S>{s, padding}, shape_in_link, tris[i], Pose::identity(), tol, cache).intersecting;
-  });
+  const AabbTree& tree = link.tree();
+  const auto apart = [&](const Aabb& node, auto full) {
+    if (!overlaps(node, box)) return true;
+    double c[3], h[3];
+    detail::OrientedBoxTest::centerHalf(node, c, h);
+    return test.separated<decltype(full)::value>(c, h, placed);
+  };
+  std::int32_t stack[AabbTree::kMaxDepth + 1];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const AabbTree::Node& n = tree.nodes()[stack[--top]];
+    if (apart(n.box, std::false_type{})) continue;
+    if (!n.isLeaf()) {
+      stack[top++] = n.first + 1;
+      stack[top++] = n.first;
+      continue;
+    }
+    for (std::int32_t slot = n.first; slot < n.first + n.count; ++slot) {
+      if (apart(tree.slotBoxes()[slot], std::true_type{})) continue;
+      SimplexCache cache;
+      if (gjkIntersect(Padded<S>{s, padding}, shape_in_link, tris[tree.items()[slot]], Pose::identity(), tol, cache)
+              .intersecting)
+        return true;
+    }
+  }
+  return false;
 }
 
 bool shapeIntersectsTriangles(const Shape& s, const Pose& shape_in_link, const LinkGeometry& link, const Tolerances& tol,
