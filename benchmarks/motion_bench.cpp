@@ -177,9 +177,10 @@ int main(int argc, char** argv) {
       const double extent = space->getMaximumExtent();
 
       std::vector<Mode> modes(4);
+      // A space per mode: the validity-checking resolution is a property of the state space.
       for (int m = 0; m < 4; ++m) {
         modes[m].name = names[m];
-        modes[m].si = std::make_shared<ob::SpaceInformation>(space);
+        modes[m].si = std::make_shared<ob::SpaceInformation>(m == 0 ? space : cw::makeStateSpace(*scene));
       }
       cw::setupCollisionChecking(modes[0].si, scene);
       for (int m = 1; m < 4; ++m) {
