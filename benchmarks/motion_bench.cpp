@@ -48,59 +48,6 @@ double threadSeconds() {
   return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
-// A scene's self pairs and obstacles in FCL: the validity check MoveIt's FCL plugin performs.
-class FclScene {
- public:
-  explicit FclScene(const cw::Scene& scene) : scene_(scene), robot_(scene.robot()) {
-    for (const cw::Obstacle& o : scene.environment().obstacles()) {
-      if (o.mesh) throw std::runtime_error("bench_motion: mesh obstacles are not converted to FCL");
-      std::shared_ptr<fcl::CollisionGeometryd> g = std::visit(
-          [](const auto& s) -> std::shared_ptr<fcl::CollisionGeometryd> {
-            using S = std::decay_t<decltype(s)>;
-            if constexpr (std::is_same_v<S, cw::Box>) return std::make_shared<fcl::Boxd>(2.0 * s.half);
-            else if constexpr (std::is_same_v<S, cw::Sphere>) return std::make_shared<fcl::Sphered>(s.r);
-            else if constexpr (std::is_same_v<S, cw::Cylinder>) return std::make_shared<fcl::Cylinderd>(s.r, 2.0 * s.h);
-            else if constexpr (std::is_same_v<S, cw::Capsule>) return std::make_shared<fcl::Capsuled>(s.r, 2.0 * s.h);
-            else throw std::runtime_error("bench_motion: unsupported obstacle shape for FCL");
-          },
-          o.shape);
-      obstacles_.push_back(std::make_unique<fcl::CollisionObjectd>(g, cw::bench::toFcl(o.pose)));
-    }
-    std::vector<fcl::CollisionObjectd*> raw;
-    for (auto& o : obstacles_) raw.push_back(o.get());
-    manager_.registerObjects(raw);
-    manager_.setup();
-  }
-
-  bool isFree(const double* state) {
-    scene_.computePoses(state, ctx());
-    const cw::Pose* poses = ctx().poses.data();
-    for (int link : scene_.environmentLinks())
-      for (std::size_t e = 0; e < robot_.objects[link].size(); ++e) {
-        fcl::CollisionObjectd& obj = *robot_.objects[link][e];
-        obj.setTransform(cw::bench::toFcl(poses[link] * robot_.origins[link][e]));
-        obj.computeAABB();
-        fcl::DefaultCollisionData<double> data;
-        manager_.collide(&obj, &data, fcl::DefaultCollisionFunction);
-        if (data.result.isCollision()) return false;
-      }
-    for (const cw::LinkPair& p : scene_.selfCollision().pairs())
-      if (robot_.pairCollides(p.a, p.b, poses)) return false;
-    return true;
-  }
-
- private:
-  cw::SceneContext& ctx() {
-    if (!ctx_) ctx_ = std::make_unique<cw::SceneContext>(scene_.makeContext());
-    return *ctx_;
-  }
-  const cw::Scene& scene_;
-  cw::bench::FclRobot<fcl::OBBRSSd> robot_;
-  std::vector<std::unique_ptr<fcl::CollisionObjectd>> obstacles_;
-  fcl::DynamicAABBTreeCollisionManagerd manager_;
-  std::unique_ptr<cw::SceneContext> ctx_;
-};
-
 class FclValidity : public ob::StateValidityChecker {
  public:
   FclValidity(const ob::SpaceInformationPtr& si, const cw::Scene& scene)
@@ -111,7 +58,7 @@ class FclValidity : public ob::StateValidityChecker {
   }
 
  private:
-  mutable FclScene fcl_;
+  mutable cw::bench::FclScene fcl_;
   cw::StateMap map_;
   mutable std::vector<double> q_;
 };

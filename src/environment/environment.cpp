@@ -13,6 +13,7 @@
 // is gjk_absolute times the pair's size) would call touching.
 #include <clearway/environment/environment.h>
 
+#include <clearway/narrowphase/epa.h>
 #include <clearway/shape/support.h>
 
 #include <algorithm>
@@ -311,6 +312,48 @@ DistanceResult Environment::linkDistance(const LinkGeometry& link, const Pose& p
   // Every item not evaluated was at least the final limit away.
   r.lower_bound = std::min({search.lower, search.limit, r.distance});
   return r;
+}
+
+double Environment::linkPenetration(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, double padding,
+                                    double t, EnvironmentCounters* counters) const noexcept {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (!pose.isFinite() || !(padding >= 0.0) || !std::isfinite(padding) || !std::isfinite(t)) return nan;
+  const Aabb link_box = transformed(link.bounds(), pose).inflated(padding);
+  double deepest = 0.0;
+  bool failed = false;
+  // One touching item: the hull's depth into it (EPA runs only here).
+  const auto depth = [&](const auto& shape, const Pose& pose_s) {
+    if (counters) ++counters->penetration_tests;
+    const PenetrationResult r = epaPenetration(link.hull(), pose, shape, pose_s, tol);
+    if (isFailure(r.status)) failed = true;
+    deepest = std::max(deepest, padding - r.signed_distance);  // padded links may touch with the hull apart
+  };
+  const auto visit = [&](const Obstacle& o, const Pose& pose_o) {
+    if (o.mesh) {
+      if (meshesIntersect(link, pose, *o.mesh, pose_o, tol, GeometryMode::Mesh, padding)) depth(o.mesh->hull(), pose_o);
+    } else if (shapeIntersectsLink(o.shape, pose_o, link, pose, tol, GeometryMode::Mesh, padding)) {
+      std::visit([&](const auto& s) { depth(s, pose_o); }, o.shape);
+    }
+  };
+  static_tree_.query(link_box, [&](std::int32_t item) {
+    const Obstacle& o = obstacles_[static_[item]];
+    visit(o, o.pose);
+  });
+  for (const int k : moving_) {
+    const Obstacle& o = obstacles_[k];
+    const Pose at = poseAt(o, t);
+    if (!at.isFinite()) return nan;
+    if (overlaps(obstacleBox(o, at), link_box)) visit(o, at);
+  }
+  if (!voxel_tree_.empty()) {
+    const std::vector<Aabb>& voxels = map_->occupied;
+    voxel_tree_.query(link_box, [&](std::int32_t v) {
+      const Box box(voxels[v].halfExtents());
+      const Pose pose_v = Pose::translation(voxels[v].center());
+      if (shapeIntersectsLink(box, pose_v, link, pose, tol, GeometryMode::Mesh, padding)) depth(box, pose_v);
+    });
+  }
+  return failed ? nan : deepest;
 }
 
 }  // namespace clearway

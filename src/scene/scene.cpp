@@ -321,28 +321,41 @@ double Scene::clearance(const double* state, SceneContext& ctx, double* lower_bo
   if (!valid) return nan;
   ++ctx.counters.clearance_queries;
   computePoses(state, ctx);
+  // Distances first; EPA only when something touches (then the value is minus the deepest penetration).
   double best = std::numeric_limits<double>::infinity(), lower = best;
-  if (fx.environment && !environment_->empty()) {
-    const double time = fx.moving ? t : 0.0;
+  const bool env = fx.environment && !environment_->empty();
+  const double time = fx.moving ? t : 0.0;
+  if (env) {
     for (int i : geometry_->geometricLinks()) {
       const DistanceResult d = environment_->linkDistance(*geometry_->link(i), ctx.poses[i], options_.tolerances,
                                                           best + link_padding_[i], time, 0.0, &ctx.counters.environment);
-      if (isFailure(d.status)) {
-        best = lower = 0.0;
-        break;
-      }
+      if (isFailure(d.status)) return nan;
       best = std::min(best, std::max(0.0, d.distance - link_padding_[i]));
       lower = std::min(lower, std::max(0.0, d.lower_bound - link_padding_[i]));
+      if (best == 0.0) break;
     }
   }
   if (fx.self && best > 0.0) {
     const DistanceResult d = self_.minimumDistance(ctx.poses.data());
-    if (isFailure(d.status)) {
-      best = lower = 0.0;
-    } else {
-      best = std::min(best, d.distance);
-      lower = std::min(lower, d.lower_bound);
+    if (isFailure(d.status)) return nan;
+    best = std::min(best, d.distance);
+    lower = std::min(lower, d.lower_bound);
+  }
+  if (best == 0.0) {
+    double deepest = 0.0;
+    if (env)
+      for (int i : geometry_->geometricLinks()) {
+        const double p = environment_->linkPenetration(*geometry_->link(i), ctx.poses[i], options_.tolerances,
+                                                       link_padding_[i], time, &ctx.counters.environment);
+        if (std::isnan(p)) return nan;
+        deepest = std::max(deepest, p);
+      }
+    if (fx.self) {
+      const double p = self_.penetration(ctx.poses.data(), ctx.self);
+      if (std::isnan(p)) return nan;
+      deepest = std::max(deepest, p);
     }
+    best = lower = -deepest;
   }
   if (lower_bound) *lower_bound = lower;
   return best;

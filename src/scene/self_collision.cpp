@@ -1,5 +1,7 @@
 #include <clearway/scene/self_collision.h>
 
+#include <clearway/narrowphase/epa.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -103,6 +105,24 @@ DistanceResult SelfCollision::minimumDistance(const Pose* poses, LinkPair* pair,
   }
   best.lower_bound = lower;
   return best;
+}
+
+double SelfCollision::penetration(const Pose* poses, SelfCollisionContext& context, LinkPair* pair) const {
+  double deepest = 0.0;
+  for (int k = 0; k < static_cast<int>(pairs_.size()); ++k) {
+    if (!pairCollides(k, poses, context)) continue;
+    const LinkPair& p = pairs_[k];
+    const PenetrationResult r = epaPenetration(geometry_->link(p.a)->hull(), poses[p.a], geometry_->link(p.b)->hull(),
+                                               poses[p.b], options_.tolerances);
+    if (isFailure(r.status)) return std::numeric_limits<double>::quiet_NaN();
+    // Padded pairs may collide with their hulls apart: then the depth is padding − distance.
+    const double depth = pair_padding_[k] - r.signed_distance;
+    if (depth > deepest) {
+      deepest = depth;
+      if (pair) *pair = p;
+    }
+  }
+  return deepest;
 }
 
 }  // namespace clearway

@@ -138,9 +138,44 @@ TEST(Scene, PlanarArmAgainstAWall) {
   EXPECT_NEAR(scene->clearance(up, ctx, &lower), 0.9, 1e-6);
   EXPECT_LE(lower, 0.9 + 1e-12);
   EXPECT_GE(lower, 0.9 * (1 - 1e-5));
-  // Reaching the wall exactly: the elbow at 0.65 from the wall... touching is a collision.
+  // Through the wall (x from 1.15 to 1.25): link2 spans x from 1.0 to 1.5, so it leaves the wall
+  // by moving 0.25 along +x (0.35 along −x, 0.45 up, 1.05 sideways): the signed clearance is −0.25,
+  // and EPA ran for it.
   const double into[2] = {0.0, 0.0};
-  EXPECT_EQ(scene->clearance(into, ctx), 0.0);
+  const long long epa_before = ctx.counters.environment.penetration_tests;
+  EXPECT_NEAR(scene->clearance(into, ctx, &lower), -0.25, 1e-5);
+  EXPECT_LE(lower, -0.25 + 1e-5);
+  EXPECT_GT(ctx.counters.environment.penetration_tests, epa_before);
+  // Free states run no EPA.
+  const long long epa_free = ctx.counters.environment.penetration_tests;
+  scene->clearance(up, ctx);
+  EXPECT_EQ(ctx.counters.environment.penetration_tests, epa_free);
+}
+
+TEST(Scene, SignedClearanceOfSelfPenetration) {
+  // Two unit cubes, the second on a prismatic joint: they overlap by 0.2 at q = 0.8 (the planar arm
+  // cannot reach itself).
+  TempDir dir;
+  const std::string urdf = dir.write("cubes.urdf", R"(<?xml version="1.0"?>
+<robot name="cubes">
+  <link name="a"><collision><geometry><box size="1 1 1"/></geometry></collision></link>
+  <link name="mid"><collision><origin xyz="0 0 5"/><geometry><sphere radius="0.1"/></geometry></collision></link>
+  <link name="b"><collision><geometry><box size="1 1 1"/></geometry></collision></link>
+  <joint name="slide" type="prismatic"><parent link="a"/><child link="mid"/><axis xyz="1 0 0"/>
+    <limit lower="0" upper="3" velocity="1" effort="1"/></joint>
+  <joint name="fix" type="fixed"><parent link="mid"/><child link="b"/><origin xyz="0 0 0"/></joint>
+</robot>
+)");
+  const std::string scene_file = dir.write("s.yaml", "format: 1\nname: cubes\nrobot:\n  urdf: " + urdf +
+                                                         "\n  group: [slide]\nchecks: [self, clearance]\n");
+  // 'mid' has geometry (a ball far above), so a and b are not adjacent: their pair is checked.
+  const auto scene = Scene::load(scene_file);
+  ASSERT_EQ(scene->selfCollision().pairs().size(), 1u);
+  SceneContext ctx = scene->makeContext();
+  const double q[1] = {0.8};
+  EXPECT_NEAR(scene->clearance(q, ctx), -0.2, 1e-6);
+  const double apart[1] = {1.5};
+  EXPECT_NEAR(scene->clearance(apart, ctx), 0.5, 1e-6);
 }
 
 TEST(Scene, InvalidStatesAreNeverFree) {
@@ -187,12 +222,13 @@ TEST(Scene, UndeclaredEffectsCostNothing) {
     // bounding spheres, so self shows as checked pairs only when declared.
     if (!self) EXPECT_EQ(n.self_pair_tests, 0);
     if (scene->effects().clearance) {
-      EXPECT_GE(c, 0.0);
+      EXPECT_FALSE(std::isnan(c));
       EXPECT_GT(n.environment.distance_tests, 0);
     } else {
       EXPECT_TRUE(std::isnan(c));
       EXPECT_EQ(n.environment.distance_tests, 0);
       EXPECT_EQ(n.clearance_queries, 0);
+      EXPECT_EQ(n.environment.penetration_tests, 0);  // no EPA without clearance
     }
   }
 }

@@ -60,6 +60,7 @@ struct EnvironmentCounters {
   long long obstacle_tests = 0;  ///< exact obstacle-vs-link tests
   long long voxel_tests = 0;     ///< voxel-vs-link GJK tests (hull tests, and voxel–triangle pairs in Mesh mode)
   long long distance_tests = 0;  ///< distance computations
+  long long penetration_tests = 0;  ///< EPA runs (only for the signed clearance of a colliding link)
 };
 
 /// Obstacles and occupancy, immutable once built; queries are const and thread-safe.
@@ -90,6 +91,13 @@ class Environment {
                               double cutoff = std::numeric_limits<double>::infinity(), double t = 0.0,
                               double relative_error = 0.0, EnvironmentCounters* counters = nullptr,
                               GeometryMode mode = GeometryMode::Mesh) const noexcept;
+
+  /// How deep the link penetrates the environment: over the obstacles and voxels its exact geometry
+  /// (grown by padding) touches, the largest EPA depth of its convex hull into them, plus padding. The
+  /// hull contains the link, so this is an upper bound on the exact depth. 0 when nothing touches; NaN
+  /// when a query failed or the input is not finite.
+  double linkPenetration(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, double padding = 0.0,
+                         double t = 0.0, EnvironmentCounters* counters = nullptr) const noexcept;
 
  private:
   std::vector<Obstacle> obstacles_;

@@ -152,9 +152,11 @@ class Scene {
   /// The same with this thread's own context.
   bool isFree(const std::vector<double>& state, CollisionReport* report = nullptr, double t = 0.0) const;
 
-  /// The distance from the robot to the nearest declared hazard (environment and/or self), minus
-  /// padding; 0 when touching or colliding; NaN when the scene does not declare `clearance` or the
-  /// state is invalid. `lower_bound` (optional) receives a certified lower bound.
+  /// Signed clearance: the distance from the robot to the nearest declared hazard (environment and/or
+  /// self) minus padding when free; when something touches, minus the deepest penetration (EPA between
+  /// convex hulls, which contain the links: never shallower than the exact depth). NaN when the scene
+  /// does not declare `clearance`, the state is invalid or a query failed. `lower_bound` (optional)
+  /// receives a certified lower bound.
   double clearance(const double* state, SceneContext& context, double* lower_bound = nullptr,
                    double t = 0.0) const noexcept;
 

@@ -83,6 +83,10 @@ class SelfCollision {
   /// The clearance of the closest checked pair (distance between exact geometries, minus padding; 0 when
   /// touching); `pair` (optional) receives it. relative_error as in meshDistance. Infinity with no pairs.
   DistanceResult minimumDistance(const Pose* link_poses, LinkPair* pair = nullptr, double relative_error = 0.0) const;
+  /// How deep the robot penetrates itself: over the colliding pairs, the largest EPA depth between the
+  /// two links' convex hulls (an upper bound on the meshes' depth), plus the pair's padding; `pair`
+  /// (optional) receives that pair. 0 when no pair collides; NaN when a query failed.
+  double penetration(const Pose* link_poses, SelfCollisionContext& context, LinkPair* pair = nullptr) const;
 
  private:
   std::shared_ptr<const RobotGeometry> geometry_;
