@@ -128,11 +128,11 @@ class FclScene {
     return true;
   }
 
-  /// The distance from the robot's moving links to the environment through the manager (0 on contact).
+  /// The distance from every link to the environment through the manager (0 on contact).
   double environmentDistance(const double* state) {
     place(state);
     double best = std::numeric_limits<double>::infinity();
-    for (int link : scene_.environmentLinks())
+    for (int link : scene_.geometry().geometricLinks())
       for (auto& obj : robot_.objects[link]) {
         fcl::DefaultDistanceData<double> data;
         manager_.distance(obj.get(), &data, fcl::DefaultDistanceFunction);
@@ -145,7 +145,7 @@ class FclScene {
   void place(const double* state) {
     scene_.computePoses(state, ctx());
     const clearway::Pose* poses = ctx().poses.data();
-    for (int link : scene_.environmentLinks())
+    for (int link : scene_.geometry().geometricLinks())
       for (std::size_t e = 0; e < robot_.objects[link].size(); ++e) {
         fcl::CollisionObjectd& obj = *robot_.objects[link][e];
         obj.setTransform(toFcl(poses[link] * robot_.origins[link][e]));

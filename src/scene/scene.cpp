@@ -206,6 +206,16 @@ void Scene::init() {
         break;
       }
     }
+  // Static links' clearance, likewise (paid only by scenes that declare clearance).
+  if (description_.effects.clearance && description_.effects.environment && !environment_->empty())
+    for (int i : geometry_->geometricLinks()) {
+      if (moves[i] || environment_->hasMovingObstacles()) continue;
+      const DistanceResult d = environment_->linkDistance(*geometry_->link(i), poses[i], options_.tolerances);
+      const bool failed = isFailure(d.status);
+      static_clearance_ = std::min(static_clearance_, failed ? 0.0 : std::max(0.0, d.distance - link_padding_[i]));
+      static_clearance_lower_ =
+          std::min(static_clearance_lower_, failed ? 0.0 : std::max(0.0, d.lower_bound - link_padding_[i]));
+    }
 }
 
 SceneContext Scene::makeContext() const {
@@ -322,11 +332,12 @@ double Scene::clearance(const double* state, SceneContext& ctx, double* lower_bo
   ++ctx.counters.clearance_queries;
   computePoses(state, ctx);
   // Distances first; EPA only when something touches (then the value is minus the deepest penetration).
-  double best = std::numeric_limits<double>::infinity(), lower = best;
   const bool env = fx.environment && !environment_->empty();
+  double best = env ? static_clearance_ : std::numeric_limits<double>::infinity();
+  double lower = env ? static_clearance_lower_ : best;
   const double time = fx.moving ? t : 0.0;
-  if (env) {
-    for (int i : geometry_->geometricLinks()) {
+  if (env && best > 0.0) {
+    for (int i : env_links_) {
       const DistanceResult d = environment_->linkDistance(*geometry_->link(i), ctx.poses[i], options_.tolerances,
                                                           best + link_padding_[i], time, 0.0, &ctx.counters.environment);
       if (isFailure(d.status)) return nan;

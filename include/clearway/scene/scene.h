@@ -10,6 +10,7 @@
 #include <clearway/scene/self_collision.h>
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -178,6 +179,8 @@ class Scene {
   std::vector<int> moving_links_, env_links_;
   std::vector<double> link_padding_;
   CollisionReport static_collision_;  // a collision no state can undo (static links), found at construction
+  double static_clearance_ = std::numeric_limits<double>::infinity();  // static links to static obstacles
+  double static_clearance_lower_ = std::numeric_limits<double>::infinity();
   std::uint64_t serial_ = 0;  // identifies this scene's per-thread contexts
 };
 
