@@ -11,7 +11,10 @@
 // FCL may differ where a link lies within a voxel of the map (FCL tests occupied cells at the finest
 // resolution, as Clearway does; both treat unknown space as free) or within GJK's tolerance.
 //
-// Usage: bench_scene [--states N] [--problems K] [--shared DIR] [--csv FILE]
+// With --start-goal it instead classifies the start and goal of every shared problem in both forms with
+// Clearway and with FCL and prints the verdicts side by side (the check `clearway check SCENE` performs).
+//
+// Usage: bench_scene [--states N] [--problems K] [--shared DIR] [--csv FILE] [--start-goal]
 #include "fcl_robot.h"
 
 #include <clearway/scene/scene.h>
@@ -59,18 +62,52 @@ double timed(int n, std::vector<char>& verdict, F&& f) {
   return best;
 }
 
+// Start and goal of every problem, both forms: Clearway's and FCL's verdicts.
+int startGoal(const std::string& scenes) {
+  std::vector<std::string> files;
+  for (const auto& f : std::filesystem::recursive_directory_iterator(scenes))
+    if (f.path().extension() == ".yaml") files.push_back(f.path().string());
+  std::sort(files.begin(), files.end());
+  std::map<std::string, std::shared_ptr<const cw::RobotGeometry>> robots;
+  int states = 0, agree = 0, free_states = 0;
+  for (const std::string& file : files) {
+    const cw::SceneDescription d = cw::parseSceneFile(file);
+    auto& g = robots[d.urdf];
+    if (!g) g = cw::loadRobotGeometry(d);
+    const cw::Scene scene(d, g, cw::loadEnvironment(d));
+    cw::bench::FclScene fcl(scene);
+    cw::SceneContext ctx = scene.makeContext();
+    for (const auto* q : {&d.start, &d.goal}) {
+      cw::CollisionReport r;
+      const bool ours = scene.isFree(q->data(), ctx, &r);
+      const bool theirs = fcl.isFree(q->data());
+      ++states;
+      agree += ours == theirs;
+      free_states += ours;
+      std::printf("%-60s %-5s clearway %-28s fcl %s\n", std::filesystem::path(file).filename().c_str(),
+                  q == &d.start ? "start" : "goal", ours ? "free" : ("collision " + scene.describe(r)).c_str(),
+                  theirs ? "free" : "collision");
+    }
+  }
+  std::printf("%zu scene files: %d states, %d free (Clearway), Clearway and FCL agree on %d\n", files.size(), states,
+              free_states, agree);
+  return agree == states ? 0 : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   int n = 2000, problems = 2;
+  bool start_goal = false;
   std::string shared = CLEARWAY_SHARED_DIR, csv;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--states") && i + 1 < argc) n = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--problems") && i + 1 < argc) problems = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--shared") && i + 1 < argc) shared = argv[++i];
     else if (!std::strcmp(argv[i], "--csv") && i + 1 < argc) csv = argv[++i];
+    else if (!std::strcmp(argv[i], "--start-goal")) start_goal = true;
     else {
-      std::fprintf(stderr, "usage: bench_scene [--states N] [--problems K] [--shared DIR] [--csv FILE]\n");
+      std::fprintf(stderr, "usage: bench_scene [--states N] [--problems K] [--shared DIR] [--csv FILE] [--start-goal]\n");
       return 2;
     }
   }
@@ -83,6 +120,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bench_scene: no shared scenes at %s\n", scenes.c_str());
     return 2;
   }
+  if (start_goal) return startGoal(scenes);
   std::vector<std::string> families;
   for (const auto& f : std::filesystem::directory_iterator(scenes))
     if (f.is_directory()) families.push_back(f.path().filename().string());
