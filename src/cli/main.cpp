@@ -78,6 +78,7 @@ struct Command {
 const Command kCommands[] = {
     {"plan", "plan start -> goal on a scene with OMPL (a bundled scene when none is given)", clearway::cli::planCommand},
     {"check", "classify joint vectors of a scene: free or which links collide", clearway::cli::checkCommand},
+    {"motion", "check joint-space segments of a scene: free, or the last valid fraction", clearway::cli::motionCommand},
     {"query", "narrow-phase queries on shape pairs from a JSON Lines file", queryCommand},
 };
 

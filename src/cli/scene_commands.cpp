@@ -35,6 +35,27 @@ std::string verdict(const Scene& scene, const std::vector<double>& q, SceneConte
 
 }  // namespace
 
+std::shared_ptr<const Scene> loadScene(const char* command, const std::string& path, const SceneOptions& options) {
+  try {
+    auto scene = Scene::load(path, options);
+    for (const std::string& w : scene->robot().loadWarnings()) std::cerr << "warning: " << w << "\n";
+    return scene;
+  } catch (const std::exception& e) {
+    std::cerr << "clearway " << command << ": " << e.what() << "\n";
+    return nullptr;
+  }
+}
+
+std::istream* openInput(const char* command, const std::string& path, std::ifstream& file) {
+  if (path == "-") return &std::cin;
+  file.open(path);
+  if (!file) {
+    std::cerr << "clearway " << command << ": cannot open " << path << ": " << std::strerror(errno) << "\n";
+    return nullptr;
+  }
+  return &file;
+}
+
 bool parseNumbers(const std::string& line, std::vector<double>& out, std::string& why) {
   out.clear();
   const char* p = line.c_str();
@@ -91,14 +112,8 @@ int checkCommand(const std::vector<std::string>& args) {
     std::cerr << "clearway check: expected a SCENE file\n" << kCheckUsage;
     return kExitUsage;
   }
-  std::shared_ptr<const Scene> scene;
-  try {
-    scene = Scene::load(scene_path, options);
-  } catch (const std::exception& e) {
-    std::cerr << "clearway check: " << e.what() << "\n";
-    return kExitUsage;
-  }
-  for (const std::string& w : scene->robot().loadWarnings()) std::cerr << "warning: " << w << "\n";
+  const std::shared_ptr<const Scene> scene = loadScene("check", scene_path, options);
+  if (!scene) return kExitUsage;
   SceneContext ctx = scene->makeContext();
   int status = kExitOk;
   if (states_path.empty()) {
@@ -113,14 +128,9 @@ int checkCommand(const std::vector<std::string>& args) {
     return std::cout ? kExitOk : kExitUsage;
   }
   std::ifstream file;
-  if (states_path != "-") {
-    file.open(states_path);
-    if (!file) {
-      std::cerr << "clearway check: cannot open " << states_path << ": " << std::strerror(errno) << "\n";
-      return kExitUsage;
-    }
-  }
-  std::istream& in = states_path == "-" ? std::cin : file;
+  std::istream* input = openInput("check", states_path, file);
+  if (!input) return kExitUsage;
+  std::istream& in = *input;
   std::string line, why;
   std::vector<double> q;
   int line_no = 0;

@@ -1,5 +1,10 @@
 #pragma once
-// Subcommands that work on a scene file: check (states), and later motion and plan.
+// Subcommands that work on a scene file: check (states), motion (segments) and plan.
+#include <clearway/scene/scene.h>
+
+#include <fstream>
+#include <istream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -10,6 +15,17 @@ int checkCommand(const std::vector<std::string>& args);
 
 /// `clearway plan [SCENE] ...`: plans start → goal with OMPL and the certified motion check.
 int planCommand(const std::vector<std::string>& args);
+
+/// `clearway motion SCENE [--motions FILE] [--mode certified|sampled:RES]`: two joint vectors per line in,
+/// `free` or `collision F` (F the last valid fraction) out.
+int motionCommand(const std::vector<std::string>& args);
+
+/// Scene::load, printing the robot's load warnings; on failure prints "clearway COMMAND: reason" and
+/// returns null.
+std::shared_ptr<const Scene> loadScene(const char* command, const std::string& path, const SceneOptions& options);
+
+/// Standard input for "-", else `file` opened on path; null (with a message) when it cannot be opened.
+std::istream* openInput(const char* command, const std::string& path, std::ifstream& file);
 
 /// Parses a line of numbers separated by spaces, tabs or commas; false (and `why`) on anything else.
 bool parseNumbers(const std::string& line, std::vector<double>& out, std::string& why);

@@ -245,7 +245,9 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
           if (d <= contact) {
             r.report.kind = CollisionReport::Kind::Environment;
             r.report.link = link;
-            r.report.hit = EnvironmentHit{};
+            // Which obstacle or voxel: one within the contact distance (for the report only).
+            sc.environment().linkIntersects(*geometry.link(link), poses[link], tol, sc.options().mode,
+                                            pad + contact, 0.0, &r.report.hit);
           }
         }
         if (d <= contact) {

@@ -381,7 +381,8 @@ std::string Scene::describe(const CollisionReport& r) const {
     case CollisionReport::Kind::Environment:
       if (r.hit.kind == EnvironmentHit::Kind::Obstacle)
         return model.link(r.link).name + " " + environment_->obstacles()[r.hit.index].name;
-      return model.link(r.link).name + " octomap";
+      if (r.hit.kind == EnvironmentHit::Kind::Voxel) return model.link(r.link).name + " octomap";
+      return model.link(r.link).name + " environment";
   }
   return "?";
 }

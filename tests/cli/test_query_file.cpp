@@ -598,4 +598,41 @@ TEST(CheckTool, ClassifiesStates) {
   EXPECT_EQ(runTool("check /nonexistent.yaml").exit_code, 2);
 }
 
+TEST(MotionTool, ChecksSegments) {
+  const std::string file = testing::TempDir() + "clearway_motion_" + std::to_string(::getpid()) + ".txt";
+  std::ofstream(file) << "# start -> goal crosses the wall; a short free step; bad lines\n"
+                         "0 -0.6 -1.2 -1.34 0 0   0 0.6 1.2 1.34 0 0\n"
+                         "0 -0.6 -1.2 -1.34 0 0,  0 -0.5 -1.2 -1.34 0 0\n"
+                         "1 2\n"
+                         "0 0 0 0 0 99  0 0 0 0 0 0\n";
+  ToolRun r = runTool("motion " + bundledScene() + " --motions '" + file + "'");
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  std::istringstream out(r.out);
+  std::vector<std::string> lines;
+  for (std::string l; std::getline(out, l);) lines.push_back(l);
+  ASSERT_EQ(lines.size(), 4u) << r.out;
+  std::istringstream first(lines[0]);
+  std::string word, link, what;
+  double fraction = -1;
+  first >> word >> fraction >> link >> what;
+  EXPECT_EQ(word, "collision") << lines[0];
+  EXPECT_GT(fraction, 0.0);
+  EXPECT_LT(fraction, 1.0);
+  EXPECT_NE(what, "environment") << "the obstacle is named: " << lines[0];
+  EXPECT_EQ(lines[1], "free");
+  EXPECT_EQ(lines[2].rfind("error line 4", 0), 0u) << lines[2];
+  EXPECT_EQ(lines[3].rfind("error line 5", 0), 0u) << lines[3];
+  EXPECT_NE(lines[3].find("wrist_3_joint"), std::string::npos) << lines[3];
+  // Without --motions: start -> goal; the sampled mode with a resolution; bad modes.
+  r = runTool("motion " + bundledScene() + " --mode sampled:0.01");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_MENTIONS(r.out, "start -> goal: collision");
+  EXPECT_EQ(runTool("motion " + bundledScene() + " --mode sampled:0").exit_code, 2);
+  EXPECT_EQ(runTool("motion " + bundledScene() + " --mode warp").exit_code, 2);
+  r = runTool("motion " + bundledScene() + " --mode cast");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_MENTIONS(r.err, "not implemented");
+  EXPECT_EQ(runTool("motion").exit_code, 2);
+}
+
 #endif
