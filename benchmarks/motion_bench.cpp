@@ -13,7 +13,7 @@
 // fcl-sampled-1%'s time to each mode's.
 //
 // Usage: bench_motion [--motions N] [--problems K] [--shared DIR] [--csv FILE]
-#include "fcl_robot.h"
+#include "fcl_ompl.h"
 
 #include <clearway/ompl/collision_checking.h>
 
@@ -47,21 +47,6 @@ double threadSeconds() {
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
   return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
-
-class FclValidity : public ob::StateValidityChecker {
- public:
-  FclValidity(const ob::SpaceInformationPtr& si, const cw::Scene& scene)
-      : ob::StateValidityChecker(si), fcl_(scene), map_(scene), q_(scene.dimension()) {}
-  bool isValid(const ob::State* s) const override {
-    map_.toVector(s, q_.data());
-    return fcl_.isFree(q_.data());
-  }
-
- private:
-  mutable cw::bench::FclScene fcl_;
-  cw::StateMap map_;
-  mutable std::vector<double> q_;
-};
 
 struct Mode {
   std::string name;
@@ -132,7 +117,7 @@ int main(int argc, char** argv) {
       cw::setupCollisionChecking(modes[0].si, scene);
       for (int m = 1; m < 4; ++m) {
         ob::SpaceInformation& si = *modes[m].si;
-        if (m == 3) si.setStateValidityChecker(std::make_shared<FclValidity>(modes[m].si, *scene));
+        if (m == 3) si.setStateValidityChecker(std::make_shared<cw::bench::FclValidity>(modes[m].si, *scene));
         else si.setStateValidityChecker(std::make_shared<cw::ValidityChecker>(modes[m].si, scene));
         si.setMotionValidator(std::make_shared<ob::DiscreteMotionValidator>(modes[m].si));
         si.setStateValidityCheckingResolution(m == 2 ? 0.001 : 0.01);

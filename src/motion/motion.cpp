@@ -245,9 +245,11 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
           if (d <= contact) {
             r.report.kind = CollisionReport::Kind::Environment;
             r.report.link = link;
-            // Which obstacle or voxel: one within the contact distance (for the report only).
+            // Which obstacle or voxel (for the report only): one within the contact distance, widened by
+            // the relative error the distance's lower bound was allowed.
             sc.environment().linkIntersects(*geometry.link(link), poses[link], tol, sc.options().mode,
-                                            pad + contact, 0.0, &r.report.hit);
+                                            pad + (contact + 1e-9) * (1.0 + options_.distance_relative_error),
+                                            0.0, &r.report.hit);
           }
         }
         if (d <= contact) {

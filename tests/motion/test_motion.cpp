@@ -219,6 +219,16 @@ TEST(MotionCertified, BadInput) {
   const double nan_end[2] = {std::nan(""), 0};
   EXPECT_FALSE(coarse.check(ok, nan_end, cc).free);
   EXPECT_FALSE(coarse.check(nan_end, ok, cc).free);
+  // A zero-length motion is its state's verdict, in both modes.
+  const double inside[2] = {0.0, 0.0};  // the block in the wall
+  for (const MotionChecker* m : {&certified, &coarse}) {
+    MotionContext c = m->makeContext();
+    EXPECT_TRUE(m->check(ok, ok, c).free);
+    const MotionResult r = m->check(inside, inside, c);
+    EXPECT_FALSE(r.free);
+    EXPECT_EQ(r.first_contact, 0.0);
+    EXPECT_EQ(r.last_valid, 0.0);
+  }
   // Options out of range are refused when the checker is made.
   for (auto edit : std::vector<void (*)(MotionOptions&)>{
            [](MotionOptions& o) { o.contact_distance = 0; }, [](MotionOptions& o) { o.contact_distance = NAN; },
