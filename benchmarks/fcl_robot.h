@@ -23,6 +23,20 @@ inline fcl::Transform3d toFcl(const clearway::Pose& p) {
   return t;
 }
 
+/// A box, sphere, cylinder or capsule as FCL's shape (Clearway stores half lengths; FCL full ones).
+inline std::shared_ptr<fcl::CollisionGeometryd> toFclShape(const clearway::Shape& shape) {
+  return std::visit(
+      [](const auto& s) -> std::shared_ptr<fcl::CollisionGeometryd> {
+        using S = std::decay_t<decltype(s)>;
+        if constexpr (std::is_same_v<S, clearway::Box>) return std::make_shared<fcl::Boxd>(2.0 * s.half);
+        else if constexpr (std::is_same_v<S, clearway::Sphere>) return std::make_shared<fcl::Sphered>(s.r);
+        else if constexpr (std::is_same_v<S, clearway::Cylinder>) return std::make_shared<fcl::Cylinderd>(s.r, 2.0 * s.h);
+        else if constexpr (std::is_same_v<S, clearway::Capsule>) return std::make_shared<fcl::Capsuled>(s.r, 2.0 * s.h);
+        else throw std::runtime_error("no FCL counterpart for this Clearway shape");
+      },
+      shape);
+}
+
 // One FCL object per collision element, made once (as MoveIt keeps them: FCL's CollisionObject
 // constructor recomputes the model's bounds over every vertex); a query only moves them.
 template <class BV>
@@ -45,16 +59,7 @@ struct FclRobot {
           model->endModel();
           geometry[i].push_back(model);
         } else {
-          geometry[i].push_back(std::visit(
-              [](const auto& s) -> std::shared_ptr<fcl::CollisionGeometryd> {
-                using S = std::decay_t<decltype(s)>;
-                if constexpr (std::is_same_v<S, clearway::Box>) return std::make_shared<fcl::Boxd>(2.0 * s.half);
-                else if constexpr (std::is_same_v<S, clearway::Sphere>) return std::make_shared<fcl::Sphered>(s.r);
-                else if constexpr (std::is_same_v<S, clearway::Cylinder>) return std::make_shared<fcl::Cylinderd>(s.r, 2.0 * s.h);
-                else if constexpr (std::is_same_v<S, clearway::Capsule>) return std::make_shared<fcl::Capsuled>(s.r, 2.0 * s.h);
-                else throw std::runtime_error("unsupported primitive for FCL");
-              },
-              *e.primitive));
+          geometry[i].push_back(toFclShape(*e.primitive));
         }
       }
     objects.resize(m.linkCount());
@@ -84,17 +89,7 @@ class FclScene {
   explicit FclScene(const clearway::Scene& scene) : scene_(scene), robot_(scene.robot()) {
     for (const clearway::Obstacle& o : scene.environment().obstacles()) {
       if (o.mesh) throw std::runtime_error("FclScene: mesh obstacles are not converted");
-      std::shared_ptr<fcl::CollisionGeometryd> g = std::visit(
-          [](const auto& s) -> std::shared_ptr<fcl::CollisionGeometryd> {
-            using S = std::decay_t<decltype(s)>;
-            if constexpr (std::is_same_v<S, clearway::Box>) return std::make_shared<fcl::Boxd>(2.0 * s.half);
-            else if constexpr (std::is_same_v<S, clearway::Sphere>) return std::make_shared<fcl::Sphered>(s.r);
-            else if constexpr (std::is_same_v<S, clearway::Cylinder>) return std::make_shared<fcl::Cylinderd>(s.r, 2.0 * s.h);
-            else if constexpr (std::is_same_v<S, clearway::Capsule>) return std::make_shared<fcl::Capsuled>(s.r, 2.0 * s.h);
-            else throw std::runtime_error("FclScene: unsupported obstacle shape");
-          },
-          o.shape);
-      obstacles_.push_back(std::make_unique<fcl::CollisionObjectd>(g, toFcl(o.pose)));
+      obstacles_.push_back(std::make_unique<fcl::CollisionObjectd>(toFclShape(o.shape), toFcl(o.pose)));
     }
     if (!scene.description().octomap.empty()) {
       auto tree = std::make_shared<octomap::OcTree>(scene.description().octomap);

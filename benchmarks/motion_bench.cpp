@@ -13,6 +13,7 @@
 // fcl-sampled-1%'s time to each mode's.
 //
 // Usage: bench_motion [--motions N] [--problems K] [--shared DIR] [--csv FILE]
+#include "bench_clock.h"
 #include "fcl_ompl.h"
 
 #include <clearway/ompl/collision_checking.h>
@@ -42,11 +43,7 @@ namespace ob = ompl::base;
 
 namespace {
 
-double threadSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
+using clearway::bench::threadSeconds;
 
 struct Mode {
   std::string name;

@@ -15,6 +15,7 @@
 // Clearway and with FCL and prints the verdicts side by side (the check `clearway check SCENE` performs).
 //
 // Usage: bench_scene [--states N] [--problems K] [--shared DIR] [--csv FILE] [--start-goal]
+#include "bench_clock.h"
 #include "fcl_robot.h"
 
 #include <clearway/scene/scene.h>
@@ -37,11 +38,7 @@ namespace cw = clearway;
 
 namespace {
 
-double threadSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
+using clearway::bench::threadSeconds;
 
 struct Sum {
   double seconds = 0;

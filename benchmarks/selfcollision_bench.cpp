@@ -13,6 +13,7 @@
 #include <clearway/load/robot_loader.h>
 #include <clearway/scene/self_collision.h>
 
+#include "bench_clock.h"
 #include "fcl_robot.h"
 
 #include <fcl/fcl.h>
@@ -37,11 +38,7 @@ namespace cw = clearway;
 
 namespace {
 
-double threadSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
+using clearway::bench::threadSeconds;
 
 struct Row {
   std::string robot, method;

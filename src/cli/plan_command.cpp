@@ -179,7 +179,13 @@ int planCommand(const std::vector<std::string>& args) {
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
   const ob::StateSpacePtr space = makeStateSpace(*scene);
   og::SimpleSetup setup(space);
-  const CollisionChecking checking = setupCollisionChecking(setup.getSpaceInformation(), scene);
+  CollisionChecking checking;
+  try {
+    checking = setupCollisionChecking(setup.getSpaceInformation(), scene);
+  } catch (const std::exception& e) {
+    std::cerr << "clearway plan: " << scene_path << ": " << e.what() << "\n";
+    return kExitUsage;
+  }
   const StateMap map(*scene);
   ob::ScopedState<> start(space), goal(space);
   map.fromVector(d.start.data(), start.get());

@@ -108,6 +108,10 @@ MotionChecker::MotionChecker(std::shared_ptr<const Scene> scene, MotionOptions o
   if (!(options_.distance_relative_error >= 0.0) || !std::isfinite(options_.distance_relative_error))
     throw std::invalid_argument("MotionChecker: distance_relative_error must be finite and >= 0");
   if (options_.max_queries < 1) throw std::invalid_argument("MotionChecker: max_queries must be >= 1");
+  // A segment has no time axis yet: moving obstacles would be checked where they are at t = 0 only.
+  if (scene_->effects().moving && scene_->environment().hasMovingObstacles())
+    throw std::invalid_argument("MotionChecker: scene '" + scene_->name() +
+                                "' has moving obstacles; segment checks against moving obstacles are not supported");
   const SelfCollision& self = scene_->selfCollision();
   if (scene_->effects().self)
     for (int k = 0; k < static_cast<int>(self.pairs().size()); ++k) {

@@ -379,6 +379,22 @@ struct DistanceMin {
     best.lower_bound = std::numeric_limits<double>::infinity();
     best.status = Status::Separated;
   }
+  // The result in the world, given the frame the search ran in: a failure carries no certificate, and
+  // pairs skipped were at least the final cutoff apart (with a relative error, below the distance).
+  DistanceResult finish(const Pose& frame) const {
+    DistanceResult r = best;
+    if (failed) {
+      r.status = Status::NotConverged;
+      r.distance = 0.0;
+      r.lower_bound = 0.0;
+      return r;
+    }
+    r.lower_bound = std::min({r.lower_bound, r.distance, cutoff});
+    r.point_a = frame * r.point_a;
+    r.point_b = frame * r.point_b;
+    r.normal = frame.R * r.normal;
+    return r;
+  }
   // Returns true when the search can stop (an overlap, or a failure).
   bool add(const DistanceResult& r) {
     best.iterations += r.iterations;
@@ -467,19 +483,7 @@ DistanceResult meshDistance(const LinkGeometry& a, const Pose& pose_a, const Lin
       for (const auto& q : b.primitives())
         if (!m.failed) m.add(gjkDistance(p.shape, p.pose, q.shape, b_in_a * q.pose, tol));
   }
-  DistanceResult r = m.best;
-  if (m.failed) {
-    r.status = Status::NotConverged;
-    r.distance = 0.0;
-    r.lower_bound = 0.0;
-    return r;
-  }
-  // Pairs skipped were at least the final cutoff apart; with a relative error, that is below the distance.
-  r.lower_bound = std::min({r.lower_bound, r.distance, m.cutoff});
-  r.point_a = pose_a * r.point_a;
-  r.point_b = pose_a * r.point_b;
-  r.normal = pose_a.R * r.normal;
-  return r;
+  return m.finish(pose_a);
 }
 
 DistanceResult shapeLinkDistance(const Shape& shape, const Pose& pose_shape, const LinkGeometry& link,
@@ -496,18 +500,7 @@ DistanceResult shapeLinkDistance(const Shape& shape, const Pose& pose_shape, con
              shape);
   for (const auto& p : link.primitives())
     if (!m.failed && !(m.best.distance <= 0.0)) m.add(gjkDistance(shape, shape_in_link, p.shape, p.pose, tol));
-  DistanceResult r = m.best;
-  if (m.failed) {
-    r.status = Status::NotConverged;
-    r.distance = 0.0;
-    r.lower_bound = 0.0;
-    return r;
-  }
-  r.lower_bound = std::min({r.lower_bound, r.distance, m.cutoff});
-  r.point_a = pose_link * r.point_a;
-  r.point_b = pose_link * r.point_b;
-  r.normal = pose_link.R * r.normal;
-  return r;
+  return m.finish(pose_link);
 }
 
 // ---- Triangle–triangle separating axes ----------------------------------------------------------------

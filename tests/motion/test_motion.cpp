@@ -238,6 +238,12 @@ TEST(MotionCertified, BadInput) {
     edit(o);
     EXPECT_THROW(MotionChecker(scene, o), std::invalid_argument);
   }
+  // Moving obstacles: refused rather than checked where they stand at t = 0.
+  const std::string moving = dir.write("moving.yaml", "format: 1\nname: moving\nrobot:\n  urdf: " + dir.path("slider.urdf") +
+                                                          "\n  group: [slide, turn]\nenvironment:\n  obstacles:\n"
+                                                          "    - {name: ball, sphere: {radius: 0.1}, pose: {position: [0, 1, 0]}, "
+                                                          "velocity: [0, -1, 0]}\nchecks: [environment, moving]\n");
+  EXPECT_THROW(MotionChecker(Scene::load(moving)), std::invalid_argument);
   // A query cap that is reached reports a collision, never a free segment.
   MotionOptions capped;
   capped.max_queries = 1;

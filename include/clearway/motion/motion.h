@@ -86,6 +86,8 @@ struct MotionContext {
 /// of bounds) anywhere makes the segment not free. Thread-safe given one context per thread.
 class MotionChecker {
  public:
+  /// Throws std::invalid_argument for options out of range, a planar or floating group joint, or a scene
+  /// with moving obstacles (segments have no time axis yet).
   MotionChecker(std::shared_ptr<const Scene> scene, MotionOptions options = {});
 
   const Scene& scene() const noexcept { return *scene_; }
