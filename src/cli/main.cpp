@@ -79,6 +79,7 @@ const Command kCommands[] = {
     {"plan", "plan start -> goal on a scene with OMPL (a bundled scene when none is given)", clearway::cli::planCommand},
     {"check", "classify joint vectors of a scene: free or which links collide", clearway::cli::checkCommand},
     {"motion", "check joint-space segments of a scene: free, or the last valid fraction", clearway::cli::motionCommand},
+    {"audit", "self-collision audit of a URDF: Adjacent, Default, Always, Never pairs with evidence; SRDF out", clearway::cli::auditCommand},
     {"query", "narrow-phase queries on shape pairs from a JSON Lines file", queryCommand},
 };
 

@@ -20,6 +20,9 @@ int planCommand(const std::vector<std::string>& args);
 /// `free` or `collision F` (F the last valid fraction) out.
 int motionCommand(const std::vector<std::string>& args);
 
+/// `clearway audit URDF [--srdf S] [--samples N] [--seed N] [--srdf-out FILE] [--report FILE]`.
+int auditCommand(const std::vector<std::string>& args);
+
 /// Scene::load, printing the robot's load warnings; on failure prints "clearway COMMAND: reason" and
 /// returns null.
 std::shared_ptr<const Scene> loadScene(const char* command, const std::string& path, const SceneOptions& options);

@@ -635,4 +635,24 @@ TEST(MotionTool, ChecksSegments) {
   EXPECT_EQ(runTool("motion").exit_code, 2);
 }
 
+TEST(AuditTool, WritesSrdfAndReport) {
+  const std::string dir = testing::TempDir() + "clearway_audit_" + std::to_string(::getpid());
+  std::filesystem::create_directories(dir);
+  const std::string urdf = std::string(CLEARWAY_SOURCE_DIR) + "/robots/arm6/arm6.urdf";
+  const std::string srdf = std::string(CLEARWAY_SOURCE_DIR) + "/robots/arm6/arm6.srdf";
+  ToolRun r = runTool("audit '" + urdf + "' --srdf '" + srdf + "' --samples 400 --seed 2 --srdf-out '" + dir +
+                      "/out.srdf' --report '" + dir + "/report.md'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_MENTIONS(r.out, "Adjacent");
+  EXPECT_MENTIONS(r.out, "pairs differ from");
+  EXPECT_MENTIONS(slurp(dir + "/out.srdf"), "<disable_collisions link1=");
+  EXPECT_MENTIONS(slurp(dir + "/report.md"), "| link 1 | link 2 | verdict |");
+  r = runTool("audit /nonexistent.urdf");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_MENTIONS(r.err, "/nonexistent.urdf");
+  EXPECT_EQ(runTool("audit '" + urdf + "' --samples 0").exit_code, 2);
+  EXPECT_EQ(runTool("audit").exit_code, 2);
+  std::filesystem::remove_all(dir);
+}
+
 #endif

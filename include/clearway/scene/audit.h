@@ -1,0 +1,48 @@
+#pragma once
+// Self-collision audit of a robot, as MoveIt Setup Assistant's collision matrix but with evidence: every
+// pair of links with geometry is classified Adjacent, Default (colliding at the default configuration),
+// Always (colliding in at least always_fraction of the samples), Never (never seen colliding) or left
+// checked, with its sample count, colliding count, a 95% Clopper–Pearson upper bound on its collision
+// probability and the smallest clearance seen (so that a "never" pair that came within a millimetre is
+// told apart from one that stayed far).
+#include <clearway/scene/self_collision.h>  // RobotGeometry
+
+#include <memory>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace clearway {
+
+struct AuditOptions {
+  int samples = 10000;            ///< random configurations, uniform within the limits (continuous: ±π)
+  std::uint64_t seed = 1;         ///< the same seed gives the same audit, whatever the thread count
+  double always_fraction = 0.95;  ///< MoveIt's default threshold for "always in collision"
+  double near_margin = 1e-3;      ///< a Never pair whose clearance came under this is flagged near_miss
+  int threads = 2;
+  Tolerances tolerances = {};
+};
+
+/// One pair's verdict and evidence.
+struct PairAudit {
+  int a = -1, b = -1;
+  std::string reason;        ///< "Adjacent", "Default", "Always", "Never", or "" (must be checked)
+  int samples = 0;           ///< configurations tested (0 for Adjacent and Default pairs)
+  int colliding = 0;
+  double p_upper = 1.0;      ///< 95% upper confidence bound on the collision probability
+  double min_clearance = 0;  ///< smallest exact distance seen over the samples (0 when it collided)
+  bool near_miss = false;    ///< Never, but closer than near_margin at some sample
+};
+
+/// The 95% one-sided Clopper–Pearson upper bound on p after k successes in n trials (1 when n = 0).
+double clopperPearsonUpper(int k, int n);
+
+/// Audits every pair of links with geometry (the SRDF of the model is ignored: adjacency only). Throws
+/// std::invalid_argument when samples < 1, threads < 1 or always_fraction is not in (0, 1].
+std::vector<PairAudit> auditSelfCollision(std::shared_ptr<const RobotGeometry> geometry, const AuditOptions& options = {});
+
+/// SRDF text with one disable_collisions element per pair that has a reason, for robot `name`.
+std::string auditSrdf(const RobotModel& model, const std::vector<PairAudit>& audit);
+
+}  // namespace clearway

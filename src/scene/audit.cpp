@@ -1,0 +1,190 @@
+#include <clearway/scene/audit.h>
+
+#include <clearway/kinematics/forward_kinematics.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+namespace clearway {
+
+namespace {
+
+// MoveIt's default: 0 when within the limits, else the middle; a floating joint's quaternion is identity.
+std::vector<double> defaultConfiguration(const RobotModel& model) {
+  std::vector<double> q(model.variableCount());
+  for (int v = 0; v < model.variableCount(); ++v) {
+    const JointVariable& var = model.variables()[v];
+    const bool qw = var.name.size() > 3 && var.name.compare(var.name.size() - 3, 3, "/qw") == 0;
+    double x = qw ? 1.0 : 0.0;
+    if (x < var.lower || x > var.upper)
+      x = std::isfinite(var.lower) && std::isfinite(var.upper) ? 0.5 * (var.lower + var.upper)
+                                                               : (std::isfinite(var.lower) ? var.lower : var.upper);
+    q[v] = x;
+  }
+  return q;
+}
+
+// Only joints that move links relative to each other are sampled: a planar or floating joint moves its
+// whole subtree rigidly, which changes no pair inside it (and a root one changes none at all).
+bool sampled(const RobotModel& model, const JointVariable& var) {
+  const JointType t = model.joint(var.joint).type;
+  return t != JointType::Planar && t != JointType::Floating;
+}
+
+// log P(X ≤ k) for X ~ Binomial(n, p), summed in log space.
+double logBinomialCdf(int k, int n, double p) {
+  if (p <= 0.0) return 0.0;
+  if (p >= 1.0) return k >= n ? 0.0 : -std::numeric_limits<double>::infinity();
+  double best = -std::numeric_limits<double>::infinity(), sum = 0.0;
+  std::vector<double> terms(k + 1);
+  for (int i = 0; i <= k; ++i) {
+    terms[i] = std::lgamma(n + 1.0) - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0) + i * std::log(p) +
+               (n - i) * std::log1p(-p);
+    best = std::max(best, terms[i]);
+  }
+  for (double t : terms) sum += std::exp(t - best);
+  return best + std::log(sum);
+}
+
+}  // namespace
+
+double clopperPearsonUpper(int k, int n) {
+  if (n <= 0 || k >= n) return 1.0;
+  if (k == 0) return 1.0 - std::pow(0.05, 1.0 / n);  // the closed form of the case below
+  // The p at which P(X ≤ k) falls to 5%: P(X ≤ k) decreases in p, so bisection; 100 halvings of [0, 1]
+  // reach double precision.
+  double lo = static_cast<double>(k) / n, hi = 1.0;
+  const double target = std::log(0.05);
+  for (int it = 0; it < 100 && hi - lo > 1e-15; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (logBinomialCdf(k, n, mid) > target ? lo : hi) = mid;
+  }
+  return hi;
+}
+
+std::vector<PairAudit> auditSelfCollision(std::shared_ptr<const RobotGeometry> geometry, const AuditOptions& options) {
+  if (options.samples < 1) throw std::invalid_argument("audit: samples must be >= 1");
+  if (options.threads < 1) throw std::invalid_argument("audit: threads must be >= 1");
+  if (!(options.always_fraction > 0.0 && options.always_fraction <= 1.0))
+    throw std::invalid_argument("audit: always_fraction must be in (0, 1]");
+  const RobotModel& model = geometry->model();
+  const int n_links = model.linkCount();
+  const Tolerances& tol = options.tolerances;
+
+  // Every pair of links with geometry; the SRDF is not consulted (the audit is what writes one).
+  std::vector<char> adjacent(static_cast<std::size_t>(n_links) * n_links, 0);
+  for (const auto& [a, b] : adjacentLinkPairs(model)) adjacent[a * n_links + b] = adjacent[b * n_links + a] = 1;
+  const std::vector<int>& links = geometry->geometricLinks();
+  std::vector<PairAudit> result;
+  for (std::size_t i = 0; i < links.size(); ++i)
+    for (std::size_t j = i + 1; j < links.size(); ++j) {
+      PairAudit p;
+      p.a = std::min(links[i], links[j]);
+      p.b = std::max(links[i], links[j]);
+      if (adjacent[p.a * n_links + p.b]) p.reason = "Adjacent";
+      p.min_clearance = std::numeric_limits<double>::infinity();
+      result.push_back(p);
+    }
+  const auto collides = [&](const PairAudit& p, const std::vector<Pose>& poses) {
+    return meshesIntersect(*geometry->link(p.a), poses[p.a], *geometry->link(p.b), poses[p.b], tol, GeometryMode::Mesh);
+  };
+
+  // Default: in collision at the default configuration.
+  const std::vector<double> q_default = defaultConfiguration(model);
+  std::vector<Pose> poses(n_links);
+  computeLinkPoses(model, q_default.data(), poses.data());
+  std::vector<int> sampled_pairs;
+  for (int k = 0; k < static_cast<int>(result.size()); ++k) {
+    if (!result[k].reason.empty()) continue;
+    if (collides(result[k], poses)) result[k].reason = "Default";
+    else sampled_pairs.push_back(k);
+  }
+
+  // The samples, drawn up front from the seed: the audit is the same whatever the thread count.
+  std::mt19937_64 rng(options.seed);
+  std::vector<double> configurations(static_cast<std::size_t>(options.samples) * model.variableCount());
+  for (int s = 0; s < options.samples; ++s)
+    for (int v = 0; v < model.variableCount(); ++v) {
+      const JointVariable& var = model.variables()[v];
+      double x = q_default[v];
+      if (sampled(model, var)) {
+        const double lo = std::isfinite(var.lower) ? var.lower : -M_PI, hi = std::isfinite(var.upper) ? var.upper : M_PI;
+        x = std::uniform_real_distribution<double>(lo, hi)(rng);
+      }
+      configurations[static_cast<std::size_t>(s) * model.variableCount() + v] = x;
+    }
+
+  // Each thread takes every threads-th sample and keeps its own counts and minima; merged after.
+  struct Partial {
+    std::vector<int> colliding;
+    std::vector<double> min_clearance;
+  };
+  std::vector<Partial> partial(options.threads);
+  const auto work = [&](int t) {
+    Partial& mine = partial[t];
+    mine.colliding.assign(result.size(), 0);
+    mine.min_clearance.assign(result.size(), std::numeric_limits<double>::infinity());
+    std::vector<Pose> ps(n_links);
+    for (int s = t; s < options.samples; s += options.threads) {
+      computeLinkPoses(model, &configurations[static_cast<std::size_t>(s) * model.variableCount()], ps.data());
+      for (const int k : sampled_pairs) {
+        const PairAudit& p = result[k];
+        if (collides(p, ps)) {
+          ++mine.colliding[k];
+          mine.min_clearance[k] = 0.0;
+          continue;
+        }
+        // The smallest clearance: the hulls' distance (one GJK call) bounds it from below, so the exact
+        // distance is needed only when the hulls come nearer than the smallest clearance yet.
+        const LinkGeometry& ga = *geometry->link(p.a);
+        const LinkGeometry& gb = *geometry->link(p.b);
+        const DistanceResult h = gjkDistance(ga.hull(), ps[p.a], gb.hull(), ps[p.b], tol);
+        if (!isFailure(h.status) && h.lower_bound >= mine.min_clearance[k]) continue;
+        const DistanceResult d = meshDistance(ga, ps[p.a], gb, ps[p.b], tol);
+        if (!isFailure(d.status)) mine.min_clearance[k] = std::min(mine.min_clearance[k], d.distance);
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < options.threads; ++t) pool.emplace_back(work, t);
+  work(0);
+  for (auto& th : pool) th.join();
+
+  for (const int k : sampled_pairs) {
+    PairAudit& p = result[k];
+    p.samples = options.samples;
+    p.min_clearance = std::numeric_limits<double>::infinity();
+    for (const Partial& part : partial) {
+      p.colliding += part.colliding[k];
+      p.min_clearance = std::min(p.min_clearance, part.min_clearance[k]);
+    }
+    p.p_upper = clopperPearsonUpper(p.colliding, p.samples);
+    if (p.colliding >= options.always_fraction * p.samples) {
+      p.reason = "Always";
+    } else if (p.colliding == 0) {
+      p.reason = "Never";
+      p.near_miss = p.min_clearance < options.near_margin;
+    }
+  }
+  for (PairAudit& p : result)
+    if (p.samples == 0) p.min_clearance = p.reason == "Default" ? 0.0 : std::numeric_limits<double>::quiet_NaN();
+  return result;
+}
+
+std::string auditSrdf(const RobotModel& model, const std::vector<PairAudit>& audit) {
+  std::ostringstream out;
+  out << "<?xml version=\"1.0\"?>\n<!-- Written by clearway audit -->\n<robot name=\"" << model.name() << "\">\n";
+  for (const PairAudit& p : audit)
+    if (!p.reason.empty())
+      out << "  <disable_collisions link1=\"" << model.link(p.a).name << "\" link2=\"" << model.link(p.b).name
+          << "\" reason=\"" << p.reason << "\"/>\n";
+  out << "</robot>\n";
+  return out.str();
+}
+
+}  // namespace clearway

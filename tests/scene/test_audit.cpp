@@ -1,0 +1,158 @@
+// Self-collision audits: known answers on a robot of our own (a pair that collides in a known fraction of
+// the joint space, one that never can, one in collision at the default configuration), the statistics,
+// determinism, the SRDF written, and the shared Panda.
+#include <clearway/load/robot_loader.h>
+#include <clearway/scene/audit.h>
+
+#include "load/robot_files.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace clearway {
+namespace {
+
+using test::TempDir;
+
+// base (a box) with a post beside it (fixed); link1, a 1 m bar on a full-turn shoulder, sweeps past the
+// post at 0.7 m; link2, a 0.5 m bar on an elbow limited to ±2.5 rad, can never reach the base; cap, a ball
+// on link2 at the elbow, always overlaps link1's end.
+const char* kAuditUrdf = R"(<?xml version="1.0"?>
+<robot name="audited">
+  <link name="base"><collision><origin xyz="0 0 0.05"/><geometry><box size="0.2 0.2 0.1"/></geometry></collision></link>
+  <link name="post"><collision><geometry><cylinder radius="0.05" length="0.4"/></geometry></collision></link>
+  <link name="link1"><collision><origin xyz="0.5 0 0"/><geometry><box size="1 0.1 0.1"/></geometry></collision></link>
+  <link name="link2"><collision><origin xyz="0.25 0 0"/><geometry><box size="0.5 0.1 0.1"/></geometry></collision></link>
+  <link name="cap"><collision><geometry><sphere radius="0.12"/></geometry></collision></link>
+  <joint name="post_joint" type="fixed"><parent link="base"/><child link="post"/><origin xyz="0.7 0 0.1"/></joint>
+  <joint name="shoulder" type="revolute"><parent link="base"/><child link="link1"/><origin xyz="0 0 0.1"/>
+    <axis xyz="0 0 1"/><limit lower="-3.141592653589793" upper="3.141592653589793" velocity="1" effort="1"/></joint>
+  <joint name="elbow" type="revolute"><parent link="link1"/><child link="link2"/><origin xyz="1 0 0"/>
+    <axis xyz="0 0 1"/><limit lower="-2.5" upper="2.5" velocity="1" effort="1"/></joint>
+  <joint name="cap_joint" type="fixed"><parent link="link2"/><child link="cap"/></joint>
+</robot>
+)";
+
+const PairAudit& find(const RobotModel& m, const std::vector<PairAudit>& audit, const char* a, const char* b) {
+  const int ia = m.linkIndex(a), ib = m.linkIndex(b);
+  for (const PairAudit& p : audit)
+    if ((p.a == ia && p.b == ib) || (p.a == ib && p.b == ia)) return p;
+  ADD_FAILURE() << "no pair " << a << " / " << b;
+  return audit.front();
+}
+
+TEST(Audit, KnownAnswers) {
+  TempDir dir;
+  auto model = std::make_shared<const RobotModel>(loadRobot(dir.write("a.urdf", kAuditUrdf)));
+  const auto geometry = std::make_shared<const RobotGeometry>(model);
+  AuditOptions options;
+  options.samples = 20000;
+  const std::vector<PairAudit> audit = auditSelfCollision(geometry, options);
+  EXPECT_EQ(audit.size(), 10u);  // 5 links with geometry
+  EXPECT_EQ(find(*model, audit, "base", "post").reason, "Adjacent");
+  EXPECT_EQ(find(*model, audit, "base", "link1").reason, "Adjacent");
+  EXPECT_EQ(find(*model, audit, "link2", "cap").reason, "Adjacent");
+  // At the default configuration (all zero) link1 lies across the post, and the cap on link1's end.
+  EXPECT_EQ(find(*model, audit, "link1", "post").reason, "Default");
+  EXPECT_EQ(find(*model, audit, "link1", "cap").reason, "Default");
+  // link2 can never reach the base: Never, and never near (the elbow stops it 0.3 m or more away).
+  const PairAudit& never = find(*model, audit, "base", "link2");
+  EXPECT_EQ(never.reason, "Never");
+  EXPECT_EQ(never.colliding, 0);
+  EXPECT_EQ(never.samples, 20000);
+  EXPECT_FALSE(never.near_miss);
+  EXPECT_GT(never.min_clearance, 0.3);
+  EXPECT_NEAR(never.p_upper, 1.0 - std::pow(0.05, 1.0 / 20000), 1e-12);
+}
+
+TEST(Audit, KnownFractionAndAlwaysThreshold) {
+  // The post at angle π instead: link1 meets it when 0.7·|sin(θ − π)| < 0.1, a fraction
+  // 2·asin(0.1/0.7) / 2π = 0.0456 of the shoulder's turn; the default (θ = 0) is free.
+  TempDir dir;
+  std::string urdf = kAuditUrdf;
+  urdf.replace(urdf.find("xyz=\"0.7 0 0.1\""), 15, "xyz=\"-0.7 0 0.1\"");
+  auto model = std::make_shared<const RobotModel>(loadRobot(dir.write("a.urdf", urdf)));
+  const auto geometry = std::make_shared<const RobotGeometry>(model);
+  AuditOptions options;
+  options.samples = 20000;
+  const std::vector<PairAudit> audit = auditSelfCollision(geometry, options);
+  const PairAudit& p = find(*model, audit, "link1", "post");
+  EXPECT_EQ(p.reason, "");  // neither Never nor Always: checked
+  const double expected = 2.0 * std::asin(0.1 / 0.7) / (2.0 * M_PI);
+  EXPECT_NEAR(static_cast<double>(p.colliding) / p.samples, expected, 0.006);
+  EXPECT_GT(p.p_upper, static_cast<double>(p.colliding) / p.samples);
+  EXPECT_LT(p.p_upper, expected + 0.01);
+  EXPECT_EQ(p.min_clearance, 0.0);
+  // A lower "always" threshold turns the same evidence into Always.
+  options.always_fraction = 0.04;
+  EXPECT_EQ(find(*model, auditSelfCollision(geometry, options), "link1", "post").reason, "Always");
+  // The same seed gives the same audit on one thread or two.
+  options.always_fraction = 0.95;
+  options.samples = 3000;
+  options.threads = 1;
+  const auto one = auditSelfCollision(geometry, options);
+  options.threads = 2;
+  const auto two = auditSelfCollision(geometry, options);
+  ASSERT_EQ(one.size(), two.size());
+  for (std::size_t k = 0; k < one.size(); ++k) {
+    EXPECT_EQ(one[k].reason, two[k].reason);
+    EXPECT_EQ(one[k].colliding, two[k].colliding);
+    if (!std::isnan(one[k].min_clearance)) EXPECT_EQ(one[k].min_clearance, two[k].min_clearance);
+    else EXPECT_TRUE(std::isnan(two[k].min_clearance));  // Adjacent pairs are not sampled
+  }
+  // The SRDF written loads back, with one disabled pair per classified pair.
+  const std::string srdf = dir.write("out.srdf", auditSrdf(*model, one));
+  const RobotModel again = loadRobot(dir.path("a.urdf"), srdf);
+  int classified = 0;
+  for (const PairAudit& q : one) classified += !q.reason.empty();
+  EXPECT_EQ(static_cast<int>(again.disabledCollisions().size()), classified);
+}
+
+TEST(Audit, ClopperPearson) {
+  EXPECT_EQ(clopperPearsonUpper(0, 0), 1.0);
+  EXPECT_EQ(clopperPearsonUpper(5, 5), 1.0);
+  EXPECT_NEAR(clopperPearsonUpper(0, 10000), 2.9953e-4, 1e-7);
+  // Beta(16, 9985) 95% quantile, and Beta(6, 5) for 5 of 10.
+  EXPECT_NEAR(clopperPearsonUpper(15, 10000), 0.0023088, 2e-6);
+  EXPECT_NEAR(clopperPearsonUpper(5, 10), 0.7778, 1e-3);
+}
+
+TEST(Audit, BadInput) {
+  TempDir dir;
+  auto model = std::make_shared<const RobotModel>(loadRobot(dir.write("a.urdf", kAuditUrdf)));
+  const auto geometry = std::make_shared<const RobotGeometry>(model);
+  AuditOptions o;
+  o.samples = 0;
+  EXPECT_THROW(auditSelfCollision(geometry, o), std::invalid_argument);
+  o = {};
+  o.threads = 0;
+  EXPECT_THROW(auditSelfCollision(geometry, o), std::invalid_argument);
+  o = {};
+  o.always_fraction = 1.5;
+  EXPECT_THROW(auditSelfCollision(geometry, o), std::invalid_argument);
+}
+
+TEST(Audit, SharedPanda) {
+  CLEARWAY_SHARED_ROBOT_OR_SKIP(urdf, "panda/panda.urdf");
+  auto model = std::make_shared<const RobotModel>(loadRobot(urdf));
+  AuditOptions options;
+  options.samples = 3000;
+  const auto audit = auditSelfCollision(std::make_shared<const RobotGeometry>(model), options);
+  EXPECT_EQ(audit.size(), 55u);  // 11 links with geometry
+  int adjacent = 0, never = 0;
+  for (const PairAudit& p : audit) {
+    adjacent += p.reason == "Adjacent";
+    never += p.reason == "Never";
+    if (p.reason == "Never") EXPECT_EQ(p.colliding, 0);
+  }
+  EXPECT_EQ(adjacent, 10);  // the chain link0 … link7, hand, and the two fingers on the hand
+  EXPECT_GT(never, 10);
+  // The shipped SRDF calls link2/link6 Never; random joint vectors do bring them together.
+  options.samples = 10000;
+  const auto more = auditSelfCollision(std::make_shared<const RobotGeometry>(model), options);
+  EXPECT_GT(find(*model, more, "panda_link2", "panda_link6").colliding, 0);
+}
+
+}  // namespace
+}  // namespace clearway
