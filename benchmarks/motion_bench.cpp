@@ -15,6 +15,7 @@
 // Usage: bench_motion [--motions N] [--problems K] [--shared DIR] [--csv FILE]
 #include "bench_clock.h"
 #include "fcl_ompl.h"
+#include "shared_problems.h"
 
 #include <clearway/ompl/collision_checking.h>
 
@@ -84,24 +85,18 @@ int main(int argc, char** argv) {
     return 2;
   }
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
-  std::vector<std::string> families;
-  for (const auto& f : std::filesystem::directory_iterator(scenes))
-    if (f.is_directory()) families.push_back(f.path().filename().string());
-  std::sort(families.begin(), families.end());
+  const std::vector<std::string> families = cw::bench::sceneFamilies(scenes);
 
   const char* names[] = {"certified", "sampled-1%", "sampled-0.1%", "fcl-sampled-1%"};
   std::map<std::string, std::map<std::string, Totals>> totals;  // family → mode → totals
-  std::map<std::string, std::shared_ptr<const cw::RobotGeometry>> robots;
+  cw::bench::RobotCache robots;
   std::mt19937_64 rng(20261123);
   for (const std::string& family : families) {
     for (int k = 1; k <= problems; ++k) {
-      char file[256];
-      std::snprintf(file, sizeof file, "%s/%s/%s_%04d.yaml", scenes.c_str(), family.c_str(), family.c_str(), k);
-      if (!std::filesystem::exists(file)) continue;
+      const std::string file = cw::bench::problemFile(scenes, family, k);
+      if (file.empty()) continue;
       const cw::SceneDescription d = cw::parseSceneFile(file);
-      auto& g = robots[d.urdf];
-      if (!g) g = cw::loadRobotGeometry(d);
-      const auto scene = std::make_shared<const cw::Scene>(d, g, cw::loadEnvironment(d));
+      const auto scene = robots.scene(d);
       const ob::StateSpacePtr space = cw::makeStateSpace(*scene);
       const double extent = space->getMaximumExtent();
 
@@ -190,7 +185,7 @@ int main(int argc, char** argv) {
       }
       modes[0].si->freeState(a);
       modes[0].si->freeState(b);
-      std::fprintf(stderr, "%s: %zu segments\n", file, segments.size());
+      std::fprintf(stderr, "%s: %zu segments\n", file.c_str(), segments.size());
     }
   }
 

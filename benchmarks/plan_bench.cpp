@@ -11,6 +11,7 @@
 //
 // Usage: bench_plan [--problems K] [--runs R] [--time S] [--logs DIR] [--shared DIR] [--csv FILE]
 #include "fcl_ompl.h"
+#include "shared_problems.h"
 
 #include <clearway/ompl/collision_checking.h>
 
@@ -78,25 +79,19 @@ int main(int argc, char** argv) {
   }
   if (!logs.empty()) std::filesystem::create_directories(logs);
   ompl::msg::setLogLevel(ompl::msg::LOG_ERROR);
-  std::vector<std::string> families;
-  for (const auto& f : std::filesystem::directory_iterator(scenes))
-    if (f.is_directory()) families.push_back(f.path().filename().string());
-  std::sort(families.begin(), families.end());
+  const std::vector<std::string> families = cw::bench::sceneFamilies(scenes);
 
   const char* checkers[] = {"clearway", "clearway-sampled", "fcl-sampled"};
   std::map<std::string, std::map<std::string, Totals>> totals;
-  std::map<std::string, std::shared_ptr<const cw::RobotGeometry>> robots;
+  cw::bench::RobotCache robots;
   for (const std::string& family : families)
     for (int k = 1; k <= problems; ++k) {
-      char file[512];
-      std::snprintf(file, sizeof file, "%s/%s/%s_%04d.yaml", scenes.c_str(), family.c_str(), family.c_str(), k);
-      if (!std::filesystem::exists(file)) continue;
+      const std::string file = cw::bench::problemFile(scenes, family, k);
+      if (file.empty()) continue;
       const cw::SceneDescription d = cw::parseSceneFile(file);
-      auto& g = robots[d.urdf];
-      if (!g) g = cw::loadRobotGeometry(d);
-      const auto scene = std::make_shared<const cw::Scene>(d, g, cw::loadEnvironment(d));
+      const auto scene = robots.scene(d);
       if (!scene->isFree(d.start) || !scene->isFree(d.goal)) {
-        std::fprintf(stderr, "%s: start or goal in collision, skipped\n", file);
+        std::fprintf(stderr, "%s: start or goal in collision, skipped\n", file.c_str());
         continue;
       }
       const cw::MotionChecker certify(scene);
@@ -160,7 +155,7 @@ int main(int argc, char** argv) {
           }
         }
       }
-      std::fprintf(stderr, "%s: done\n", file);
+      std::fprintf(stderr, "%s: done\n", file.c_str());
     }
 
   std::FILE* out = csv.empty() ? nullptr : std::fopen(csv.c_str(), "w");

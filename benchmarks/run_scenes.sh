@@ -4,14 +4,7 @@
 # and goal of all 60 problems in both forms against FCL (start_goal.txt), and motion checks per segment
 # (motion.csv, motion_table.txt), and RRTConnect with each checker (plan.csv, plan_table.txt, OMPL benchmark
 # logs in plan_logs/). Takes about 15 minutes on 2 cores.
-set -euo pipefail
-cd "$(dirname "$0")/.."
-BUILD=${BUILD:-/tmp/build-bench}
-OUT=${OUT:-benchmarks/results}
-nice -n 10 cmake -S . -B "$BUILD" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS_RELEASE="-O2 -DNDEBUG" \
-  -DCLEARWAY_BUILD_TESTS=OFF -DCLEARWAY_BUILD_TOOLS=OFF -DCLEARWAY_BUILD_BENCHMARKS=ON >/dev/null
-nice -n 10 cmake --build "$BUILD" -j2 --target bench_scene bench_motion bench_plan
-mkdir -p "$OUT"
+source "$(dirname "$0")/build_bench.sh" bench_scene bench_motion bench_plan
 nice -n 10 "$BUILD/benchmarks/bench_scene" --start-goal > "$OUT/start_goal.txt"
 tail -1 "$OUT/start_goal.txt"
 nice -n 10 "$BUILD/benchmarks/bench_scene" --states 1000 --problems 1 --csv "$OUT/scene.csv" "$@" | tee "$OUT/scene_table.txt"

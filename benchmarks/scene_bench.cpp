@@ -17,6 +17,7 @@
 // Usage: bench_scene [--states N] [--problems K] [--shared DIR] [--csv FILE] [--start-goal]
 #include "bench_clock.h"
 #include "fcl_robot.h"
+#include "shared_problems.h"
 
 #include <clearway/scene/scene.h>
 
@@ -65,13 +66,11 @@ int startGoal(const std::string& scenes) {
   for (const auto& f : std::filesystem::recursive_directory_iterator(scenes))
     if (f.path().extension() == ".yaml") files.push_back(f.path().string());
   std::sort(files.begin(), files.end());
-  std::map<std::string, std::shared_ptr<const cw::RobotGeometry>> robots;
+  cw::bench::RobotCache robots;
   int states = 0, agree = 0, free_states = 0;
   for (const std::string& file : files) {
     const cw::SceneDescription d = cw::parseSceneFile(file);
-    auto& g = robots[d.urdf];
-    if (!g) g = cw::loadRobotGeometry(d);
-    const cw::Scene scene(d, g, cw::loadEnvironment(d));
+    const cw::Scene scene(d, robots.robot(d), cw::loadEnvironment(d));
     cw::bench::FclScene fcl(scene);
     cw::SceneContext ctx = scene.makeContext();
     for (const auto* q : {&d.start, &d.goal}) {
@@ -118,24 +117,18 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (start_goal) return startGoal(scenes);
-  std::vector<std::string> families;
-  for (const auto& f : std::filesystem::directory_iterator(scenes))
-    if (f.is_directory()) families.push_back(f.path().filename().string());
-  std::sort(families.begin(), families.end());
+  const std::vector<std::string> families = cw::bench::sceneFamilies(scenes);
 
   // family/form → method → sums
   std::map<std::string, std::map<std::string, Sum>> sums;
-  std::map<std::string, std::shared_ptr<const cw::RobotGeometry>> robots;
+  cw::bench::RobotCache robots;
   for (const std::string& family : families)
     for (int k = 1; k <= problems; ++k)
       for (const char* form : {"primitive", "octomap"}) {
-        char file[512];
-        std::snprintf(file, sizeof file, "%s/%s/%s_%04d%s.yaml", scenes.c_str(), family.c_str(), family.c_str(), k,
-                      std::strcmp(form, "octomap") ? "" : ".octomap");
-        if (!std::filesystem::exists(file)) continue;
-        cw::SceneDescription d = cw::parseSceneFile(file);
-        auto& g = robots[d.urdf];
-        if (!g) g = cw::loadRobotGeometry(d);
+        const std::string file = cw::bench::problemFile(scenes, family, k, !std::strcmp(form, "octomap"));
+        if (file.empty()) continue;
+        const cw::SceneDescription d = cw::parseSceneFile(file);
+        const auto g = robots.robot(d);
         const auto env = cw::loadEnvironment(d);
         auto with = [&](bool self, bool environment, bool clearance) {
           cw::SceneDescription e = d;
@@ -202,7 +195,7 @@ int main(int argc, char** argv) {
           cd.worst_gap = std::max(cd.worst_gap, gap);
           cd.disagree += gap > 1e-3;
         }
-        std::fprintf(stderr, "%s: %d states\n", file, n);
+        std::fprintf(stderr, "%s: %d states\n", file.c_str(), n);
       }
 
   std::FILE* out = csv.empty() ? nullptr : std::fopen(csv.c_str(), "w");

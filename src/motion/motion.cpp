@@ -149,15 +149,13 @@ MotionResult MotionChecker::sampled(const double* q0, const double* q1, MotionCo
   const int n = std::isfinite(len) ? std::max(1, static_cast<int>(std::ceil(len / options_.resolution))) : 1;
   r.steps = 1;
   if (!sc.isFree(q0, ctx.scene, &r.report)) return r;
+  // The end first (each state is checked once); if it collides, the states in between say whether the
+  // segment collides earlier.
   ++r.steps;
-  if (!sc.isFree(q1, ctx.scene, &r.report)) {
-    // The end collides; where the segment first does, the samples below will say.
-  } else if (n == 1) {
-    r.free = true;
-    return r;
-  }
+  CollisionReport end;
+  const bool end_free = sc.isFree(q1, ctx.scene, &end);
   double last = 0.0;
-  for (int k = 1; k <= n; ++k) {
+  for (int k = 1; k < n; ++k) {
     const double s = static_cast<double>(k) / n;
     interpolate(q0, q1, s, ctx.q.data());
     ++r.steps;
@@ -168,8 +166,13 @@ MotionResult MotionChecker::sampled(const double* q0, const double* q1, MotionCo
     }
     last = s;
   }
-  r.free = true;
-  r.report = CollisionReport{};
+  r.report = end_free ? CollisionReport{} : end;
+  if (end_free) {
+    r.free = true;
+  } else {
+    r.first_contact = 1.0;
+    r.last_valid = last;
+  }
   return r;
 }
 

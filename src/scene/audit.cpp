@@ -40,14 +40,18 @@ bool sampled(const RobotModel& model, const JointVariable& var) {
 double logBinomialCdf(int k, int n, double p) {
   if (p <= 0.0) return 0.0;
   if (p >= 1.0) return k >= n ? 0.0 : -std::numeric_limits<double>::infinity();
+  // A running log-sum-exp: the sum is rescaled whenever a larger term arrives.
   double best = -std::numeric_limits<double>::infinity(), sum = 0.0;
-  std::vector<double> terms(k + 1);
   for (int i = 0; i <= k; ++i) {
-    terms[i] = std::lgamma(n + 1.0) - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0) + i * std::log(p) +
-               (n - i) * std::log1p(-p);
-    best = std::max(best, terms[i]);
+    const double term = std::lgamma(n + 1.0) - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0) + i * std::log(p) +
+                        (n - i) * std::log1p(-p);
+    if (term > best) {
+      sum = sum * std::exp(best - term) + 1.0;
+      best = term;
+    } else {
+      sum += std::exp(term - best);
+    }
   }
-  for (double t : terms) sum += std::exp(t - best);
   return best + std::log(sum);
 }
 

@@ -250,18 +250,21 @@ bool Scene::validState(const double* state, std::string* why) const {
   return true;
 }
 
+bool Scene::withinBounds(const double* state) const noexcept {
+  for (std::size_t i = 0; i < group_variables_.size(); ++i) {
+    const JointVariable& var = robot().variables()[group_variables_[i]];
+    // Written so that a NaN fails.
+    if (!(state[i] >= var.lower - kJointLimitTolerance && state[i] <= var.upper + kJointLimitTolerance)) return false;
+  }
+  return true;
+}
+
 bool Scene::isFree(const double* state, SceneContext& ctx, CollisionReport* report, double t) const noexcept {
   ++ctx.counters.states;
   CollisionReport local;
   CollisionReport& r = report ? *report : local;
   r = CollisionReport{};
-  bool valid = true;
-  for (std::size_t i = 0; i < group_variables_.size() && valid; ++i) {
-    const JointVariable& var = robot().variables()[group_variables_[i]];
-    // Written so that a NaN fails.
-    valid = state[i] >= var.lower - kJointLimitTolerance && state[i] <= var.upper + kJointLimitTolerance;
-  }
-  if (!valid) {
+  if (!withinBounds(state)) {
     ++ctx.counters.invalid_states;
     r.kind = CollisionReport::Kind::Invalid;
     return false;
@@ -323,12 +326,7 @@ double Scene::clearance(const double* state, SceneContext& ctx, double* lower_bo
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const Effects& fx = description_.effects;
   if (!fx.clearance) return nan;
-  bool valid = true;
-  for (std::size_t i = 0; i < group_variables_.size() && valid; ++i) {
-    const JointVariable& var = robot().variables()[group_variables_[i]];
-    valid = state[i] >= var.lower - kJointLimitTolerance && state[i] <= var.upper + kJointLimitTolerance;
-  }
-  if (!valid) return nan;
+  if (!withinBounds(state)) return nan;
   ++ctx.counters.clearance_queries;
   computePoses(state, ctx);
   // Distances first; EPA only when something touches (then the value is minus the deepest penetration).

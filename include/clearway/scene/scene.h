@@ -167,6 +167,7 @@ class Scene {
  private:
   void init();
   SceneContext& threadContext() const;
+  bool withinBounds(const double* state) const noexcept;  // the cheap check of every query (no reason)
 
   SceneDescription description_;
   SceneOptions options_;
