@@ -16,6 +16,9 @@
 #include <clearway/narrowphase/gjk.h>
 #include <clearway/narrowphase/ray_cast.h>
 
+#include "fcl_robot.h"
+#include "narrowphase_shapes.h"
+
 #include <fcl/config.h>
 #include <fcl/geometry/shape/box.h>
 #include <fcl/geometry/shape/capsule.h>
@@ -52,6 +55,22 @@
 namespace cw = clearway;
 using cw::Vec3;
 
+using cw::bench::Rng;
+using cw::bench::toFcl;
+using cw::bench::reach;
+using cw::bench::makeHull;
+using cw::bench::makeBox;
+using cw::bench::makeSphere;
+using cw::bench::makeCapsule;
+using cw::bench::makeCylinder;
+using cw::bench::makeCone;
+using cw::bench::kTight;
+using cw::bench::tightTolerances;
+using cw::bench::PairCase;
+using cw::bench::Family;
+using cw::bench::makePools;
+using cw::bench::addSeparatedPairs;
+
 namespace {
 
 // ---- Settings ---------------------------------------------------------------------------------------
@@ -60,7 +79,6 @@ const double kTolerances[] = {1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7};
 // G. van den Bergen, "Ray Casting against General Convex Objects with Application to Continuous
 // Collision Detection" (2004): GJK ray cast time per query in µs on a 2.6 GHz CPU, by tolerance.
 const double kVanDenBergenRayUs[] = {0.62, 0.77, 1.02, 1.43, 2.03, 2.80, 3.65};
-constexpr double kTight = 1e-12;  // the reference tolerance
 // Errors of this size (metres, on shapes about 1 m across) are rounding of the reference itself: two
 // methods both under it count as equally accurate.
 constexpr double kErrorFloor = 1e-12;
@@ -117,168 +135,6 @@ std::vector<double> medianInterleaved(std::vector<Pass>& passes, int reps) {
     median.push_back(v[v.size() / 2]);
   }
   return median;
-}
-
-// ---- Random numbers (own generators, so the pair lists do not depend on the standard library) ----------
-
-class Rng {
- public:
-  explicit Rng(std::uint64_t seed) : state_(seed) {}
-  // splitmix64
-  std::uint64_t next() {
-    std::uint64_t z = (state_ += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-  }
-  double uniform(double lo, double hi) { return lo + (hi - lo) * static_cast<double>(next() >> 11) * 0x1p-53; }
-  double normal() {  // Box–Muller
-    const double u1 = 1.0 - uniform(0.0, 1.0), u2 = uniform(0.0, 1.0);
-    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
-  }
-  Vec3 unitVector() {
-    for (;;) {
-      const Vec3 v(normal(), normal(), normal());
-      const double n = v.norm();
-      if (n > 1e-6) return v / n;
-    }
-  }
-  Vec3 inBall() {
-    for (;;) {
-      const Vec3 v(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1));
-      if (v.squaredNorm() <= 1.0) return v;
-    }
-  }
-  // A uniformly distributed rotation (a normalised 4D Gaussian is a uniform unit quaternion).
-  cw::Pose pose(const Vec3& t) {
-    return cw::Pose::fromQuaternion(normal(), normal(), normal(), normal() + 1e-12, t);
-  }
-
- private:
-  std::uint64_t state_;
-};
-
-fcl::Transform3d toFcl(const cw::Pose& p) {
-  fcl::Transform3d t = fcl::Transform3d::Identity();
-  t.linear() = p.R;
-  t.translation() = p.t;
-  return t;
-}
-
-// How far the posed shape reaches along unit d, measured from its pose's origin (skin included).
-double reach(const cw::Shape& shape, const cw::Pose& pose, const Vec3& d) {
-  return std::visit([&](const auto& s) { return d.dot(pose.R * s.support(pose.R.transpose() * d)) + s.radius(); },
-                    shape);
-}
-
-// ---- Shapes: each maker returns the same shape for Clearway and for FCL ------------------------------
-
-// The convex hull of n points on the surface of an ellipsoid with random semi-axes in [0.5, 1.5] m, so
-// that nearly every point is a vertex. FCL gets exactly our hull's vertices and triangles.
-std::pair<cw::Shape, fcl::Convexd> makeHull(Rng& rng, int n) {
-  const Vec3 axes(rng.uniform(0.5, 1.5), rng.uniform(0.5, 1.5), rng.uniform(0.5, 1.5));
-  std::vector<Vec3> pts;
-  for (int i = 0; i < n; ++i) pts.push_back(axes.cwiseProduct(rng.unitVector()));
-  cw::ConvexHull hull(pts);
-  auto vertices = std::make_shared<std::vector<Vec3>>(hull.vertices());
-  auto faces = std::make_shared<std::vector<int>>();
-  for (const auto& t : hull.triangles()) faces->insert(faces->end(), {3, t[0], t[1], t[2]});
-  const int nf = static_cast<int>(hull.triangles().size());
-  // throw_if_invalid = true proves FCL accepted the mesh as watertight and convex (its edge walk is on).
-  fcl::Convexd convex(vertices, nf, faces, /*throw_if_invalid=*/true);
-  return {cw::Shape(std::move(hull)), convex};
-}
-
-std::pair<cw::Shape, fcl::Boxd> makeBox(Rng& rng) {
-  const Vec3 h(rng.uniform(0.2, 1.0), rng.uniform(0.2, 1.0), rng.uniform(0.2, 1.0));
-  return {cw::Box(h), fcl::Boxd(2 * h.x(), 2 * h.y(), 2 * h.z())};
-}
-std::pair<cw::Shape, fcl::Sphered> makeSphere(Rng& rng) {
-  const double r = rng.uniform(0.2, 1.0);
-  return {cw::Sphere(r), fcl::Sphered(r)};
-}
-std::pair<cw::Shape, fcl::Capsuled> makeCapsule(Rng& rng) {
-  const double r = rng.uniform(0.1, 0.5), h = rng.uniform(0.1, 1.0);
-  return {cw::Capsule(r, h), fcl::Capsuled(r, 2 * h)};
-}
-std::pair<cw::Shape, fcl::Cylinderd> makeCylinder(Rng& rng) {
-  const double r = rng.uniform(0.2, 0.8), h = rng.uniform(0.2, 1.0);
-  return {cw::Cylinder(r, h), fcl::Cylinderd(r, 2 * h)};
-}
-std::pair<cw::Shape, fcl::Coned> makeCone(Rng& rng) {
-  const double r = rng.uniform(0.2, 0.8), h = rng.uniform(0.2, 1.0);
-  return {cw::Cone(r, h), fcl::Coned(r, 2 * h)};  // both: apex at +h, base at −h
-}
-
-// ---- Pair families --------------------------------------------------------------------------------------
-
-cw::Tolerances tightTolerances() {
-  cw::Tolerances t;
-  t.gjk_relative = kTight;
-  t.gjk_max_iterations = 1000;
-  t.cast_relative = kTight;
-  t.cast_max_iterations = 1000;
-  return t;
-}
-
-struct PairCase {
-  int ia = 0, ib = 0;  // indices into the shape pools
-  cw::Pose pa, pb;
-  fcl::Transform3d ta, tb;
-  double ref = 0.0;        // reference distance (Clearway at 1e-12)
-  bool path_start = false;  // intersection paths: the first pose of a path (warm caches restart)
-};
-
-// Shape pools for A and B (the same shapes in both libraries) and the list of posed pairs.
-template <class FA, class FB>
-struct Family {
-  std::string name;
-  std::vector<cw::Shape> ca, cb;
-  std::vector<FA> fa;
-  std::vector<FB> fb;
-  std::vector<PairCase> cases;
-  int reference_failures = 0;  // candidate pairs dropped because the reference did not converge
-};
-
-template <class FA, class FB, class MakeA, class MakeB>
-Family<FA, FB> makePools(const std::string& name, int pool, std::uint64_t seed, MakeA makeA, MakeB makeB) {
-  Family<FA, FB> f;
-  f.name = name;
-  Rng rng(seed);
-  for (int i = 0; i < pool; ++i) {
-    auto a = makeA(rng);
-    f.ca.push_back(std::move(a.first));
-    f.fa.push_back(std::move(a.second));
-    auto b = makeB(rng);
-    f.cb.push_back(std::move(b.first));
-    f.fb.push_back(std::move(b.second));
-  }
-  return f;
-}
-
-// Random separated pairs: random rotations, B placed along a random direction at (0.8 … 1.8) × the
-// sum of both shapes' reaches, kept when the reference gap is at least 1 cm.
-template <class FA, class FB>
-void addSeparatedPairs(Family<FA, FB>& f, int n, std::uint64_t seed) {
-  Rng rng(seed);
-  const cw::Tolerances tight = tightTolerances();
-  while (static_cast<int>(f.cases.size()) < n) {
-    PairCase c;
-    c.ia = static_cast<int>(rng.next() % f.ca.size());
-    c.ib = static_cast<int>(rng.next() % f.cb.size());
-    c.pa = rng.pose(Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)));
-    c.pb = rng.pose(Vec3::Zero());
-    const Vec3 u = rng.unitVector();
-    const double reach_sum = reach(f.ca[c.ia], c.pa, u) + reach(f.cb[c.ib], c.pb, -u);
-    c.pb.t = c.pa.t + rng.uniform(0.8, 1.8) * reach_sum * u;
-    const cw::DistanceResult r = cw::gjkDistance(f.ca[c.ia], c.pa, f.cb[c.ib], c.pb, tight);
-    if (cw::isFailure(r.status)) ++f.reference_failures;
-    if (cw::isFailure(r.status) || !(r.distance >= 0.01)) continue;
-    c.ref = r.distance;
-    c.ta = toFcl(c.pa);
-    c.tb = toFcl(c.pb);
-    f.cases.push_back(c);
-  }
 }
 
 // Smooth paths: A still; B circles A (azimuth once round, elevation swinging) while turning about a

@@ -14,6 +14,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev  # tests and benchmarks
   libfcl-dev                         # benchmarks only: FCL side by side
   gnuplot-nox                        # benchmark plots (PNG)
+  slurmd slurmctld slurm-client munge parallel  # clearway bench shards: the one-node Slurm test (GNU parallel without root)
 )
 missing=()
 for p in "${packages[@]}"; do

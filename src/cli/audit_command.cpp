@@ -4,12 +4,17 @@
 #include <clearway/load/robot_loader.h>
 #include <clearway/scene/audit.h>
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <sstream>
 
 namespace clearway::cli {
 
@@ -26,7 +31,9 @@ const char* const kAuditUsage =
     "95% Clopper-Pearson upper bound on the collision probability, smallest clearance seen; 'near' marks\n"
     "a Never pair that came within 1 mm). Prints a summary, and with --srdf the pairs where the given SRDF\n"
     "and the audit disagree. --srdf-out writes disable_collisions for every classified pair; --report a\n"
-    "Markdown table of all pairs. Defaults: 10000 samples, seed 1; both cores are used.\n"
+    "Markdown table of all pairs and, beside it (REPORT with .png), a heat map of the link-pair matrix\n"
+    "(drawn by gnuplot when installed). A progress bar goes to stderr on a terminal.\n"
+    "Defaults: 10000 samples, seed 1; both cores are used.\n"
     "Exit status: 0 on success, 2 on a usage error or a robot that does not load.\n";
 
 bool parseCount(const std::string& s, long long& out) {
@@ -41,6 +48,86 @@ std::string clearanceText(double c) {
   if (std::isinf(c)) return "inf";
   std::snprintf(buf, sizeof buf, "%.4g", c);
   return buf;
+}
+
+// A bar on stderr, redrawn in place: only on a terminal (logs and pipes get the summary lines alone).
+void progressBar(int done, int total) {
+  constexpr int kWidth = 40;
+  const int filled = static_cast<int>(static_cast<long long>(kWidth) * done / std::max(total, 1));
+  std::fprintf(stderr, "\r  [%s%s] %3d%%  %d / %d samples", std::string(filled, '#').c_str(),
+               std::string(kWidth - filled, ' ').c_str(), static_cast<int>(100LL * done / std::max(total, 1)), done, total);
+  if (done >= total) std::fputc('\n', stderr);
+  std::fflush(stderr);
+}
+
+std::string quoted(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("''") : std::string(1, c);
+  return out + "'";
+}
+
+// The link-pair matrix as a PNG (through gnuplot, when installed): one cell per pair, coloured by the
+// colliding fraction on a log scale; Never pairs green (dark when they came within the near margin),
+// Adjacent and Default grey; each cell lettered with its verdict. Returns false (with a reason) when
+// no picture was drawn.
+bool writeHeatmap(const RobotModel& model, const std::vector<PairAudit>& audit, const std::string& png,
+                  std::string& why) {
+  std::vector<int> links;
+  for (const PairAudit& p : audit) links.push_back(p.a), links.push_back(p.b);
+  std::sort(links.begin(), links.end());
+  links.erase(std::unique(links.begin(), links.end()), links.end());
+  auto at = [&](int link) { return std::lower_bound(links.begin(), links.end(), link) - links.begin(); };
+  std::ostringstream sampled, never, fixed, labels, tics;
+  for (const PairAudit& p : audit) {
+    const long x = at(p.a), y = at(p.b);
+    const std::string cell = std::to_string(x) + " " + std::to_string(y);
+    const char* letter = p.reason == "Adjacent" ? "A" : p.reason == "Default" ? "D" : p.reason == "Always" ? "Al"
+                         : p.reason == "Never" ? (p.near_miss ? "N*" : "N") : "";
+    if (p.samples == 0) fixed << cell << "\n";
+    else if (p.colliding == 0) never << cell << " " << (p.near_miss ? 1 : 0) << "\n";
+    else sampled << cell << " " << static_cast<double>(p.colliding) / p.samples << "\n";
+    if (*letter) labels << cell << " " << letter << "\n";
+  }
+  for (std::size_t i = 0; i < links.size(); ++i) tics << (i ? ", " : "") << quoted(model.link(links[i]).name) << " " << i;
+  const int n = static_cast<int>(links.size());
+  const int size = std::max(700, 40 * n + 300);
+  std::ostringstream gp;
+  gp << "# Written by clearway audit: the link-pair matrix of " << model.name() << "\n"
+     << "set terminal pngcairo noenhanced size " << size << "," << size << " font ',9'\n"
+     << "set output " << quoted(png) << "\n"
+     << "set title \"Self-collision audit of " << model.name()
+     << ": fraction of samples colliding\\nA adjacent, D default, Al always, N never, N* never but within 1 mm\"\n"
+     << "set size ratio -1\nset xrange [-0.5:" << n - 0.5 << "]\nset yrange [-0.5:" << n - 0.5 << "]\n"
+     << "set xtics (" << tics.str() << ") rotate by 60 right\nset ytics (" << tics.str() << ")\n"
+     << "set logscale cb\nset cbrange [1e-5:1]\nset cblabel 'colliding fraction'\n"
+     << "set palette defined (0 '#fff7bc', 0.5 '#fe9929', 1 '#cc4c02')\nset key off\nset grid front\n"
+     << "$sampled << EOD\n" << sampled.str() << "EOD\n$never << EOD\n" << never.str() << "EOD\n$fixed << EOD\n"
+     << fixed.str() << "EOD\n$labels << EOD\n" << labels.str() << "EOD\n";
+  // Empty datablocks make gnuplot stop with an error: plot only those with rows.
+  std::vector<std::string> parts;
+  if (!sampled.str().empty()) parts.push_back("$sampled using 1:2:(0.5):(0.5):3 with boxxyerror fs solid 1.0 noborder lc palette");
+  if (!never.str().empty())
+    parts.push_back("$never using 1:2:(0.5):(0.5):($3 > 0 ? 0x2e7d32 : 0xa5d6a7) with boxxyerror fs solid 1.0 noborder lc rgb variable");
+  if (!fixed.str().empty()) parts.push_back("$fixed using 1:2:(0.5):(0.5) with boxxyerror fs solid 1.0 noborder lc rgb '#bdbdbd'");
+  if (!labels.str().empty()) parts.push_back("$labels using 1:2:3 with labels font ',7'");
+  if (parts.empty()) {
+    why = "no pairs";
+    return false;
+  }
+  gp << "plot ";
+  for (std::size_t i = 0; i < parts.size(); ++i) gp << (i ? ", " : "") << parts[i];
+  gp << "\n";
+  const std::string script = png + ".gp";
+  std::ofstream(script) << gp.str();
+  if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
+    why = "gnuplot is not installed (" + script + " written)";
+    return false;
+  }
+  if (std::system(("gnuplot " + quoted(script) + " 2>/dev/null").c_str()) != 0) {
+    why = "gnuplot failed on " + script;
+    return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -106,6 +193,7 @@ int auditCommand(const std::vector<std::string>& args) {
   const auto geometry = std::make_shared<const RobotGeometry>(model);
   std::cerr << "clearway audit: " << model->name() << ", " << geometry->geometricLinks().size()
             << " links with geometry, " << options.samples << " samples (seed " << options.seed << ")\n";
+  if (isatty(STDERR_FILENO)) options.progress = progressBar;
   const std::vector<PairAudit> audit = auditSelfCollision(geometry, options);
 
   std::map<std::string, int> counts;
@@ -140,9 +228,16 @@ int auditCommand(const std::vector<std::string>& args) {
     }
   }
   if (!report.empty()) {
+    // The picture beside the report: report.md → report.png.
+    const std::filesystem::path png = std::filesystem::path(report).replace_extension(".png");
+    std::string why;
+    const bool drawn = writeHeatmap(*model, audit, png.string(), why);
+    if (!drawn) std::cerr << "clearway audit: no heat map: " << why << "\n";
     std::ofstream out(report);
     out << "# Self-collision audit of " << model->name() << "\n\n" << options.samples << " samples, seed "
-        << options.seed << ".\n\n| link 1 | link 2 | verdict | colliding | samples | p (95% upper) | min clearance (m) |\n"
+        << options.seed << ".\n\n";
+    if (drawn) out << "![link-pair matrix](" << png.filename().string() << ")\n\n";
+    out << "| link 1 | link 2 | verdict | colliding | samples | p (95% upper) | min clearance (m) |\n"
         << "|---|---|---|---|---|---|---|\n";
     for (const PairAudit& p : audit)
       out << "| " << model->link(p.a).name << " | " << model->link(p.b).name << " | "

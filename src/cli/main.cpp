@@ -80,6 +80,7 @@ const Command kCommands[] = {
     {"check", "classify joint vectors of a scene: free or which links collide", clearway::cli::checkCommand},
     {"motion", "check joint-space segments of a scene: free, or the last valid fraction", clearway::cli::motionCommand},
     {"audit", "self-collision audit of a URDF: Adjacent, Default, Always, Never pairs with evidence; SRDF out", clearway::cli::auditCommand},
+    {"bench", "accuracy against time per suite, mode and tolerance, FCL side by side: CSV, table, plots; shards", clearway::cli::benchCommand},
     {"query", "narrow-phase queries on shape pairs from a JSON Lines file", queryCommand},
 };
 

@@ -23,6 +23,10 @@ int motionCommand(const std::vector<std::string>& args);
 /// `clearway audit URDF [--srdf S] [--samples N] [--seed N] [--srdf-out FILE] [--report FILE]`.
 int auditCommand(const std::vector<std::string>& args);
 
+/// `clearway bench [SUITE...] [--shard I/N] ...` and `clearway bench merge`: accuracy against time, CSV,
+/// table, plots and OMPL logs (see bench_command.cpp).
+int benchCommand(const std::vector<std::string>& args);
+
 /// Scene::load, printing the robot's load warnings; on failure prints "clearway COMMAND: reason" and
 /// returns null.
 std::shared_ptr<const Scene> loadScene(const char* command, const std::string& path, const SceneOptions& options);

@@ -3,6 +3,7 @@
 #include <clearway/kinematics/forward_kinematics.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -129,6 +130,8 @@ std::vector<PairAudit> auditSelfCollision(std::shared_ptr<const RobotGeometry> g
     std::vector<double> min_clearance;
   };
   std::vector<Partial> partial(options.threads);
+  std::atomic<int> done{0};
+  const int report_every = std::max(1, options.samples / 100);
   const auto work = [&](int t) {
     Partial& mine = partial[t];
     mine.colliding.assign(result.size(), 0);
@@ -152,12 +155,16 @@ std::vector<PairAudit> auditSelfCollision(std::shared_ptr<const RobotGeometry> g
         const DistanceResult d = meshDistance(ga, ps[p.a], gb, ps[p.b], tol);
         if (!isFailure(d.status)) mine.min_clearance[k] = std::min(mine.min_clearance[k], d.distance);
       }
+      const int now = done.fetch_add(1, std::memory_order_relaxed) + 1;
+      // Only the calling thread reports, so the callback needs no locking.
+      if (t == 0 && options.progress && now / report_every != (now - 1) / report_every) options.progress(now, options.samples);
     }
   };
   std::vector<std::thread> pool;
   for (int t = 1; t < options.threads; ++t) pool.emplace_back(work, t);
   work(0);
   for (auto& th : pool) th.join();
+  if (options.progress) options.progress(options.samples, options.samples);
 
   for (const int k : sampled_pairs) {
     PairAudit& p = result[k];

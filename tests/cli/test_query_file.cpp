@@ -3,6 +3,7 @@
 // 1e-6 bounds the gap between GJK's bounds and these pairs converge far below it) unless a looser
 // bound is stated beside the check; bad input must name the offending key.
 #include "cli/query_file.h"
+#include "cli/tool_run.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -450,24 +451,8 @@ TEST(QueryFileErrors, StreamKeepsGoingAndSkipsBlankLines) {
 // The built tool.
 
 #ifdef CLEARWAY_TOOL_PATH
+using namespace clearway_test;
 namespace {
-struct ToolRun {
-  int exit_code;
-  std::string out, err;
-};
-std::string slurp(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-ToolRun runTool(const std::string& args) {
-  // CTest runs tests in parallel processes: name the capture files after this process.
-  const std::string stem = testing::TempDir() + "clearway_query_" + std::to_string(::getpid());
-  const std::string out = stem + ".out", err = stem + ".err";
-  const int raw = std::system((std::string("'") + CLEARWAY_TOOL_PATH + "' " + args + " >'" + out + "' 2>'" + err + "'").c_str());
-  return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, slurp(out), slurp(err)};
-}
 std::vector<nlohmann::json> jsonLines(const std::string& text) {
   std::vector<nlohmann::json> v;
   std::istringstream in(text);
@@ -647,6 +632,12 @@ TEST(AuditTool, WritesSrdfAndReport) {
   EXPECT_MENTIONS(r.out, "pairs differ from");
   EXPECT_MENTIONS(slurp(dir + "/out.srdf"), "<disable_collisions link1=");
   EXPECT_MENTIONS(slurp(dir + "/report.md"), "| link 1 | link 2 | verdict |");
+  // The heat map beside the report, linked from it (gnuplot draws it; without gnuplot the script stays).
+  EXPECT_TRUE(std::filesystem::exists(dir + "/report.png.gp"));
+  if (std::system("command -v gnuplot >/dev/null 2>&1") == 0) {
+    EXPECT_GT(std::filesystem::file_size(dir + "/report.png"), 1000u);
+    EXPECT_MENTIONS(slurp(dir + "/report.md"), "![link-pair matrix](report.png)");
+  }
   r = runTool("audit /nonexistent.urdf");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_MENTIONS(r.err, "/nonexistent.urdf");

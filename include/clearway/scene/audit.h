@@ -10,6 +10,7 @@
 #include <memory>
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,9 @@ struct AuditOptions {
   double near_margin = 1e-3;      ///< a Never pair whose clearance came under this is flagged near_miss
   int threads = 2;
   Tolerances tolerances = {};
+  /// Called from the calling thread with (samples done, samples in all) about every 1% of a run and once
+  /// at the end; may be empty. For progress bars.
+  std::function<void(int, int)> progress;
 };
 
 /// One pair's verdict and evidence.

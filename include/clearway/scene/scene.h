@@ -113,6 +113,8 @@ class Scene {
   const RobotGeometry& geometry() const noexcept { return *geometry_; }
   const std::shared_ptr<const RobotGeometry>& geometryPtr() const noexcept { return geometry_; }
   const Environment& environment() const noexcept { return *environment_; }
+  /// The environment, to share with another Scene over the same obstacles (another mode, say).
+  const std::shared_ptr<const Environment>& environmentPtr() const noexcept { return environment_; }
   const SelfCollision& selfCollision() const noexcept { return self_; }
   const CollisionFilter& filter() const noexcept { return filter_; }
   const SceneOptions& options() const noexcept { return options_; }

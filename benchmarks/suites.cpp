@@ -1,0 +1,442 @@
+// The suites of `clearway bench` (see suites.h). Times are this thread's CPU time, the faster of two
+// passes; FCL runs in the same process on the same shapes, states and segments.
+#include "suites.h"
+
+#include "bench_clock.h"
+#include "fcl_ompl.h"
+#include "narrowphase_shapes.h"
+#include "shared_problems.h"
+
+#include <clearway/ompl/collision_checking.h>
+
+#include <fcl/narrowphase/detail/gjk_solver_indep.h>
+#include <fcl/narrowphase/detail/gjk_solver_libccd.h>
+#include <ompl/base/DiscreteMotionValidator.h>
+#include <ompl/geometric/SimpleSetup.h>
+#include <ompl/geometric/planners/rrt/RRTConnect.h>
+#include <ompl/tools/benchmark/Benchmark.h>
+#include <ompl/util/Console.h>
+
+#include <algorithm>
+#include <cstring>
+#include <cmath>
+#include <filesystem>
+#include <stdexcept>
+
+namespace clearway::bench {
+namespace {
+
+namespace ob = ompl::base;
+namespace og = ompl::geometric;
+
+// A case's own seed: the run's seed and the case's name, never its position, so shards agree.
+std::uint64_t caseSeed(const SuiteConfig& config, const SuiteCase& c) {
+  std::uint64_t h = 1469598103934665603ULL;  // FNV-1a
+  for (char ch : c.suite + "/" + c.subject) h = (h ^ static_cast<unsigned char>(ch)) * 1099511628211ULL;
+  return h ^ config.seed;
+}
+
+template <class T>
+inline void doNotOptimize(const T& value) {
+  asm volatile("" : : "r,m"(value) : "memory");
+}
+
+// ns per item of body(0 … n−1), the faster of two passes.
+template <class Body>
+double bestNs(std::size_t n, Body&& body) {
+  double best = INFINITY;
+  for (int pass = 0; pass < 2; ++pass) {
+    const double t0 = threadSeconds();
+    for (std::size_t i = 0; i < n; ++i) body(i);
+    best = std::min(best, threadSeconds() - t0);
+  }
+  return 1e9 * best / static_cast<double>(std::max<std::size_t>(n, 1));
+}
+
+// Verdict counts against a reference (true = colliding).
+void judge(SuiteRow& row, const std::vector<char>& verdict, const std::vector<char>& truth) {
+  row.items = static_cast<long>(truth.size());
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    row.positives += truth[i];
+    row.misses += truth[i] && !verdict[i];
+    row.false_alarms += !truth[i] && verdict[i];
+  }
+  row.error = row.items ? double(row.misses + row.false_alarms) / double(row.items) : 0.0;
+  row.max_error = row.misses + row.false_alarms > 0 ? 1.0 : 0.0;
+}
+
+// ---- narrowphase: GJK distance on separated convex pairs, by tolerance --------------------------------
+
+const double kGjkTolerances[] = {1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-9};
+
+template <class FA, class FB>
+void distanceRows(const Family<FA, FB>& f, std::vector<SuiteRow>& rows) {
+  const std::size_t n = f.cases.size();
+  std::vector<double> value(n);
+  std::vector<char> failed(n);
+  std::vector<int> iterations(n);
+  auto finish = [&](const char* engine, double tol, double ns) {
+    SuiteRow r;
+    r.suite = "narrowphase", r.subject = f.name, r.engine = engine, r.mode = "distance", r.tolerance = tol;
+    r.items = static_cast<long>(n), r.ns_per_item = ns;
+    double sum = 0;
+    long iters = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      iters += iterations[i];
+      if (failed[i]) {
+        ++r.misses;
+        continue;
+      }
+      const double e = std::abs(value[i] - f.cases[i].ref);
+      sum += e;
+      r.max_error = std::max(r.max_error, e);
+    }
+    r.error = n > static_cast<std::size_t>(r.misses) ? sum / double(n - r.misses) : 0.0;
+    r.work_per_item = double(iters) / double(std::max<std::size_t>(n, 1));
+    rows.push_back(r);
+    std::fill(iterations.begin(), iterations.end(), 0);
+  };
+  for (double tol : kGjkTolerances) {
+    Tolerances t;
+    t.gjk_relative = tol;
+    const double ns = bestNs(n, [&](std::size_t i) {
+      const PairCase& c = f.cases[i];
+      const DistanceResult r = gjkDistance(f.ca[c.ia], c.pa, f.cb[c.ib], c.pb, t);
+      doNotOptimize(r.point_a);
+      value[i] = r.distance, failed[i] = isFailure(r.status), iterations[i] = r.iterations;
+    });
+    finish("clearway", tol, ns);
+    // FCL's two GJK solvers at the same nominal tolerance (indep: relative; libccd: absolute, metres).
+    auto fcl = [&](auto solver, const char* engine) {
+      const double fns = bestNs(n, [&](std::size_t i) {
+        const PairCase& c = f.cases[i];
+        double d = -1;
+        Vec3 p1, p2;
+        failed[i] = !solver.shapeDistance(f.fa[c.ia], c.ta, f.fb[c.ib], c.tb, &d, &p1, &p2);
+        doNotOptimize(p1);
+        value[i] = d;
+      });
+      finish(engine, tol, fns);
+    };
+    fcl::detail::GJKSolver_indep<double> indep;
+    indep.gjk_tolerance = tol;
+    fcl(indep, "fcl-indep");
+    fcl::detail::GJKSolver_libccd<double> libccd;
+    libccd.distance_tolerance = tol;
+    fcl(libccd, "fcl-libccd");
+  }
+}
+
+void narrowphaseCase(const SuiteCase& c, const SuiteConfig& config, std::vector<SuiteRow>& rows) {
+  const std::uint64_t seed = caseSeed(config, c);
+  constexpr int kPool = 32;
+  if (c.subject == "hull16") {
+    auto hull = [](Rng& rng) { return makeHull(rng, 16); };
+    auto f = makePools<fcl::Convexd, fcl::Convexd>(c.subject, kPool, seed, hull, hull);
+    addSeparatedPairs(f, config.count, seed + 1);
+    distanceRows(f, rows);
+  } else if (c.subject == "box-capsule") {
+    auto f = makePools<fcl::Boxd, fcl::Capsuled>(c.subject, kPool, seed, makeBox, makeCapsule);
+    addSeparatedPairs(f, config.count, seed + 1);
+    distanceRows(f, rows);
+  } else if (c.subject == "cylinder-cone") {
+    auto f = makePools<fcl::Cylinderd, fcl::Coned>(c.subject, kPool, seed, makeCylinder, makeCone);
+    addSeparatedPairs(f, config.count, seed + 1);
+    distanceRows(f, rows);
+  } else {
+    throw std::runtime_error("unknown shape family '" + c.subject + "'");
+  }
+}
+
+// ---- shared problems ------------------------------------------------------------------------------------
+
+// Every case of a process shares the robots it has loaded.
+RobotCache& robots() {
+  static RobotCache cache;
+  return cache;
+}
+
+// Uniform in the group's bounds (continuous joints: [−π, π)).
+void randomState(const Scene& scene, Rng& rng, double* q) {
+  for (int i = 0; i < scene.dimension(); ++i) {
+    const double lo = std::isfinite(scene.lower(i)) ? scene.lower(i) : -M_PI;
+    const double hi = std::isfinite(scene.upper(i)) ? scene.upper(i) : M_PI;
+    q[i] = rng.uniform(lo, hi);
+  }
+}
+
+// ---- states: one joint vector at a time, exact meshes, convex hulls and FCL ----------------------------
+
+void statesCase(const SuiteCase& c, const SuiteConfig& config, std::vector<SuiteRow>& rows) {
+  const SceneDescription d = parseSceneFile(c.file);
+  const auto mesh = robots().scene(d);
+  SceneOptions hull_options;
+  hull_options.mode = GeometryMode::Hull;
+  const Scene hull(d, mesh->geometryPtr(), mesh->environmentPtr(), hull_options);
+  FclScene fcl(*mesh);
+
+  Rng rng(caseSeed(config, c));
+  const int n = mesh->dimension();
+  std::vector<double> states(static_cast<std::size_t>(config.count) * n);
+  for (int i = 0; i < config.count; ++i) randomState(*mesh, rng, &states[i * n]);
+  const std::size_t count = config.count;
+  std::vector<char> truth(count), verdict(count);
+  SceneContext ctx = mesh->makeContext();
+  for (std::size_t i = 0; i < count; ++i) truth[i] = !mesh->isFree(&states[i * n], ctx);
+
+  auto row = [&](const char* engine, const char* mode, double ns) {
+    SuiteRow r;
+    r.suite = "states", r.subject = c.subject, r.engine = engine, r.mode = mode, r.ns_per_item = ns;
+    r.work_per_item = 1;
+    judge(r, verdict, truth);
+    rows.push_back(r);
+  };
+  row("clearway", "mesh", bestNs(count, [&](std::size_t i) { verdict[i] = !mesh->isFree(&states[i * n], ctx); }));
+  SceneContext hull_ctx = hull.makeContext();
+  row("clearway", "hull", bestNs(count, [&](std::size_t i) { verdict[i] = !hull.isFree(&states[i * n], hull_ctx); }));
+  row("fcl", "obbrss", bestNs(count, [&](std::size_t i) { verdict[i] = !fcl.isFree(&states[i * n]); }));
+}
+
+// ---- motions: certified, and OMPL's sampling over Clearway and over FCL, by tolerance -------------------
+
+struct MotionMode {
+  const char* engine;
+  const char* mode;
+  double tolerance;  // certified: contact distance (m); sampled: resolution (fraction of the extent)
+};
+const MotionMode kMotionModes[] = {
+    {"clearway", "certified", 1e-2}, {"clearway", "certified", 1e-3}, {"clearway", "certified", 1e-4},
+    {"clearway", "sampled", 0.05},   {"clearway", "sampled", 0.01},   {"clearway", "sampled", 0.001},
+    {"fcl", "sampled", 0.05},        {"fcl", "sampled", 0.01},        {"fcl", "sampled", 0.001},
+};
+
+void motionsCase(const SuiteCase& c, const SuiteConfig& config, std::vector<SuiteRow>& rows) {
+  const SceneDescription d = parseSceneFile(c.file);
+  const auto scene = robots().scene(d);
+  const StateMap map(*scene);
+  const int n = scene->dimension();
+  const double extent = makeStateSpace(*scene)->getMaximumExtent();
+
+  // Segments: a valid state, and a valid one up to 0.2·extent away (RRTConnect's default range).
+  Rng rng(caseSeed(config, c));
+  SceneContext ctx = scene->makeContext();
+  std::vector<std::vector<double>> q0s, q1s;
+  std::vector<double> a(n), b(n), dir(n);
+  for (long attempts = 0; static_cast<int>(q0s.size()) < config.count && attempts < 1000L * config.count; ++attempts) {
+    randomState(*scene, rng, a.data());
+    if (!scene->isFree(a.data(), ctx)) continue;
+    double norm = 0;
+    for (double& x : dir) {
+      x = rng.normal();
+      norm += x * x;
+    }
+    const double length = 0.2 * extent * rng.uniform(0.05, 1.0) / std::sqrt(norm);
+    for (int i = 0; i < n; ++i) {
+      b[i] = a[i] + length * dir[i];
+      if (std::isfinite(scene->lower(i))) b[i] = std::clamp(b[i], scene->lower(i), scene->upper(i));
+      else b[i] = std::remainder(b[i], 2 * M_PI);
+    }
+    if (!scene->isFree(b.data(), ctx)) continue;
+    q0s.push_back(a);
+    q1s.push_back(b);
+  }
+  const std::size_t count = q0s.size();
+  // The reference: Clearway's states every 1e-3 rad along the segment.
+  MotionOptions dense;
+  dense.mode = clearway::MotionMode::Sampled;
+  dense.resolution = 1e-3;
+  const MotionChecker reference(scene, dense);
+  MotionContext ref_ctx = reference.makeContext();
+  std::vector<char> truth(count), verdict(count);
+  for (std::size_t s = 0; s < count; ++s) {
+    std::vector<double> u = q1s[s];
+    map.unwrap(q0s[s].data(), u.data());
+    truth[s] = !reference.check(q0s[s].data(), u.data(), ref_ctx).free;
+  }
+
+  for (const MotionMode& m : kMotionModes) {
+    const bool certified = !std::strcmp(m.mode, "certified");
+    auto si = std::make_shared<ob::SpaceInformation>(makeStateSpace(*scene));
+    if (certified) {
+      MotionOptions options;
+      options.contact_distance = m.tolerance;
+      setupCollisionChecking(si, scene, options);
+    } else {
+      if (!std::strcmp(m.engine, "fcl")) si->setStateValidityChecker(std::make_shared<FclValidity>(si, *scene));
+      else si->setStateValidityChecker(std::make_shared<ValidityChecker>(si, scene));
+      si->setMotionValidator(std::make_shared<ob::DiscreteMotionValidator>(si));
+      si->setStateValidityCheckingResolution(m.tolerance);
+      si->setup();
+    }
+    ob::State* sa = si->allocState();
+    ob::State* sb = si->allocState();
+    const double ns = bestNs(count, [&](std::size_t s) {
+      map.fromVector(q0s[s].data(), sa);
+      map.fromVector(q1s[s].data(), sb);
+      verdict[s] = !si->checkMotion(sa, sb);
+    });
+    // Work, counted outside the timing: advancement steps, or the states OMPL checks.
+    long work = 0;
+    for (std::size_t s = 0; s < count; ++s) {
+      map.fromVector(q0s[s].data(), sa);
+      map.fromVector(q1s[s].data(), sb);
+      if (certified) work += static_cast<const ContinuousMotionValidator&>(*si->getMotionValidator()).check(sa, sb).steps;
+      else work += si->getStateSpace()->validSegmentCount(sa, sb);
+    }
+    si->freeState(sa);
+    si->freeState(sb);
+    SuiteRow r;
+    r.suite = "motions", r.subject = c.subject, r.engine = m.engine, r.mode = m.mode, r.tolerance = m.tolerance;
+    r.ns_per_item = ns;
+    r.work_per_item = double(work) / double(std::max<std::size_t>(count, 1));
+    judge(r, verdict, truth);
+    r.error = r.items ? double(r.misses) / double(r.items) : 0.0;  // the missed-collision rate
+    rows.push_back(r);
+  }
+}
+
+// ---- plan: RRTConnect with each checker, through ompl::tools::Benchmark (Planner Arena logs) ------------
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+void planCase(const SuiteCase& c, const SuiteConfig& config, std::vector<SuiteRow>& rows) {
+  const SceneDescription d = parseSceneFile(c.file);
+  const auto scene = robots().scene(d);
+  if (!scene->isFree(d.start) || !scene->isFree(d.goal)) {
+    std::fprintf(stderr, "%s: start or goal in collision: no planning\n", c.file.c_str());
+    return;
+  }
+  const MotionChecker certify(scene);
+  MotionContext certify_ctx = certify.makeContext();
+  MotionOptions dense_options;
+  dense_options.mode = clearway::MotionMode::Sampled;
+  dense_options.resolution = 1e-3;
+  const MotionChecker dense(scene, dense_options);
+  MotionContext dense_ctx = dense.makeContext();
+  const StateMap map(*scene);
+  const std::string logs = config.out + "/plan";
+  std::filesystem::create_directories(logs);
+  struct Checker {
+    const char* engine;
+    const char* mode;
+  };
+  for (const Checker& k : {Checker{"clearway", "certified"}, Checker{"clearway", "sampled"}, Checker{"fcl", "sampled"}}) {
+    const bool certified = !std::strcmp(k.mode, "certified");
+    og::SimpleSetup setup(makeStateSpace(*scene));
+    const ob::SpaceInformationPtr si = setup.getSpaceInformation();
+    if (certified) {
+      setupCollisionChecking(si, scene);
+    } else {
+      if (!std::strcmp(k.engine, "fcl")) si->setStateValidityChecker(std::make_shared<FclValidity>(si, *scene));
+      else si->setStateValidityChecker(std::make_shared<ValidityChecker>(si, scene));
+      si->setMotionValidator(std::make_shared<ob::DiscreteMotionValidator>(si));
+      si->setStateValidityCheckingResolution(0.01);  // OMPL's default
+    }
+    ob::ScopedState<> start(setup.getStateSpace()), goal(setup.getStateSpace());
+    map.fromVector(d.start.data(), start.get());
+    map.fromVector(d.goal.data(), goal.get());
+    setup.setStartAndGoalStates(start, goal);
+    setup.setup();
+    const std::string name = c.subject + "_" + k.engine + "-" + k.mode;
+    ompl::tools::Benchmark bench(setup, name);
+    bench.addPlanner(std::make_shared<og::RRTConnect>(si));
+    std::vector<double> q0(scene->dimension()), q1(scene->dimension());
+    // Every solution is re-checked: certified ("certified": free, never within 1 mm) and densely sampled
+    // at 1e-3 rad ("collides_dense": a collision the sampling sees).
+    bench.setPostRunEvent([&](const ob::PlannerPtr& planner, ompl::tools::Benchmark::RunProperties& run) {
+      bool certified_path = false, collides = false;
+      const ob::ProblemDefinitionPtr& pdef = planner->getProblemDefinition();
+      if (pdef->hasExactSolution()) {
+        certified_path = true;
+        const auto* path = pdef->getSolutionPath()->as<og::PathGeometric>();
+        for (std::size_t i = 0; i + 1 < path->getStateCount(); ++i) {
+          map.toVector(path->getState(i), q0.data());
+          map.toVector(path->getState(i + 1), q1.data());
+          map.unwrap(q0.data(), q1.data());
+          certified_path = certified_path && certify.check(q0.data(), q1.data(), certify_ctx).free;
+          collides = collides || !dense.check(q0.data(), q1.data(), dense_ctx).free;
+        }
+      }
+      run["certified BOOLEAN"] = certified_path ? "1" : "0";
+      run["collides_dense BOOLEAN"] = collides ? "1" : "0";
+    });
+    const ompl::tools::Benchmark::Request request(config.plan_time, 4096.0, config.plan_runs, 0.05, false, false, false);
+    bench.benchmark(request);
+    bench.saveResultsToFile((logs + "/" + name + ".log").c_str());
+
+    SuiteRow r;
+    r.suite = "plan", r.subject = c.subject, r.engine = k.engine, r.mode = k.mode;
+    r.tolerance = certified ? MotionOptions{}.contact_distance : 0.01;
+    std::vector<double> times;
+    for (const auto& run : bench.getRecordedExperimentData().planners.at(0).runs) {
+      ++r.items;
+      const bool solved = run.count("solved BOOLEAN") && run.at("solved BOOLEAN") == "1";
+      const bool exact = !run.count("approximate solution BOOLEAN") || run.at("approximate solution BOOLEAN") == "0";
+      if (!solved || !exact) continue;
+      ++r.positives;
+      times.push_back(std::stod(run.at("time REAL")));
+      r.false_alarms += run.at("certified BOOLEAN") != "1";
+      r.misses += run.at("collides_dense BOOLEAN") == "1";
+    }
+    r.ns_per_item = 1e9 * median(times);
+    r.work_per_item = r.items ? double(r.positives) / double(r.items) : 0.0;
+    r.error = r.positives ? double(r.misses) / double(r.positives) : 0.0;
+    r.max_error = r.misses ? 1.0 : 0.0;
+    rows.push_back(r);
+  }
+}
+
+const char* const kShapeFamilies[] = {"hull16", "box-capsule", "cylinder-cone"};
+
+}  // namespace
+
+const std::vector<std::string>& suiteNames() {
+  static const std::vector<std::string> names = {"narrowphase", "states", "motions", "plan"};
+  return names;
+}
+
+std::vector<SuiteCase> enumerateCases(const SuiteConfig& config) {
+  std::vector<SuiteCase> cases;
+  for (const std::string& suite : suiteNames()) {
+    if (std::find(config.suites.begin(), config.suites.end(), suite) == config.suites.end()) continue;
+    if (suite == "narrowphase") {
+      for (const char* family : kShapeFamilies) cases.push_back({suite, family, ""});
+      continue;
+    }
+    const std::string scenes = config.shared + "/scenes";
+    if (!std::filesystem::is_directory(scenes))
+      throw std::runtime_error("suite '" + suite + "' needs the shared scenes, and " + scenes + " is not a folder");
+    for (const std::string& family : sceneFamilies(scenes))
+      for (int k = 1; k <= config.problems; ++k) {
+        const std::string file = problemFile(scenes, family, k);
+        if (!file.empty()) cases.push_back({suite, std::filesystem::path(file).stem().string(), file});
+      }
+  }
+  if (!config.subjects.empty())
+    cases.erase(std::remove_if(cases.begin(), cases.end(),
+                               [&](const SuiteCase& c) {
+                                 return std::none_of(config.subjects.begin(), config.subjects.end(), [&](const std::string& s) {
+                                   return c.subject.find(s) != std::string::npos;
+                                 });
+                               }),
+                cases.end());
+  for (const std::string& suite : config.suites)
+    if (std::find(suiteNames().begin(), suiteNames().end(), suite) == suiteNames().end())
+      throw std::runtime_error("unknown suite '" + suite + "' (known: narrowphase, states, motions, plan)");
+  return cases;
+}
+
+void runCase(const SuiteCase& c, const SuiteConfig& config, std::vector<SuiteRow>& rows) {
+  ompl::msg::setLogLevel(ompl::msg::LOG_ERROR);
+  if (c.suite == "narrowphase") narrowphaseCase(c, config, rows);
+  else if (c.suite == "states") statesCase(c, config, rows);
+  else if (c.suite == "motions") motionsCase(c, config, rows);
+  else if (c.suite == "plan") planCase(c, config, rows);
+  else throw std::runtime_error("unknown suite '" + c.suite + "'");
+}
+
+}  // namespace clearway::bench

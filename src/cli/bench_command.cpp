@@ -1,0 +1,511 @@
+// `clearway bench`: runs the suites of benchmarks/suites.h, case by case, and writes what accuracy costs
+// in time: results.csv (one row per case and configuration), summary.csv and a table (one row per
+// configuration over all cases), gnuplot plots (PNG) and OMPL benchmark logs for planning.
+//
+// Sharding: `--shard I/N` runs the cases whose index is I modulo N and writes results.csv only;
+// `clearway bench merge` checks that shards 0 … N−1 of one configuration are all there, each once, and
+// writes the same files an unsharded run writes. Rows are copied verbatim and ordered by case, so a
+// merged results.csv equals an unsharded one except for the measured times.
+#include "scene_commands.h"
+
+#ifdef CLEARWAY_HAVE_BENCH_SUITES
+#include "../../benchmarks/suites.h"
+#endif
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace clearway::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+const char* const kBenchUsage =
+    "usage: clearway bench [SUITE...] [--out DIR] [--shard I/N] [--count N] [--problems K]\n"
+    "                      [--plan-runs R] [--plan-time S] [--seed N] [--subjects S1,S2] [--shared DIR]\n"
+    "       clearway bench merge --out DIR SHARD_DIR...\n"
+    "\n"
+    "SUITE: narrowphase (GJK distance by tolerance, Clearway and FCL's two solvers), states (one state:\n"
+    "exact meshes, convex hulls, FCL OBBRSS), motions (certified by contact distance, OMPL's sampling by\n"
+    "resolution over Clearway and over FCL, against a dense reference), plan (RRTConnect with each\n"
+    "checker; OMPL benchmark logs in DIR/plan), or all. Default: narrowphase states motions.\n"
+    "Writes DIR/results.csv; unsharded runs and merges also DIR/summary.csv, DIR/table.txt (printed),\n"
+    "DIR/plots.gp and its PNG plots (when gnuplot is installed). --count: pairs per shape family, states\n"
+    "or motions per problem (default 200); --problems: problems per scene family (default 1);\n"
+    "--subjects: only the shape families or problems whose name contains one of the strings.\n"
+    "--shard I/N runs the cases with index I modulo N (0 <= I < N); merge combines shards 0..N-1.\n";
+
+constexpr const char* kColumns =
+    "suite,case,subject,engine,mode,tolerance,items,ns_per_item,work_per_item,positives,misses,false_alarms,"
+    "error,max_error";
+constexpr int kFields = 14;
+
+struct Row {
+  long case_index = 0;
+  std::string suite, engine, mode;
+  double tolerance = 0, items = 0, ns = 0, work = 0, positives = 0, misses = 0, false_alarms = 0, error = 0,
+         max_error = 0;
+  std::string line;  // as written: merges copy it
+};
+
+// The identity of a run: its configuration line, the shard and the number of cases.
+struct Results {
+  std::string config;
+  long shard = -1, shards = 0;  // -1: all cases
+  long cases = 0;
+  std::vector<Row> rows;
+};
+
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  std::stringstream in(s);
+  std::string field;
+  while (std::getline(in, field, sep)) out.push_back(field);
+  if (!s.empty() && s.back() == sep) out.emplace_back();
+  return out;
+}
+
+bool parseLong(const std::string& s, long& out) {
+  if (s.empty()) return false;
+  char* end = nullptr;
+  errno = 0;
+  out = std::strtol(s.c_str(), &end, 10);
+  return errno == 0 && *end == '\0';
+}
+
+bool parseDouble(const std::string& s, double& out) {
+  if (s.empty()) return false;
+  char* end = nullptr;
+  out = std::strtod(s.c_str(), &end);
+  return *end == '\0';
+}
+
+// "I/N" with 0 ≤ I < N.
+bool parseShard(const std::string& s, long& index, long& count, std::string& why) {
+  const auto slash = s.find('/');
+  if (slash == std::string::npos || !parseLong(s.substr(0, slash), index) || !parseLong(s.substr(slash + 1), count)) {
+    why = "expected I/N, two integers";
+    return false;
+  }
+  if (count < 1 || index < 0 || index >= count) {
+    why = "the index must be in [0, N) and N at least 1";
+    return false;
+  }
+  return true;
+}
+
+Row parseRow(const std::string& line, const std::string& where) {
+  const std::vector<std::string> f = split(line, ',');
+  if (static_cast<int>(f.size()) != kFields) throw std::runtime_error(where + ": expected " + std::to_string(kFields) +
+                                                                       " fields, found " + std::to_string(f.size()));
+  Row r;
+  r.line = line;
+  r.suite = f[0], r.engine = f[3], r.mode = f[4];
+  double* numbers[] = {&r.tolerance, &r.items, &r.ns, &r.work, &r.positives, &r.misses, &r.false_alarms, &r.error,
+                       &r.max_error};
+  if (!parseLong(f[1], r.case_index) || r.case_index < 0) throw std::runtime_error(where + ": bad case index '" + f[1] + "'");
+  for (int k = 0; k < 9; ++k)
+    if (!parseDouble(f[5 + k], *numbers[k]))
+      throw std::runtime_error(where + ": field " + std::to_string(6 + k) + " is not a number: '" + f[5 + k] + "'");
+  return r;
+}
+
+Results readResults(const std::string& file) {
+  std::ifstream in(file);
+  if (!in) throw std::runtime_error("cannot open " + file + ": " + std::strerror(errno));
+  Results res;
+  std::string line;
+  int n = 0;
+  bool header = false, seen_shard = false, seen_cases = false, seen_end = false;
+  while (std::getline(in, line)) {
+    const std::string where = file + ":" + std::to_string(++n);
+    if (n == 1 && line != "# clearway bench results v1") throw std::runtime_error(where + ": not a clearway bench results file");
+    if (line.rfind("# config: ", 0) == 0) res.config = line.substr(10);
+    else if (line.rfind("# shard: ", 0) == 0) {
+      seen_shard = true;
+      const std::string s = line.substr(9);
+      std::string why;
+      if (s != "all" && !parseShard(s, res.shard, res.shards, why)) throw std::runtime_error(where + ": shard '" + s + "': " + why);
+    } else if (line.rfind("# cases: ", 0) == 0) {
+      seen_cases = parseLong(line.substr(9), res.cases) && res.cases >= 0;
+      if (!seen_cases) throw std::runtime_error(where + ": bad case count");
+    } else if (line.rfind("# end: ", 0) == 0) {
+      // Written last: a file cut short anywhere (even inside a number of the last row) lacks it.
+      long count = -1;
+      seen_end = parseLong(line.substr(7, line.find(' ', 7) - 7), count) && count == static_cast<long>(res.rows.size());
+      if (!seen_end) throw std::runtime_error(where + ": the end line does not match the " + std::to_string(res.rows.size()) + " rows read");
+    } else if (seen_end) {
+      throw std::runtime_error(where + ": text after the end line");
+    } else if (line.rfind("#", 0) == 0) {
+      continue;
+    } else if (!header) {
+      if (line != kColumns) throw std::runtime_error(where + ": unexpected column header");
+      header = true;
+    } else {
+      res.rows.push_back(parseRow(line, where));
+      if (res.rows.back().case_index >= res.cases) throw std::runtime_error(where + ": case index beyond the case count");
+    }
+  }
+  if (!header || res.config.empty() || !seen_shard || !seen_cases || !seen_end)
+    throw std::runtime_error(file + ": truncated: the config, shard, cases, column or end lines are missing");
+  return res;
+}
+
+void writeResults(const std::string& file, const Results& res) {
+  std::ofstream out(file);
+  out << "# clearway bench results v1\n# config: " << res.config << "\n# shard: "
+      << (res.shard < 0 ? std::string("all") : std::to_string(res.shard) + "/" + std::to_string(res.shards))
+      << "\n# cases: " << res.cases << "\n"
+      << "# ns_per_item is thread CPU time (planning: median solve time); every other field depends only on\n"
+      << "# the config and the case\n"
+      << kColumns << "\n";
+  for (const Row& r : res.rows) out << r.line << "\n";
+  out << "# end: " << res.rows.size() << " rows\n";
+  out.flush();
+  if (!out) throw std::runtime_error("cannot write " + file);
+}
+
+// ---- Summary, table and plots ---------------------------------------------------------------------------
+
+struct Summary {
+  std::string suite, engine, mode;
+  double tolerance = 0, items = 0, ns_total = 0, work_total = 0, positives = 0, misses = 0, false_alarms = 0,
+         error_weighted = 0, error_weight = 0, max_error = 0;
+  double ns() const { return items > 0 ? ns_total / items : 0.0; }
+  double work() const { return items > 0 ? work_total / items : 0.0; }
+  double error() const { return error_weight > 0 ? error_weighted / error_weight : 0.0; }
+  std::string key() const { return engine + " " + mode; }
+};
+
+std::vector<Summary> summarize(const std::vector<Row>& rows) {
+  std::vector<Summary> out;
+  for (const Row& r : rows) {
+    auto it = std::find_if(out.begin(), out.end(), [&](const Summary& s) {
+      return s.suite == r.suite && s.engine == r.engine && s.mode == r.mode && s.tolerance == r.tolerance;
+    });
+    if (it == out.end()) {
+      out.push_back({r.suite, r.engine, r.mode, r.tolerance});
+      it = out.end() - 1;
+    }
+    it->items += r.items;
+    it->ns_total += r.ns * r.items;
+    it->work_total += r.work * r.items;
+    it->positives += r.positives;
+    it->misses += r.misses;
+    it->false_alarms += r.false_alarms;
+    // Distance errors average over the pairs that gave one; planning rates over the solved runs.
+    const double weight = r.suite == "narrowphase" ? r.items - r.misses : r.suite == "plan" ? r.positives : r.items;
+    it->error_weighted += r.error * weight;
+    it->error_weight += weight;
+    it->max_error = std::max(it->max_error, r.max_error);
+  }
+  return out;
+}
+
+// FCL's time for the same job, to divide by: the same mode and tolerance (the faster FCL solver), else
+// what OMPL users run by default (FCL sampled at 1%), else FCL's only mode in the suite.
+double fclPeerNs(const Summary& s, const std::vector<Summary>& all) {
+  double same = 0, fallback = 0;
+  for (const Summary& f : all) {
+    if (f.suite != s.suite || f.engine.rfind("fcl", 0) != 0 || f.ns() <= 0) continue;
+    if (f.mode == s.mode && f.tolerance == s.tolerance && (same == 0 || f.ns() < same)) same = f.ns();
+    if ((f.tolerance == 0.01 || f.tolerance == 0) && fallback == 0) fallback = f.ns();
+  }
+  return same > 0 ? same : fallback;
+}
+
+std::string fmt(const char* f, double x) {
+  char b[64];
+  std::snprintf(b, sizeof b, f, x);
+  return b;
+}
+
+std::string table(const std::vector<Summary>& all) {
+  std::ostringstream t;
+  char line[256];
+  std::snprintf(line, sizeof line, "%-12s %-11s %-10s %9s %7s %12s %9s %6s %6s %6s %11s %11s %8s\n", "suite", "engine",
+                "mode", "tolerance", "items", "ns/item", "work", "refpos", "missed", "extra", "error", "max_error",
+                "FCL/x");
+  t << line;
+  for (const Summary& s : all) {
+    const double peer = s.engine.rfind("fcl", 0) == 0 ? 0.0 : fclPeerNs(s, all);
+    std::snprintf(line, sizeof line, "%-12s %-11s %-10s %9.3g %7.0f %12.1f %9.2f %6.0f %6.0f %6.0f %11.3g %11.3g %8s\n",
+                  s.suite.c_str(), s.engine.c_str(), s.mode.c_str(), s.tolerance, s.items, s.ns(), s.work(), s.positives,
+                  s.misses, s.false_alarms, s.error(), s.max_error, peer > 0 && s.ns() > 0 ? fmt("%.2f", peer / s.ns()).c_str() : "-");
+    t << line;
+  }
+  t << "work: GJK iterations per query (Clearway; FCL does not report them), states or advancement steps per motion, solved fraction of planning runs.\n"
+       "refpos: items the reference calls colliding (planning: solved runs); missed: said free where the\n"
+       "reference collides (planning: solved paths a 1e-3 rad sampling finds colliding); extra: said colliding\n"
+       "where the reference is free (planning: paths the certified check does not pass). error: mean |distance\n"
+       "error| in m (narrowphase), wrong-verdict rate (states), missed-collision rate (motions, planning).\n"
+       "FCL/x: FCL's time for the same job divided by this row's (above 1: this row is faster).\n";
+  return t.str();
+}
+
+void writeSummaryCsv(const std::string& file, const std::vector<Summary>& all) {
+  std::ofstream out(file);
+  out << "suite,engine,mode,tolerance,items,ns_per_item,work_per_item,positives,misses,false_alarms,error,max_error,"
+         "fcl_ratio\n";
+  for (const Summary& s : all) {
+    const double peer = fclPeerNs(s, all);
+    out << s.suite << "," << s.engine << "," << s.mode << "," << fmt("%.10g", s.tolerance) << "," << s.items << ","
+        << fmt("%.6g", s.ns()) << "," << fmt("%.6g", s.work()) << "," << s.positives << "," << s.misses << ","
+        << s.false_alarms << "," << fmt("%.6g", s.error()) << "," << fmt("%.6g", s.max_error) << ","
+        << (peer > 0 && s.ns() > 0 ? fmt("%.4g", peer / s.ns()) : "") << "\n";
+  }
+  if (!out) throw std::runtime_error("cannot write " + file);
+}
+
+// One gnuplot datablock per curve (engine + mode) of a suite: x = time per item, y = the chosen error.
+std::string datablocks(const std::vector<Summary>& all, const std::string& suite, const char* prefix, double unit,
+                       double (*y)(const Summary&), std::vector<std::string>& names) {
+  std::ostringstream gp;
+  std::map<std::string, std::vector<const Summary*>> curves;
+  std::vector<std::string> order;
+  for (const Summary& s : all)
+    if (s.suite == suite) {
+      if (!curves.count(s.key())) order.push_back(s.key());
+      curves[s.key()].push_back(&s);
+    }
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const std::string name = "$" + std::string(prefix) + std::to_string(k);
+    gp << name << " << EOD\n";
+    for (const Summary* s : curves[order[k]]) gp << fmt("%.6g", s->ns() / unit) << " " << fmt("%.6g", y(*s)) << " " << fmt("%g", s->tolerance) << "\n";
+    gp << "EOD\n";
+    names.push_back(name + "|" + order[k]);
+  }
+  return gp.str();
+}
+
+std::string plotCommand(const std::vector<std::string>& names) {
+  std::string cmd = "plot ";
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    const auto bar = names[k].find('|');
+    cmd += (k ? ", " : "") + names[k].substr(0, bar) + " using 1:2 with linespoints pt 7 title '" + names[k].substr(bar + 1) +
+           "', " + names[k].substr(0, bar) + " using 1:2:3 with labels offset 0.6,0.6 font ',7' notitle";
+  }
+  return cmd + "\n";
+}
+
+// Writes plots.gp (self-contained: the data is inside) and runs gnuplot on it when it is installed.
+void writePlots(const std::string& dir, const std::vector<Summary>& all) {
+  std::ostringstream gp;
+  gp << "# Written by clearway bench: what accuracy costs in time. Run: gnuplot plots.gp\n"
+        "set terminal pngcairo noenhanced size 1000,650 font ',10'\nset grid\nset key outside right top\n"
+        "set logscale x\n";
+  auto has = [&](const char* suite) {
+    return std::any_of(all.begin(), all.end(), [&](const Summary& s) { return s.suite == suite; });
+  };
+  if (has("narrowphase")) {
+    std::vector<std::string> names;
+    gp << datablocks(all, "narrowphase", "np", 1.0, [](const Summary& s) { return std::max(s.max_error, 1e-17); }, names);
+    gp << "set output 'narrowphase.png'\nset title 'GJK distance: worst error against time per query (labels: tolerance; "
+          "1e-17 means exact)'\nset xlabel 'ns per query'\nset ylabel 'max |distance error| (m)'\nset logscale y\n"
+          "set format y '1e%T'\n"
+       << plotCommand(names) << "unset logscale y\nset format y '%g'\n";
+  }
+  if (has("states")) {
+    std::vector<std::string> names;
+    gp << datablocks(all, "states", "st", 1.0, [](const Summary& s) { return s.error(); }, names);
+    gp << "set output 'states.png'\nset title 'One state: wrong verdicts against time per state'\n"
+          "set xlabel 'ns per state'\nset ylabel 'wrong-verdict rate (against exact meshes)'\nset yrange [-0.01:*]\n"
+       << plotCommand(names) << "set yrange [*:*]\n";
+  }
+  if (has("motions")) {
+    std::vector<std::string> missed, extra;
+    gp << datablocks(all, "motions", "mm", 1e3, [](const Summary& s) { return s.items ? s.misses / s.items : 0.0; }, missed);
+    gp << datablocks(all, "motions", "mf", 1e3, [](const Summary& s) { return s.items ? s.false_alarms / s.items : 0.0; }, extra);
+    gp << "set terminal pngcairo noenhanced size 1400,600 font ',10'\nset output 'motions.png'\nset multiplot layout 1,2 "
+          "title 'Motion checks: what each mode misses and adds, against time per motion (labels: contact distance in m, "
+          "or resolution as a fraction of the extent)'\nset xlabel 'us per motion'\nset yrange [-0.002:*]\n"
+          "set key inside right top\nset title 'missed collisions (dense reference collides, mode says free)'\n"
+          "set ylabel 'missed-collision rate'\n"
+       << plotCommand(missed) << "set title 'false alarms (reference free, mode says collision)'\n"
+       << "set ylabel 'false-alarm rate'\n" << plotCommand(extra) << "unset multiplot\n";
+  }
+  const std::string file = dir + "/plots.gp";
+  std::ofstream(file) << gp.str();
+  if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
+    std::cerr << "clearway bench: gnuplot is not installed: " << file << " written, plots not drawn\n";
+    return;
+  }
+  const std::string cmd = "cd '" + dir + "' && gnuplot plots.gp";
+  if (std::system(cmd.c_str()) != 0) std::cerr << "clearway bench: gnuplot failed on " << file << "\n";
+}
+
+void finish(const std::string& dir, const Results& res) {
+  writeResults(dir + "/results.csv", res);
+  const std::vector<Summary> all = summarize(res.rows);
+  writeSummaryCsv(dir + "/summary.csv", all);
+  const std::string t = table(all);
+  std::ofstream(dir + "/table.txt") << "# " << res.config << "\n" << t;
+  std::cout << t;
+  writePlots(dir, all);
+}
+
+int usageError(const std::string& why) {
+  std::cerr << "clearway bench: " << why << " (clearway bench --help shows the usage)\n";
+  return 2;
+}
+
+int mergeCommand(const std::vector<std::string>& args) {
+  std::string out;
+  std::vector<std::string> dirs;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "--out" && i + 1 < args.size()) out = args[++i];
+    else if (args[i].rfind("--", 0) == 0) return usageError("merge: unknown option " + args[i]);
+    else dirs.push_back(args[i]);
+  }
+  if (out.empty() || dirs.empty()) return usageError("merge: needs --out DIR and at least one shard folder");
+  try {
+    Results merged;
+    std::vector<int> seen;
+    for (const std::string& d : dirs) {
+      const std::string file = d + "/results.csv";
+      Results shard = readResults(file);
+      if (shard.shard < 0) throw std::runtime_error(file + ": not a shard (its shard line says all)");
+      if (merged.config.empty()) {
+        merged.config = shard.config, merged.cases = shard.cases, merged.shards = shard.shards;
+        seen.assign(shard.shards, 0);
+      }
+      if (shard.config != merged.config) throw std::runtime_error(file + ": another configuration: " + shard.config);
+      if (shard.shards != merged.shards || shard.cases != merged.cases)
+        throw std::runtime_error(file + ": shard " + std::to_string(shard.shard) + "/" + std::to_string(shard.shards) +
+                                 " of " + std::to_string(shard.cases) + " cases does not match the first shard");
+      if (seen[shard.shard]++) throw std::runtime_error(file + ": shard " + std::to_string(shard.shard) + " given twice");
+      for (const Row& r : shard.rows)
+        if (r.case_index % shard.shards != shard.shard)
+          throw std::runtime_error(file + ": case " + std::to_string(r.case_index) + " does not belong to this shard");
+      merged.rows.insert(merged.rows.end(), shard.rows.begin(), shard.rows.end());
+      if (fs::is_directory(d + "/plan")) {
+        fs::create_directories(out + "/plan");
+        for (const auto& log : fs::directory_iterator(d + "/plan"))
+          fs::copy_file(log.path(), out + "/plan/" + log.path().filename().string(), fs::copy_options::overwrite_existing);
+      }
+    }
+    for (std::size_t i = 0; i < seen.size(); ++i)
+      if (!seen[i]) throw std::runtime_error("shard " + std::to_string(i) + "/" + std::to_string(seen.size()) + " is missing");
+    std::stable_sort(merged.rows.begin(), merged.rows.end(),
+                     [](const Row& a, const Row& b) { return a.case_index < b.case_index; });
+    fs::create_directories(out);
+    finish(out, merged);
+  } catch (const std::exception& e) {
+    std::cerr << "clearway bench merge: " << e.what() << "\n";
+    return 2;
+  }
+  return 0;
+}
+
+}  // namespace
+
+int benchCommand(const std::vector<std::string>& args) {
+  if (args.size() == 1 && (args[0] == "-h" || args[0] == "--help")) {
+    std::cout << kBenchUsage;
+    return 0;
+  }
+  if (!args.empty() && args[0] == "merge") return mergeCommand(std::vector<std::string>(args.begin() + 1, args.end()));
+#ifndef CLEARWAY_HAVE_BENCH_SUITES
+  std::cerr << "clearway bench: this build has no benchmark suites (FCL, libfcl-dev, was not found at build time); "
+               "`clearway bench merge` works\n";
+  return 2;
+#else
+  bench::SuiteConfig config;
+  config.shared = CLEARWAY_SOURCE_DIR "/../shared";
+  config.out = "bench-results";
+  long shard = -1, shards = 0;
+  auto number = [&](std::size_t& i, const char* name, double lo, double& value) {
+    if (i + 1 >= args.size() || !parseDouble(args[i + 1], value) || !(value >= lo))
+      throw std::runtime_error(std::string(name) + " needs a number >= " + fmt("%g", lo));
+    ++i;
+  };
+  try {
+    for (std::size_t i = 0; i < args.size(); ++i) {
+      double v = 0;
+      if (args[i] == "--out" && i + 1 < args.size()) config.out = args[++i];
+      else if (args[i] == "--shared" && i + 1 < args.size()) config.shared = args[++i];
+      else if (args[i] == "--subjects" && i + 1 < args.size()) {
+        for (const std::string& s : split(args[++i], ','))
+          if (!s.empty()) config.subjects.push_back(s);
+      }
+      else if (args[i] == "--shard" && i + 1 < args.size()) {
+        std::string why;
+        if (!parseShard(args[++i], shard, shards, why)) throw std::runtime_error("--shard " + args[i] + ": " + why);
+      } else if (args[i] == "--count") number(i, "--count", 1, v), config.count = static_cast<int>(v);
+      else if (args[i] == "--problems") number(i, "--problems", 1, v), config.problems = static_cast<int>(v);
+      else if (args[i] == "--plan-runs") number(i, "--plan-runs", 1, v), config.plan_runs = static_cast<int>(v);
+      else if (args[i] == "--plan-time") number(i, "--plan-time", 1e-3, v), config.plan_time = v;
+      else if (args[i] == "--seed") number(i, "--seed", 0, v), config.seed = static_cast<std::uint64_t>(v);
+      else if (args[i] == "all") config.suites = bench::suiteNames();
+      else if (args[i].rfind("--", 0) == 0) throw std::runtime_error("unknown option " + args[i]);
+      else config.suites.push_back(args[i]);
+    }
+  } catch (const std::exception& e) {
+    return usageError(e.what());
+  }
+  if (config.suites.empty()) config.suites = {"narrowphase", "states", "motions"};
+  std::vector<bench::SuiteCase> cases;
+  try {
+    cases = bench::enumerateCases(config);
+  } catch (const std::exception& e) {
+    return usageError(e.what());
+  }
+  Results res;
+  std::string suites;
+  for (const std::string& s : bench::suiteNames())
+    if (std::find(config.suites.begin(), config.suites.end(), s) != config.suites.end()) suites += (suites.empty() ? "" : ",") + s;
+  std::string subjects;
+  for (const std::string& s : config.subjects) subjects += (subjects.empty() ? "" : ",") + s;
+  res.config = "suites=" + suites + (subjects.empty() ? "" : " subjects=" + subjects) + " count=" + std::to_string(config.count) + " problems=" + std::to_string(config.problems) +
+               " plan_runs=" + std::to_string(config.plan_runs) + " plan_time=" + fmt("%g", config.plan_time) +
+               " seed=" + std::to_string(config.seed);
+  res.shard = shard, res.shards = shards, res.cases = static_cast<long>(cases.size());
+  std::error_code ec;
+  fs::create_directories(config.out, ec);
+  if (ec) return usageError("cannot create " + config.out + ": " + ec.message());
+  int done = 0, mine = 0;
+  for (std::size_t k = 0; k < cases.size(); ++k) mine += shard < 0 || static_cast<long>(k) % shards == shard;
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    if (shard >= 0 && static_cast<long>(k) % shards != shard) continue;
+    const bench::SuiteCase& c = cases[k];
+    std::cerr << "[" << ++done << "/" << mine << "] " << c.suite << " " << c.subject << "\n";
+    std::vector<bench::SuiteRow> rows;
+    try {
+      bench::runCase(c, config, rows);
+    } catch (const std::exception& e) {
+      std::cerr << "clearway bench: " << c.suite << " " << c.subject << ": " << e.what() << "\n";
+      return 1;
+    }
+    for (const bench::SuiteRow& r : rows) {
+      std::ostringstream line;
+      line << r.suite << "," << k << "," << r.subject << "," << r.engine << "," << r.mode << "," << fmt("%.10g", r.tolerance)
+           << "," << r.items << "," << fmt("%.6g", r.ns_per_item) << "," << fmt("%.10g", r.work_per_item) << ","
+           << r.positives << "," << r.misses << "," << r.false_alarms << "," << fmt("%.10g", r.error) << ","
+           << fmt("%.10g", r.max_error);
+      res.rows.push_back(parseRow(line.str(), "row"));
+    }
+  }
+  try {
+    if (shard >= 0) writeResults(config.out + "/results.csv", res);
+    else finish(config.out, res);
+  } catch (const std::exception& e) {
+    std::cerr << "clearway bench: " << e.what() << "\n";
+    return 2;
+  }
+  return 0;
+#endif
+}
+
+}  // namespace clearway::cli
