@@ -10,12 +10,14 @@
 #include <ompl/geometric/SimpleSetup.h>
 #include <ompl/geometric/planners/prm/PRM.h>
 #include <ompl/geometric/planners/rrt/RRTConnect.h>
+#include <ompl/geometric/planners/rrt/pRRT.h>
 #include <ompl/util/Console.h>
 #include <ompl/util/RandomNumbers.h>
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <random>
 #include <thread>
 
@@ -144,11 +146,9 @@ TEST(OmplPlugin, MotionValidatorTakesTheShortWayAndReportsLastValid) {
   EXPECT_EQ(c.motion->counters().motions.load(), 4u);
 }
 
-// Plans on the bundled scene with RRTConnect and checks the path independently: every segment
+// Plans on the bundled scene with the given planner and checks the path independently: every segment
 // certified free, and dense samples along it valid.
-TEST(OmplPlugin, PlansOnTheBundledScene) {
-  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
-  ompl::RNG::setSeed(42);
+void planAndCertify(const std::function<ob::PlannerPtr(const ob::SpaceInformationPtr&)>& makePlanner) {
   const auto scene = Scene::load(bundledScene());
   og::SimpleSetup setup(makeStateSpace(*scene));
   const CollisionChecking c = setupCollisionChecking(setup.getSpaceInformation(), scene);
@@ -157,7 +157,7 @@ TEST(OmplPlugin, PlansOnTheBundledScene) {
   map.fromVector(scene->description().start.data(), start.get());
   map.fromVector(scene->description().goal.data(), goal.get());
   setup.setStartAndGoalStates(start, goal);
-  setup.setPlanner(std::make_shared<og::RRTConnect>(setup.getSpaceInformation()));
+  setup.setPlanner(makePlanner(setup.getSpaceInformation()));
   ASSERT_EQ(setup.solve(60.0), ob::PlannerStatus::EXACT_SOLUTION);
   setup.simplifySolution();
   og::PathGeometric& path = setup.getSolutionPath();
@@ -180,7 +180,26 @@ TEST(OmplPlugin, PlansOnTheBundledScene) {
   EXPECT_GT(c.motion->counters().motions.load(), 0u);
 }
 
-// PRM grows its roadmap in a second thread while the first one queries: the checkers are shared.
+TEST(OmplPlugin, PlansOnTheBundledScene) {
+  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+  ompl::RNG::setSeed(42);
+  planAndCertify([](const ob::SpaceInformationPtr& si) { return std::make_shared<og::RRTConnect>(si); });
+}
+
+// OMPL's parallel planners call the checkers from several threads at once (pRRT: two trees grown in
+// parallel; PRM: the roadmap grows in one thread while another looks for a solution). Run under
+// ThreadSanitizer by scripts/tsan.sh.
+TEST(OmplPlugin, ParallelPlannersShareTheCheckers) {
+  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+  planAndCertify([](const ob::SpaceInformationPtr& si) {
+    auto p = std::make_shared<og::pRRT>(si);
+    p->setThreadCount(2);
+    return p;
+  });
+  planAndCertify([](const ob::SpaceInformationPtr& si) { return std::make_shared<og::PRM>(si); });
+}
+
+// Four threads ask the same checkers what one thread asked them: the answers must not change.
 TEST(OmplPlugin, ThreadsShareTheCheckers) {
   const auto scene = Scene::load(bundledScene());
   auto si = std::make_shared<ob::SpaceInformation>(makeStateSpace(*scene));
