@@ -94,7 +94,7 @@ bool writeHeatmap(const RobotModel& model, const std::vector<PairAudit>& audit, 
   std::ostringstream gp;
   gp << "# Written by clearway audit: the link-pair matrix of " << model.name() << "\n"
      << "set terminal pngcairo noenhanced size " << size << "," << size << " font ',9'\n"
-     << "set output " << quoted(png) << "\n"
+     << "set output " << quoted(std::filesystem::path(png).filename().string()) << "\n"
      << "set title \"Self-collision audit of " << model.name()
      << ": fraction of samples colliding\\nA adjacent, D default, Al always, N never, N* never but within 1 mm\"\n"
      << "set size ratio -1\nset xrange [-0.5:" << n - 0.5 << "]\nset yrange [-0.5:" << n - 0.5 << "]\n"
@@ -119,15 +119,7 @@ bool writeHeatmap(const RobotModel& model, const std::vector<PairAudit>& audit, 
   gp << "\n";
   const std::string script = png + ".gp";
   std::ofstream(script) << gp.str();
-  if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
-    why = "gnuplot is not installed (" + script + " written)";
-    return false;
-  }
-  if (std::system(("gnuplot " + quoted(script) + " 2>/dev/null").c_str()) != 0) {
-    why = "gnuplot failed on " + script;
-    return false;
-  }
-  return true;
+  return runGnuplot(script, why);
 }
 
 }  // namespace

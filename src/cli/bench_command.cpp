@@ -338,12 +338,8 @@ void writePlots(const std::string& dir, const std::vector<Summary>& all) {
   }
   const std::string file = dir + "/plots.gp";
   std::ofstream(file) << gp.str();
-  if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
-    std::cerr << "clearway bench: gnuplot is not installed: " << file << " written, plots not drawn\n";
-    return;
-  }
-  const std::string cmd = "cd '" + dir + "' && gnuplot plots.gp";
-  if (std::system(cmd.c_str()) != 0) std::cerr << "clearway bench: gnuplot failed on " << file << "\n";
+  std::string why;
+  if (!runGnuplot(file, why)) std::cerr << "clearway bench: plots not drawn: " << why << "\n";
 }
 
 void finish(const std::string& dir, const Results& res) {

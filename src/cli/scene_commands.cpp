@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 
@@ -155,6 +156,26 @@ int checkCommand(const std::vector<std::string>& args) {
   std::cout.flush();
   if (!std::cout) return kExitUsage;
   return status;
+}
+
+bool runGnuplot(const std::string& script, std::string& why) {
+  if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
+    why = "gnuplot is not installed (" + script + " written)";
+    return false;
+  }
+  // Single-quoted for the shell: a quote inside becomes '\''.
+  auto shell = [](const std::string& s) {
+    std::string out = "'";
+    for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return out + "'";
+  };
+  const std::filesystem::path path(script);
+  const std::string dir = path.has_parent_path() ? path.parent_path().string() : ".";
+  if (std::system(("cd " + shell(dir) + " && gnuplot " + shell(path.filename().string()) + " 2>/dev/null").c_str()) != 0) {
+    why = "gnuplot failed on " + script;
+    return false;
+  }
+  return true;
 }
 
 }  // namespace clearway::cli

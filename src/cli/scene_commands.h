@@ -27,6 +27,10 @@ int auditCommand(const std::vector<std::string>& args);
 /// table, plots and OMPL logs (see bench_command.cpp).
 int benchCommand(const std::vector<std::string>& args);
 
+/// Runs gnuplot on `script` inside the script's folder (so the outputs it names land beside it). False,
+/// with `why`, when gnuplot is not installed or fails; the script stays for the user to run.
+bool runGnuplot(const std::string& script, std::string& why);
+
 /// Scene::load, printing the robot's load warnings; on failure prints "clearway COMMAND: reason" and
 /// returns null.
 std::shared_ptr<const Scene> loadScene(const char* command, const std::string& path, const SceneOptions& options);

@@ -1,12 +1,13 @@
 #include <clearway/scene/scene.h>
 
+#include <clearway/detail/per_thread.h>
+
 #include <clearway/kinematics/forward_kinematics.h>
 #include <clearway/load/robot_loader.h>
 
 #include <atomic>
 #include <cmath>
 #include <limits>
-#include <unordered_map>
 
 namespace clearway {
 
@@ -316,10 +317,7 @@ bool Scene::isFree(const std::vector<double>& state, CollisionReport* report, do
 
 SceneContext& Scene::threadContext() const {
   // Keyed by serial, not address: a new scene at a freed scene's address must not inherit its caches.
-  thread_local std::unordered_map<std::uint64_t, SceneContext> contexts;
-  auto it = contexts.find(serial_);
-  if (it == contexts.end()) it = contexts.emplace(serial_, makeContext()).first;
-  return it->second;
+  return detail::perThread<SceneContext>(serial_, [this] { return makeContext(); });
 }
 
 double Scene::clearance(const double* state, SceneContext& ctx, double* lower_bound, double t) const noexcept {

@@ -1,11 +1,12 @@
 #include <clearway/ompl/collision_checking.h>
 
+#include <clearway/detail/per_thread.h>
+
 #include <ompl/base/spaces/RealVectorStateSpace.h>
 #include <ompl/base/spaces/SO2StateSpace.h>
 
 #include <chrono>
 #include <cmath>
-#include <unordered_map>
 
 namespace clearway {
 
@@ -15,21 +16,7 @@ namespace {
 
 std::atomic<std::uint64_t> g_next_serial{1};
 
-// Scratch per thread and per checker, found by the checker's serial (never its address, which a new
-// checker may reuse). A planner's thread asks the same checker again and again: the last one found is
-// remembered, so a check costs no hash lookup (map nodes never move, so the pointer stays valid).
-template <class T, class Make>
-T& perThread(std::uint64_t serial, Make&& make) {
-  thread_local std::unordered_map<std::uint64_t, T> scratch;
-  thread_local std::uint64_t last_serial = 0;  // serials start at 1
-  thread_local T* last = nullptr;
-  if (serial == last_serial) return *last;
-  auto it = scratch.find(serial);
-  if (it == scratch.end()) it = scratch.emplace(serial, make()).first;
-  last_serial = serial;
-  last = &it->second;
-  return *last;
-}
+using detail::perThread;
 
 struct ValidityScratch {
   SceneContext ctx;
