@@ -16,11 +16,17 @@ MotionBound::MotionBound(const Scene& scene) : dim_(scene.dimension()), links_(s
   // Which state entry drives each joint (through a mimic too), and by how much.
   std::vector<int> var_to_state(model.variableCount(), -1);
   for (int i = 0; i < dim_; ++i) var_to_state[scene.groupVariables()[i]] = i;
-  joint_var_.assign(model.jointCount(), -1);
-  joint_mult_.assign(model.jointCount(), 1.0);
-  prismatic_.assign(model.jointCount(), 0);
-  for (int j = 0; j < model.jointCount(); ++j) {
+  const int joints = model.jointCount();
+  joint_var_.assign(joints, -1);
+  joint_mult_.assign(joints, 1.0);
+  prismatic_.assign(joints, 0);
+  step_.assign(joints, 0.0);
+  for (int j = 0; j < joints; ++j) {
     const Joint& joint = model.joint(j);
+    // The offset from the parent link's frame to the child's: the origin, plus a prismatic joint's travel.
+    step_[j] = joint.origin.t.norm();
+    if (joint.type == JointType::Prismatic) step_[j] += std::max(std::abs(joint.lower), std::abs(joint.upper));
+    if (joint.type == JointType::Planar || joint.type == JointType::Floating) step_[j] = std::numeric_limits<double>::infinity();
     const Joint& owner = joint.isMimic() ? model.joint(joint.mimic.joint) : joint;
     if (owner.first_variable < 0) continue;
     const int v = var_to_state[owner.first_variable];
@@ -32,30 +38,75 @@ MotionBound::MotionBound(const Scene& scene) : dim_(scene.dimension()), links_(s
     prismatic_[j] = joint.type == JointType::Prismatic;
     if (joint.isMimic()) joint_mult_[j] = std::abs(joint.mimic.multiplier);
   }
-  // The chain of each link, and each chain joint's reach to the link: the joint offsets in between
-  // (lengths do not change under rotation; a prismatic joint in between adds its largest travel) plus
-  // the link's radius about its own origin.
+  // A revolute joint's axis is fixed in the links rigidly attached to either side of it (through joints
+  // the group does not move): their distances from it are exact, so a link turning about a nearby axis
+  // (a base about its own turntable, a gripper about the wrist) barely counts. The rigid transforms
+  // come from the poses at one reference state.
+  exact_.assign(static_cast<std::size_t>(links_) * joints, std::numeric_limits<double>::infinity());
+  // The farthest hull vertex of a link from a line (point o, unit direction u) in the link's frame.
+  const auto axisReach = [&](int link, const Vec3& o, const Vec3& u) {
+    const LinkGeometry* g = scene.geometry().link(link);
+    double r = 0.0;
+    if (g)
+      for (const Vec3& v : g->hull().vertices()) {
+        const Vec3 w = v - o;
+        r = std::max(r, (w - w.dot(u) * u).norm());
+      }
+    return r * (1.0 + 1e-12) + 1e-12 * (g ? g->boundingRadius() + o.norm() : 0.0);  // rounding
+  };
+  {
+    std::vector<double> reference(dim_);
+    for (int i = 0; i < dim_; ++i) {
+      const double lo = scene.lower(i), hi = scene.upper(i);
+      reference[i] = std::isfinite(lo) && std::isfinite(hi) ? 0.5 * (lo + hi) : std::isfinite(lo) ? lo : std::isfinite(hi) ? hi : 0.0;
+    }
+    SceneContext ctx = scene.makeContext();
+    scene.computePoses(reference.data(), ctx);
+    // Links joined through joints without a state entry form rigid bodies.
+    std::vector<int> body(links_);
+    for (int l = 0; l < links_; ++l) body[l] = l;
+    const auto find = [&](int l) {
+      while (body[l] != l) l = body[l] = body[body[l]];
+      return l;
+    };
+    for (int j = 0; j < joints; ++j)
+      if (joint_var_[j] < 0 && model.joint(j).parent_link >= 0 && model.joint(j).child_link >= 0)
+        body[find(model.joint(j).parent_link)] = find(model.joint(j).child_link);
+    for (int j = 0; j < joints; ++j) {
+      const Joint& joint = model.joint(j);
+      if (joint_var_[j] < 0 || prismatic_[j] || joint.child_link < 0 || joint.parent_link < 0) continue;
+      const Pose& child = ctx.poses[joint.child_link];  // the joint frame, turned by q about the axis
+      const Vec3 point = child.t, dir = child.R * joint.axis.normalized();
+      for (int l = 0; l < links_; ++l) {
+        const int root = find(l);
+        if (root != find(joint.child_link) && root != find(joint.parent_link)) continue;
+        const Pose& pose = ctx.poses[l];
+        exact_[static_cast<std::size_t>(l) * joints + j] =
+            axisReach(l, pose.R.transpose() * (point - pose.t), pose.R.transpose() * dir);
+      }
+    }
+  }
   chain_.resize(links_);
+  prefix_.resize(links_);
   joint_reach_.resize(links_);
+  radius_.assign(links_, 0.0);
   link_coef_.assign(static_cast<std::size_t>(links_) * dim_, 0.0);
   for (int i = 0; i < links_; ++i) {
     for (int l = i; model.link(l).parent_joint >= 0; l = model.parentLink(l)) chain_[i].push_back(model.link(l).parent_joint);
     std::reverse(chain_[i].begin(), chain_[i].end());
     const LinkGeometry* g = scene.geometry().link(i);
-    double reach = g ? g->boundingRadius() : 0.0;
-    joint_reach_[i].assign(chain_[i].size(), 0.0);
-    // From the link upwards: the reach of joint k is measured from its own origin, which is where the
-    // joint's motion acts; the offsets of the joints after it (their origins) stand between.
-    for (int k = static_cast<int>(chain_[i].size()) - 1; k >= 0; --k) {
-      const Joint& joint = model.joint(chain_[i][k]);
-      joint_reach_[i][k] = reach;
-      reach += joint.origin.t.norm();
-      if (joint.type == JointType::Prismatic)
-        reach += std::max(std::abs(joint.lower), std::abs(joint.upper));  // may be infinite: then so is the bound
-      if (joint.type == JointType::Planar || joint.type == JointType::Floating)
-        reach = std::numeric_limits<double>::infinity();
+    radius_[i] = g ? g->boundingRadius() : 0.0;
+    const std::size_t n = chain_[i].size();
+    prefix_[i].assign(n, 0.0);
+    for (std::size_t k = 0; k < n; ++k) prefix_[i][k] = (k ? prefix_[i][k - 1] : 0.0) + step_[chain_[i][k]];
+    // A chain joint's reach to the link: the offsets of the joints after it, plus the link's radius (the
+    // lengths do not change under rotation); the link's own joint knows it exactly.
+    joint_reach_[i].assign(n, 0.0);
+    for (std::size_t k = 0; k < n; ++k) {
+      joint_reach_[i][k] = radius_[i] + (prefix_[i][n - 1] - prefix_[i][k]);
+      joint_reach_[i][k] = std::min(joint_reach_[i][k], exactReach(i, chain_[i][k]));
     }
-    for (std::size_t k = 0; k < chain_[i].size(); ++k) {
+    for (std::size_t k = 0; k < n; ++k) {
       const int j = chain_[i][k];
       if (joint_var_[j] < 0) continue;
       const double w = prismatic_[j] ? 1.0 : joint_reach_[i][k];
@@ -67,29 +118,67 @@ MotionBound::MotionBound(const Scene& scene) : dim_(scene.dimension()), links_(s
 double MotionBound::link(int link, const double* dq) const noexcept {
   double b = 0.0;
   const double* c = &link_coef_[static_cast<std::size_t>(link) * dim_];
-  for (int v = 0; v < dim_; ++v) b += c[v] * std::abs(dq[v]);
+  for (int v = 0; v < dim_; ++v)
+    if (dq[v] != 0.0) b += c[v] * std::abs(dq[v]);
   return b;
 }
 
 double MotionBound::pair(int a, int b, const double* dq) const noexcept {
-  // Joints shared by both chains move the pair rigidly: measured in the frame of the last shared
-  // joint's child, only the joints after the fork move either link.
+  // Joints shared by both chains move the pair rigidly. The others lie on the path a → fork → b, and
+  // the pair may be watched from any link X on that path: the joints between a and X move a, the rest
+  // move b. Each joint costs |Δq| times its reach to the link it moves (for a link above the joint, the
+  // offsets up to the fork and down to that link); the bound is the cheapest X, found in one sweep.
   const std::vector<int>& ca = chain_[a];
   const std::vector<int>& cb = chain_[b];
+  const std::size_t na = ca.size(), nb = cb.size();
   std::size_t fork = 0;
-  while (fork < ca.size() && fork < cb.size() && ca[fork] == cb[fork]) ++fork;
-  double bound = 0.0;
-  for (int side = 0; side < 2; ++side) {
-    const int l = side == 0 ? a : b;
-    const std::vector<int>& c = chain_[l];
-    for (std::size_t k = fork; k < c.size(); ++k) {
-      const int j = c[k];
-      if (joint_var_[j] < 0) continue;
-      const double w = prismatic_[j] ? 1.0 : joint_reach_[l][k];
-      bound += joint_mult_[j] * w * std::abs(dq[joint_var_[j]]);
+  while (fork < na && fork < nb && ca[fork] == cb[fork]) ++fork;
+  const double above = fork ? prefix_[a][fork - 1] : 0.0;  // equal for b: the shared joints
+  const double side_a = na > fork ? prefix_[a][na - 1] - above : 0.0;
+  const double side_b = nb > fork ? prefix_[b][nb - 1] - above : 0.0;
+  // Path order: a's joints upwards, then b's downwards. cost_a[k]: the joint moving a; cost_b[k]: moving b.
+  constexpr std::size_t kMaxPath = 128;
+  double cost_a[kMaxPath], cost_b[kMaxPath];
+  std::size_t n = 0;
+  const auto add = [&](int j, double reach_a, double reach_b) {
+    const int v = joint_var_[j];
+    if (v < 0 || dq[v] == 0.0) return;
+    const double w = joint_mult_[j] * std::abs(dq[v]);
+    cost_a[n] = (prismatic_[j] ? 1.0 : reach_a) * w;
+    cost_b[n] = (prismatic_[j] ? 1.0 : reach_b) * w;
+    ++n;
+  };
+  if (na - fork + nb - fork > kMaxPath) {  // beyond any real robot: watched from the fork
+    double bound = 0.0;
+    for (int side = 0; side < 2; ++side) {
+      const int l = side ? b : a;
+      for (std::size_t k = fork; k < chain_[l].size(); ++k) {
+        const int j = chain_[l][k], v = joint_var_[j];
+        if (v >= 0 && dq[v] != 0.0) bound += joint_mult_[j] * std::abs(dq[v]) * (prismatic_[j] ? 1.0 : joint_reach_[l][k]);
+      }
     }
+    return bound;
   }
-  return bound;
+  for (std::size_t k = na; k-- > fork;) {
+    // From this joint up to the fork, then down to b.
+    const double reach_b = radius_[b] + (prefix_[a][k] - above) + side_b;
+    add(ca[k], joint_reach_[a][k], std::min(reach_b, exactReach(b, ca[k])));
+  }
+  for (std::size_t k = fork; k < nb; ++k) {
+    const double reach_a = radius_[a] + (prefix_[b][k] - above) + side_a;
+    add(cb[k], std::min(reach_a, exactReach(a, cb[k])), joint_reach_[b][k]);
+  }
+  // Split after i joints: Σ_{k<i} cost_a + Σ_{k≥i} cost_b, smallest over i, by a suffix sweep.
+  double suffix_b = 0.0;
+  double best = INFINITY;
+  double prefix_a[kMaxPath + 1];
+  prefix_a[0] = 0.0;
+  for (std::size_t k = 0; k < n; ++k) prefix_a[k + 1] = prefix_a[k] + cost_a[k];
+  for (std::size_t i = n + 1; i-- > 0;) {
+    best = std::min(best, prefix_a[i] + suffix_b);
+    if (i > 0) suffix_b += cost_b[i - 1];
+  }
+  return best;
 }
 
 }  // namespace clearway
@@ -128,6 +217,7 @@ MotionContext MotionChecker::makeContext() const {
   const std::size_t items = self_items_.size() + scene_->environmentLinks().size();
   c.safe_until.resize(items);
   c.bound.resize(items);
+  c.hull_cache.resize(self_items_.size());
   return c;
 }
 
@@ -223,10 +313,22 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
           const LinkPair& p = self_items_[k];
           const LinkGeometry& a = *geometry.link(p.a);
           const LinkGeometry& b = *geometry.link(p.b);
-          // The hulls contain the links: their distance bounds the links' from below, in one GJK call.
-          const DistanceResult h = gjkDistance(a.hull(), poses[p.a], b.hull(), poses[p.b], tol);
-          d = isFailure(h.status) ? 0.0 : h.lower_bound - self_padding_[k];
-          if (d <= contact && !hull_mode && !isFailure(h.status)) {
+          // Ever tighter and dearer lower bounds, each only when the one before cannot certify the rest of
+          // the segment (`enough`), and computed only as far as that needs: the bounding balls, the
+          // hulls (warm-started GJK), the convex parts, and last the triangles.
+          const double enough = remaining + self_padding_[k];
+          double lower = (poses[p.a] * a.sphereCenter() - poses[p.b] * b.sphereCenter()).norm() - a.sphereRadius() -
+                         b.sphereRadius();
+          if (!(lower >= enough))  // (the GJK bound first in max(): it is a number even if the balls' is not)
+            lower = std::max(gjkLowerBound(a.hull(), poses[p.a], b.hull(), poses[p.b], tol, ctx.hull_cache[k], enough,
+                                           options_.distance_relative_error),
+                             lower);
+          d = lower - self_padding_[k];
+          if (d <= contact && !hull_mode)
+            d = std::max(partsLowerBound(a, poses[p.a], b, poses[p.b], tol, enough, options_.distance_relative_error) -
+                             self_padding_[k],
+                         d);
+          if (d <= contact && !hull_mode) {
             const DistanceResult m = meshDistance(a, poses[p.a], b, poses[p.b], tol, options_.distance_relative_error);
             d = isFailure(m.status) ? 0.0 : m.lower_bound - self_padding_[k];
           }

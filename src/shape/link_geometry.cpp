@@ -280,6 +280,53 @@ LinkGeometry::LinkGeometry(std::vector<Triangle> triangles, std::vector<Primitiv
   for (const Vec3& v : hull_.vertices()) sphere_radius_ = std::max(sphere_radius_, (v - sphere_center_).norm());
   // Rounding of the norms (relative) and of the centre (relative to the coordinates).
   sphere_radius_ = sphere_radius_ * (1.0 + 1e-12) + 1e-12 * bounding_radius_;
+  buildParts();
+}
+
+void LinkGeometry::buildParts() {
+  const auto add = [&](std::vector<Vec3> points) {
+    ConvexHull hull(points);
+    Aabb box;
+    for (const Vec3& v : hull.vertices()) box.grow(v);
+    double radius = 0.0;
+    for (const Vec3& v : hull.vertices()) radius = std::max(radius, (v - box.center()).norm());
+    parts_.push_back({std::move(hull), box.center(), radius * (1.0 + 1e-12) + 1e-12 * bounding_radius_});
+  };
+  // The tree's top nodes split the triangles spatially; descending level by level keeps the parts even.
+  if (!tree_.empty()) {
+    const auto& nodes = tree_.nodes();
+    std::vector<std::int32_t> frontier{0};
+    while (static_cast<int>(frontier.size()) * 2 <= kMaxParts - static_cast<int>(primitives_.size())) {
+      std::vector<std::int32_t> next;
+      for (std::int32_t n : frontier) {
+        if (nodes[n].isLeaf()) next.push_back(n);
+        else next.insert(next.end(), {nodes[n].first, nodes[n].first + 1});
+      }
+      if (next.size() == frontier.size()) break;  // all leaves
+      frontier = std::move(next);
+    }
+    for (std::int32_t top : frontier) {
+      std::vector<Vec3> points;
+      std::vector<std::int32_t> stack{top};
+      while (!stack.empty()) {
+        const AabbTree::Node& node = nodes[stack.back()];
+        stack.pop_back();
+        if (!node.isLeaf()) {
+          stack.push_back(node.first);
+          stack.push_back(node.first + 1);
+          continue;
+        }
+        for (std::int32_t k = node.first; k < node.first + node.count; ++k)
+          for (const Vec3& v : triangles_[tree_.items()[k]].v) points.push_back(v);
+      }
+      add(std::move(points));
+    }
+  }
+  for (const Primitive& p : primitives_) {
+    std::vector<Vec3> points;
+    std::visit(HullPoints{p.pose, points}, p.shape);
+    add(std::move(points));
+  }
 }
 
 LinkGeometry::LinkGeometry(const TriangleMesh& mesh, const TreeBuildOptions& options)
@@ -317,6 +364,23 @@ LinkGeometry::LinkGeometry(const std::vector<CollisionElement>& elements, const 
     : LinkGeometry(elementTriangles(elements, meshes), elementPrimitives(elements), options) {}
 
 // ---- Queries ------------------------------------------------------------------------------------------
+
+double partsLowerBound(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                       const Tolerances& tol, double enough, double relative) noexcept {
+  if (!pose_a.isFinite() || !pose_b.isFinite()) return 0.0;
+  double best = enough;  // any bound at or above `enough` serves as well as the distance
+  for (const LinkGeometry::Part& pa : a.parts()) {
+    const Vec3 ca = pose_a * pa.center;
+    for (const LinkGeometry::Part& pb : b.parts()) {
+      const double balls = (ca - pose_b * pb.center).norm() - pa.radius - pb.radius;
+      if (balls >= best) continue;
+      SimplexCache cache;
+      best = std::min(best, std::max(balls, gjkLowerBound(pa.hull, pose_a, pb.hull, pose_b, tol, cache, best, relative)));
+      if (!(best > 0.0)) return 0.0;
+    }
+  }
+  return best;
+}
 
 bool meshesIntersect(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
                      const Tolerances& tol, GeometryMode mode, double padding, SimplexCache* hull_cache) noexcept {

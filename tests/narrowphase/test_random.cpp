@@ -578,6 +578,52 @@ TEST(RandomNarrowphase, WarmCacheAlongSmoothMotion) {
               checked, double(warm_iterations) / steps, double(cold_iterations) / steps);
 }
 
+// gjkLowerBound along the same kind of motion, its cache warm from step to step (and stale at the
+// start): never above the reference distance, and either at least `enough` or within the relative
+// error of the distance (hulls have no radius, so the cores' relative error is the distance's).
+TEST(RandomNarrowphase, LowerBoundAlongSmoothMotion) {
+  Rng g(0x10BDull);
+  const Tolerances tol;
+  int steps = 0, stopped_early = 0;
+  for (int seq = 0; seq < 40 && !tooManyFailures(); ++seq) {
+    const double sa = logUniform(g, 1e-2, 1e2), sb = sa * logUniform(g, 0.2, 5.0);
+    const Body a0 = makeBody(Kind::Hull, sa, randomPose(g, 3 * sa), g);
+    const Body b0 = makeBody(Kind::Hull, sb, Pose(), g);
+    const ConvexHull& hull_a = std::get<ConvexHull>(a0.shape);
+    const ConvexHull& hull_b = std::get<ConvexHull>(b0.shape);
+    const double reach = 1.6 * (a0.size + b0.size);
+    const Vec3 start = unitVector(g) * reach + inBall(g, 0.3 * (a0.size + b0.size));
+    const Vec3 axis = unitVector(g);
+    const Mat3 r0 = randomRotation(g);
+    SimplexCache cache;
+    cache.axis = unitVector(g);  // stale: from some other pair
+    cache.valid = true;
+    constexpr int kSteps = 40;
+    for (int k = 0; k <= kSteps; ++k) {
+      SCOPED_TRACE("sequence " + std::to_string(seq) + " step " + std::to_string(k));
+      const double u = static_cast<double>(k) / kSteps;
+      Body b = b0;
+      b.pose.R = Eigen::AngleAxisd(0.8 * u, axis).toRotationMatrix() * r0;
+      b.pose.t = a0.pose.t + (1.0 - 2.0 * u) * start;
+      b.inner = b.outer = ref::meshFromHull(hull_b, b.pose);
+      const Bracket ref = signedBracket(a0, b);
+      const Scales sc = scalesOf(a0, b);
+      const double enough = k % 3 == 0 ? INFINITY : logUniform(g, 1e-3, 1.0) * (a0.size + b0.size);
+      const double relative = k % 2 ? 0.25 : 1e-3;
+      const double lower = gjkLowerBound(hull_a, a0.pose, hull_b, b.pose, tol, cache, enough, relative);
+      ++steps;
+      EXPECT_GE(lower, 0.0);
+      EXPECT_LE(lower, std::max(ref.hi, 0.0) + sc.tiny) << "ref " << ref.lo << " … " << ref.hi;
+      if (ref.lo > sc.band) {
+        stopped_early += lower >= enough;
+        EXPECT_GE(lower, std::min(enough, (1.0 - relative) * ref.lo) - sc.band) << "ref " << ref.lo << ", enough " << enough;
+      }
+    }
+  }
+  std::printf("[   stat   ] lower bounds: %d steps, %d stopped at `enough`\n", steps, stopped_early);
+  EXPECT_GT(stopped_early, 20);
+}
+
 // Rays against hulls and boxes (slab clipping) and spheres (the quadratic), from outside and inside.
 TEST(RandomNarrowphase, RayCastAgainstSlabs) {
   Rng g(0x5AB5ull);

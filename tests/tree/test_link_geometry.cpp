@@ -370,6 +370,13 @@ TEST(LinkGeometry, DistanceMatchesBruteForce) {
         const std::string what = meshes[i].name + " vs " + meshes[j].name + " case " + std::to_string(c);
         ASSERT_FALSE(isFailure(d.status)) << what;
         EXPECT_LE(d.lower_bound, d.distance) << what;
+        // The convex parts contain the meshes and lie inside the hulls: their bound sits between.
+        ASSERT_GE(ga.parts().size(), 1u);
+        ASSERT_LE(ga.parts().size(), static_cast<std::size_t>(LinkGeometry::kMaxParts));
+        const double parts = partsLowerBound(ga, pa, gb, pb, tol, INFINITY, 0.25);
+        EXPECT_LE(parts, ref + kBand) << what;
+        EXPECT_GE(parts, 0.75 * gjkDistance(ga.hull(), pa, gb.hull(), pb, tol).lower_bound - kBand) << what;
+        EXPECT_LE(partsLowerBound(ga, pa, gb, pb, tol, 0.5 * parts, 0.25), parts + kBand) << what;
         if (ref == 0.0) {
           ++zero;
           EXPECT_EQ(d.distance, 0.0) << what;

@@ -5,14 +5,16 @@
 // M. Saha, J.-C. Latombe, "Exact Collision Checking of Robot Paths" (WAFR 2002 / IEEE T-ASE 2005).
 // For a link A and a step Δq, no point of A moves farther than Σ_v |Δq_v|·c_{v,A}, where c_{v,A} sums,
 // over the joints of A's chain that variable v drives, the joint's reach: for a revolute joint, the
-// largest distance from its origin to A's geometry (a configuration-independent bound: the lengths of
-// the joint offsets in between plus A's radius); for a prismatic joint, 1. Two links of one robot move
-// relative to each other only through the joints below their common ancestor, so a pair's bound sums
-// the chains' differences only. If a pair is d apart at s, it cannot touch before s + d / B_pair. Each
-// pair keeps the parameter it is safe until and is measured again only when the segment reaches it;
-// hulls (which contain the links) give a cheap lower bound on the distance, and the exact triangles
-// are consulted only when the hulls come close. Every step advances by at least contact_distance / B,
-// so the loop ends; a cap on the number of distance queries ends it too (reported as a collision).
+// largest distance from its axis to A's geometry (a configuration-independent bound: the lengths of
+// the joint offsets in between plus A's radius, or exact when A is rigid with the axis); for a
+// prismatic joint, 1. Two links of one robot move relative to each other only through the joints on
+// the path between them, and may be watched from any link on that path: the joints on one side of it
+// move A, the others B; the pair's bound is that of the cheapest such link. If a pair is d apart at s,
+// it cannot touch before s + d / B_pair. Each pair keeps the parameter it is safe until and is measured
+// again only when the segment reaches it, with bounds ever tighter and dearer (balls, hulls, convex
+// parts, triangles) computed only until one certifies the rest of the segment. Every step advances by
+// at least contact_distance / B, so the loop ends; a cap on the number of distance queries ends it too
+// (reported as a collision).
 #include <clearway/scene/scene.h>
 
 #include <vector>
@@ -36,10 +38,15 @@ class MotionBound {
   int dim_ = 0, links_ = 0;
   std::vector<double> link_coef_;                 // links × dim
   std::vector<std::vector<int>> chain_;           // per link: the joints from the root, in order
+  std::vector<std::vector<double>> prefix_;       // per link: running sum of step_ along its chain
   std::vector<std::vector<double>> joint_reach_;  // per link: per joint of its chain, its reach to the link
+  std::vector<double> radius_;                    // per link: farthest hull vertex from the link's origin
   std::vector<int> joint_var_;                    // per joint: the state entry that drives it, -1 if none
   std::vector<double> joint_mult_;                // per joint: |multiplier| of a mimic, 1 otherwise
   std::vector<char> prismatic_;                   // per joint
+  std::vector<double> step_;                      // per joint: largest parent-to-child frame offset
+  std::vector<double> exact_;  // links × joints: the link's farthest point from a revolute axis it is rigid with; else ∞
+  double exactReach(int link, int joint) const noexcept { return exact_[static_cast<std::size_t>(link) * joint_var_.size() + joint]; }
 };
 
 /// How a segment is checked.
@@ -80,6 +87,7 @@ struct MotionContext {
   std::vector<double> q, dq;
   std::vector<double> safe_until;  // per item: self pairs, then environment links
   std::vector<double> bound;       // per item: its motion bound for this segment
+  std::vector<SimplexCache> hull_cache;  // per self pair: the hulls' last GJK axis (warm starts, kept across segments)
 };
 
 /// Checks the segment. Both ends must be states of the scene's dimension; an invalid state (NaN, out

@@ -212,6 +212,48 @@ IntersectResult gjkIntersect(const A& a, const Pose& pose_a, const B& b, const P
   return r;
 }
 
+/// A certified lower bound on the distance between two posed convex shapes (0 when they may touch),
+/// for conservative advancement, where a bound that is large enough beats an exact distance: GJK starts
+/// from the pair's cached axis and stops once the bound reaches `enough` metres or is within `relative`
+/// (a fraction of the distance) of it. Any direction v gives the bound v·w/‖v‖ (w the support point
+/// along −v), so the answer is certified however the loop ends, and a failed query only weakens it.
+template <class A, class B>
+double gjkLowerBound(const A& a, const Pose& pose_a, const B& b, const Pose& pose_b, const Tolerances& tol,
+                     SimplexCache& cache, double enough, double relative) noexcept {
+  using namespace detail;
+  const MinkowskiDifference<A, B> md{a, b, relativePose(pose_a, pose_b), cache.hint_a, cache.hint_b};
+  const double rsum = md.radius();
+  Vec3 v = cache.valid ? cache.axis : md.center();
+  if (!(v.squaredNorm() > 0.0) || !v.allFinite()) v = Vec3::UnitX();
+  double vv = v.squaredNorm();
+  double lower = 0.0;  // on the cores' distance
+  Simplex s;
+  for (int it = 1; it <= tol.gjk_max_iterations; ++it) {
+    const SupportPoint p = md.support(-v);
+    const double vw = v.dot(p.w);
+    if (vw > 0.0) lower = std::max(lower, vw / std::sqrt(vv));
+    if (!(lower - rsum < enough)) break;
+    // Until the simplex holds a point, v is only a direction: the relative test needs v in the difference.
+    if (s.n > 0 && (vv - vw <= relative * vv || inSimplex(s, p.w))) break;
+    s.p[s.n++] = p;
+    const Vec3 v_next = reduceSimplex(s);
+    const double vv_next = v_next.squaredNorm();
+    if (s.n == 4) { lower = 0.0; break; }             // the origin is inside: overlapping
+    if (it > 1 && !(vv_next < vv)) break;            // rounding stalls progress: keep what is proven
+    if (!std::isfinite(vv_next) || !(vv_next > 0.0)) { lower = 0.0; break; }
+    v = v_next;
+    vv = vv_next;
+  }
+  cache.hint_a = md.hint_a;
+  cache.hint_b = md.hint_b;
+  if (std::isfinite(vv) && vv > 0.0) {
+    cache.axis = v;
+    cache.valid = true;
+  }
+  const double d = lower - rsum;
+  return std::isfinite(d) && d > 0.0 ? d : 0.0;
+}
+
 /// Distance between two posed shapes: witness points and normal in the world frame.
 /// A non-finite pose yields Status::InvalidInput.
 DistanceResult gjkDistance(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b,

@@ -60,17 +60,29 @@ class LinkGeometry {
   const Aabb& bounds() const noexcept { return bounds_; }
   /// The largest distance of a hull vertex from the link frame's origin.
   double boundingRadius() const noexcept { return bounding_radius_; }
+  /// Convex pieces whose union contains the link: the hulls of the triangles under the tree's top nodes
+  /// (up to kMaxParts), and one per primitive; each with a ball that contains it (link frame). Tighter
+  /// than hull() where the link is concave, and far cheaper than the triangles.
+  struct Part {
+    ConvexHull hull;
+    Vec3 center;
+    double radius;
+  };
+  static constexpr int kMaxParts = 8;
+  const std::vector<Part>& parts() const noexcept { return parts_; }
   /// A ball containing the hull (the first, cheapest test): centre in the link frame, and radius.
   const Vec3& sphereCenter() const noexcept { return sphere_center_; }
   double sphereRadius() const noexcept { return sphere_radius_; }
 
  private:
   LinkGeometry(std::vector<Triangle> triangles, std::vector<Primitive> primitives, const TreeBuildOptions& options);
+  void buildParts();
 
   std::vector<Triangle> triangles_;
   std::vector<Primitive> primitives_;
   AabbTree tree_;
   ConvexHull hull_;
+  std::vector<Part> parts_;
   Aabb bounds_;
   double bounding_radius_ = 0.0;
   Vec3 sphere_center_ = Vec3::Zero();
@@ -88,6 +100,12 @@ class LinkGeometry {
 bool meshesIntersect(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
                      const Tolerances& tol, GeometryMode mode, double padding = 0.0,
                      SimplexCache* hull_cache = nullptr) noexcept;
+
+/// A certified lower bound on the distance between two links from their convex parts (0 when parts
+/// touch): the least over part pairs, each pair's GJK stopping once it reaches `enough` metres or is
+/// within `relative` of its distance. Between the hulls' bound and meshDistance in cost and tightness.
+double partsLowerBound(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                       const Tolerances& tol, double enough, double relative) noexcept;
 
 /// The same for a convex shape (an obstacle, a primitive) against a link: hull first, then (Mesh mode)
 /// the shape's box in the link frame against the triangle tree, and the link's primitives.
