@@ -50,22 +50,23 @@ void planarBasis(const Vec3& axis, Vec3* u, Vec3* v) noexcept {
   *v = axis.cross(*u);
 }
 
-void computeLinkPoses(const RobotModel& model, const double* q, Pose* link_poses) noexcept {
-  const std::vector<Link>& links = model.links();
+void computeLinkPose(const RobotModel& model, const double* q, Pose* link_poses, int i) noexcept {
   const std::vector<Joint>& joints = model.joints();
-  link_poses[0] = Pose::identity();
-  for (std::size_t i = 1; i < links.size(); ++i) {
-    const Joint& j = joints[links[i].parent_joint];
-    const Pose frame = link_poses[j.parent_link] * j.origin;
-    if (j.type == JointType::Fixed) {
-      link_poses[i] = frame;
-    } else if (j.isMimic()) {
-      const double value = j.mimic.multiplier * q[joints[j.mimic.joint].first_variable] + j.mimic.offset;
-      link_poses[i] = frame * jointMotion(j, &value);
-    } else {
-      link_poses[i] = frame * jointMotion(j, q + j.first_variable);
-    }
+  const Joint& j = joints[model.links()[i].parent_joint];
+  const Pose frame = link_poses[j.parent_link] * j.origin;
+  if (j.type == JointType::Fixed) {
+    link_poses[i] = frame;
+  } else if (j.isMimic()) {
+    const double value = j.mimic.multiplier * q[joints[j.mimic.joint].first_variable] + j.mimic.offset;
+    link_poses[i] = frame * jointMotion(j, &value);
+  } else {
+    link_poses[i] = frame * jointMotion(j, q + j.first_variable);
   }
+}
+
+void computeLinkPoses(const RobotModel& model, const double* q, Pose* link_poses) noexcept {
+  link_poses[0] = Pose::identity();
+  for (int i = 1; i < model.linkCount(); ++i) computeLinkPose(model, q, link_poses, i);
 }
 
 bool validateJointVector(const RobotModel& model, const double* q, std::string* why) {

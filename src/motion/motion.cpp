@@ -1,5 +1,6 @@
 #include <clearway/motion/motion.h>
 
+#include <clearway/kinematics/forward_kinematics.h>
 #include <clearway/narrowphase/gjk.h>
 
 #include <algorithm>
@@ -21,8 +22,12 @@ MotionBound::MotionBound(const Scene& scene) : dim_(scene.dimension()), links_(s
   joint_mult_.assign(joints, 1.0);
   prismatic_.assign(joints, 0);
   step_.assign(joints, 0.0);
+  axis_.assign(joints, Vec3::UnitX());
+  child_.assign(joints, -1);
   for (int j = 0; j < joints; ++j) {
     const Joint& joint = model.joint(j);
+    axis_[j] = joint.axis.normalized();
+    child_[j] = joint.child_link;
     // The offset from the parent link's frame to the child's: the origin, plus a prismatic joint's travel.
     step_[j] = joint.origin.t.norm();
     if (joint.type == JointType::Prismatic) step_[j] += std::max(std::abs(joint.lower), std::abs(joint.upper));
@@ -90,12 +95,15 @@ MotionBound::MotionBound(const Scene& scene) : dim_(scene.dimension()), links_(s
   prefix_.resize(links_);
   joint_reach_.resize(links_);
   radius_.assign(links_, 0.0);
+  sphere_center_.assign(links_, Vec3::Zero());
+  sphere_radius_.assign(links_, 0.0);
   link_coef_.assign(static_cast<std::size_t>(links_) * dim_, 0.0);
   for (int i = 0; i < links_; ++i) {
     for (int l = i; model.link(l).parent_joint >= 0; l = model.parentLink(l)) chain_[i].push_back(model.link(l).parent_joint);
     std::reverse(chain_[i].begin(), chain_[i].end());
     const LinkGeometry* g = scene.geometry().link(i);
     radius_[i] = g ? g->boundingRadius() : 0.0;
+    if (g) sphere_center_[i] = g->sphereCenter(), sphere_radius_[i] = g->sphereRadius();
     const std::size_t n = chain_[i].size();
     prefix_[i].assign(n, 0.0);
     for (std::size_t k = 0; k < n; ++k) prefix_[i][k] = (k ? prefix_[i][k - 1] : 0.0) + step_[chain_[i][k]];
@@ -121,6 +129,67 @@ double MotionBound::link(int link, const double* dq) const noexcept {
   for (int v = 0; v < dim_; ++v)
     if (dq[v] != 0.0) b += c[v] * std::abs(dq[v]);
   return b;
+}
+
+double MotionBound::linkStep(int link, const double* dq, const Pose* poses, double d) const noexcept {
+  // For a step h, joint k turns the link by h·w_k about its axis; the link's points are within r_k
+  // (measured now, from the bounding ball) of the axis, plus how far the joints after k can move them
+  // relative to it, h·γ_k, and never beyond the static reach R_k. So the link moves at most
+  // f(h) = h·Σ w_k·min(R_k, r_k + h·γ_k): convex, piecewise quadratic, its pieces starting where a
+  // joint's dynamic reach meets its static one; the step is the root of f(h) = d.
+  const std::vector<int>& chain = chain_[link];
+  const Vec3 center = poses[link] * sphere_center_[link];
+  constexpr int kMax = 64;
+  double cap[kMax];  // per turning joint: where r_k + h·γ_k reaches R_k
+  double gain[kMax], excess[kMax];  // ... and its w·γ and w·(R − r) there
+  int n = 0;
+  double a = 0.0, c = 0.0, after = 0.0;  // f(h) = h·(a + c·h) on the first piece; after: Σ w·R so far (γ_k)
+  for (std::size_t k = chain.size(); k-- > 0;) {
+    const int j = chain[k], v = joint_var_[j];
+    if (v < 0 || dq[v] == 0.0) continue;
+    const double w = joint_mult_[j] * std::abs(dq[v]);
+    const double reach = prismatic_[j] ? 1.0 : joint_reach_[link][k];
+    if (prismatic_[j] || n == kMax) {
+      a += w * reach;
+    } else {
+      const Pose& frame = poses[child_[j]];
+      const Vec3 u = frame.R * axis_[j], r = center - frame.t;
+      const double now = std::min(reach, (r - r.dot(u) * u).norm() + sphere_radius_[link]);
+      a += w * now;
+      if (now < reach) {
+        if (after > 0.0) {
+          c += w * after;
+          cap[n] = (reach - now) / after, gain[n] = w * after, excess[n] = w * (reach - now);
+          ++n;
+        }
+      }
+    }
+    after += w * reach;
+  }
+  const double fixed = after > 0.0 ? d / after : INFINITY;  // `after` is now link(dq): the static step
+  // Pieces in order of their starts: on each, f(h) = h·(a + c·h); past cap_k joint k turns static,
+  // trading c·h for the constant w·(R − r) in the bracket.
+  for (int i = 1; i < n; ++i)
+    for (int k = i; k > 0 && cap[k] < cap[k - 1]; --k) {
+      std::swap(cap[k], cap[k - 1]);
+      std::swap(gain[k], gain[k - 1]);
+      std::swap(excess[k], excess[k - 1]);
+    }
+  double h = INFINITY;
+  for (int i = 0; i <= n; ++i) {
+    const double end = i < n ? cap[i] : INFINITY;
+    // The root of c·h² + a·h − d on this piece, if it lies before the piece ends.
+    const double root = c > 0.0 ? 2.0 * d / (a + std::sqrt(a * a + 4.0 * c * d)) : a > 0.0 ? d / a : INFINITY;
+    if (root <= end) {
+      h = root;
+      break;
+    }
+    a += excess[i];
+    c -= gain[i];
+    if (c < 0.0) c = 0.0;  // rounding
+  }
+  h = std::max(fixed, h);
+  return std::isnan(h) ? 0.0 : h;
 }
 
 double MotionBound::pair(int a, int b, const double* dq) const noexcept {
@@ -218,6 +287,8 @@ MotionContext MotionChecker::makeContext() const {
   c.safe_until.resize(items);
   c.bound.resize(items);
   c.hull_cache.resize(self_items_.size());
+  c.pose_stamp.assign(scene_->robot().linkCount(), 0);
+  c.pose_path.reserve(scene_->robot().linkCount());
   return c;
 }
 
@@ -295,13 +366,23 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
   }
 
   const RobotGeometry& geometry = sc.geometry();
+  const RobotModel& model = sc.robot();
+  const std::vector<int>& group = sc.groupVariables();
+  // A step usually measures one or two items: only their links' poses (and their ancestors') are computed.
+  Pose* poses = ctx.scene.poses.data();
+  poses[0] = Pose::identity();
+  const auto pose = [&](int link) {
+    for (int l = link; l > 0 && ctx.pose_stamp[l] != ctx.step_stamp; l = model.parentLink(l)) ctx.pose_path.push_back(l);
+    for (; !ctx.pose_path.empty(); ctx.pose_path.pop_back()) {
+      computeLinkPose(model, ctx.scene.q.data(), poses, ctx.pose_path.back());
+      ctx.pose_stamp[ctx.pose_path.back()] = ctx.step_stamp;
+    }
+  };
   double s = 0.0, last_certified = 0.0;
   while (true) {
-    sc.computePoses([&] {
-      interpolate(q0, q1, s, ctx.q.data());
-      return ctx.q.data();
-    }(), ctx.scene);
-    const Pose* poses = ctx.scene.poses.data();
+    interpolate(q0, q1, s, ctx.q.data());
+    for (std::size_t i = 0; i < group.size(); ++i) ctx.scene.q[group[i]] = ctx.q[i];
+    ++ctx.step_stamp;
     double next = 2.0;
     for (int k = 0; k < n_items; ++k) {
       if (ctx.safe_until[k] <= s) {
@@ -311,6 +392,8 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
         ++r.distance_queries;
         if (k < n_self) {
           const LinkPair& p = self_items_[k];
+          pose(p.a);
+          pose(p.b);
           const LinkGeometry& a = *geometry.link(p.a);
           const LinkGeometry& b = *geometry.link(p.b);
           // Ever tighter and dearer lower bounds, each only when the one before cannot certify the rest of
@@ -339,6 +422,7 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
           }
         } else {
           const int link = env_links[k - n_self];
+          pose(link);
           const double pad = sc.linkPadding(link);
           const double cutoff = remaining + pad + contact;
           // As for pairs: the hull's distance first, the exact geometry only when the hull comes close.
@@ -369,7 +453,7 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
           r.free = false;
           return r;
         }
-        ctx.safe_until[k] = s + d / ctx.bound[k];
+        ctx.safe_until[k] = s + (k < n_self ? d / ctx.bound[k] : bound_.linkStep(env_links[k - n_self], ctx.dq.data(), poses, d));
       }
       next = std::min(next, ctx.safe_until[k]);
     }

@@ -293,6 +293,19 @@ TEST(MotionBound, HoldsOnTheSharedRobots) {
       for (int link : scene->environmentLinks()) {
         const double b = bound.link(link, dq.data());
         for (const Vec3& v : vertices(link)) EXPECT_LE((c1.poses[link] * v - c0.poses[link] * v).norm(), b + 1e-9) << name;
+        // linkStep: over h·dq (and every state on the way) no vertex moves d or farther.
+        const double d = std::uniform_real_distribution<double>(0.001, 0.3)(rng);
+        const double h = bound.linkStep(link, dq.data(), c0.poses.data(), d);
+        EXPECT_GE(h, d / b * (1 - 1e-12)) << name;
+        for (double t : {0.25, 0.5, 0.75, 1.0}) {
+          std::vector<double> q(n);
+          for (int i = 0; i < n; ++i) q[i] = q0[i] + std::min(h, 1.0) * t * dq[i];
+          SceneContext ct = scene->makeContext();
+          scene->computePoses(q.data(), ct);
+          for (const Vec3& v : vertices(link))
+            EXPECT_LE((ct.poses[link] * v - c0.poses[link] * v).norm(), d + 1e-9)
+                << name << ": " << scene->robot().link(link).name << " h " << h << " t " << t;
+        }
       }
       for (const LinkPair& p : scene->selfCollision().pairs()) {
         const double b = bound.pair(p.a, p.b, dq.data());

@@ -24,6 +24,10 @@ constexpr double kJointLimitTolerance = 1e-9;
 /// (a NaN in q gives NaN poses, which collision queries report as NotConverged/InvalidInput).
 void computeLinkPoses(const RobotModel& model, const double* q, Pose* link_poses) noexcept;
 
+/// Writes link i's world pose (i ≥ 1) from its parent link's, which must be in link_poses already: one
+/// step of computeLinkPoses, for callers that need a few links only.
+void computeLinkPose(const RobotModel& model, const double* q, Pose* link_poses, int i) noexcept;
+
 /// The frames u, v of a planar joint's plane: with the unit axis n, (u, v, n) is right-handed.
 void planarBasis(const Vec3& axis, Vec3* u, Vec3* v) noexcept;
 

@@ -31,6 +31,11 @@ class MotionBound {
   double link(int link, const double* dq) const noexcept;
   /// Upper bound on how much the distance between links a and b can change for the step dq.
   double pair(int a, int b, const double* dq) const noexcept;
+  /// The largest h ≤ 1 such that, for the step h·dq from the state whose link poses are `poses` (the
+  /// link's and its ancestors' at least), no point of the link moves d or farther: the reaches measured
+  /// from where the joint axes are now, which is much tighter than d / link(dq) for a link near the axes
+  /// that turn it. Never below d / link(dq).
+  double linkStep(int link, const double* dq, const Pose* poses, double d) const noexcept;
   /// Coefficient of state entry v for link i (metres per radian, or 1 for prismatic).
   double linkCoefficient(int link, int v) const noexcept { return link_coef_[link * dim_ + v]; }
 
@@ -45,6 +50,10 @@ class MotionBound {
   std::vector<double> joint_mult_;                // per joint: |multiplier| of a mimic, 1 otherwise
   std::vector<char> prismatic_;                   // per joint
   std::vector<double> step_;                      // per joint: largest parent-to-child frame offset
+  std::vector<Vec3> axis_;                        // per joint: unit axis in the joint (child link) frame
+  std::vector<int> child_;                        // per joint: child link
+  std::vector<Vec3> sphere_center_;               // per link: its bounding ball (link frame)
+  std::vector<double> sphere_radius_;
   std::vector<double> exact_;  // links × joints: the link's farthest point from a revolute axis it is rigid with; else ∞
   double exactReach(int link, int joint) const noexcept { return exact_[static_cast<std::size_t>(link) * joint_var_.size() + joint]; }
 };
@@ -88,6 +97,9 @@ struct MotionContext {
   std::vector<double> safe_until;  // per item: self pairs, then environment links
   std::vector<double> bound;       // per item: its motion bound for this segment
   std::vector<SimplexCache> hull_cache;  // per self pair: the hulls' last GJK axis (warm starts, kept across segments)
+  std::vector<std::uint64_t> pose_stamp;  // per link: the step its pose in scene.poses was computed for
+  std::vector<int> pose_path;             // scratch: links whose poses are due, deepest first
+  std::uint64_t step_stamp = 0;
 };
 
 /// Checks the segment. Both ends must be states of the scene's dimension; an invalid state (NaN, out
