@@ -131,65 +131,84 @@ double MotionBound::link(int link, const double* dq) const noexcept {
   return b;
 }
 
-double MotionBound::linkStep(int link, const double* dq, const Pose* poses, double d) const noexcept {
-  // For a step h, joint k turns the link by h·w_k about its axis; the link's points are within r_k
-  // (measured now, from the bounding ball) of the axis, plus how far the joints after k can move them
-  // relative to it, h·γ_k, and never beyond the static reach R_k. So the link moves at most
-  // f(h) = h·Σ w_k·min(R_k, r_k + h·γ_k): convex, piecewise quadratic, its pieces starting where a
-  // joint's dynamic reach meets its static one; the step is the root of f(h) = d.
+// A bound on how far points of links move for a step h·dq, measured from where the joint axes are now:
+// joint k turns a link by h·w_k about its axis; the link's points are within r_k (now, from its bounding
+// ball) of the axis, plus how far the joints after k can move them relative to it, h·γ_k, and never
+// beyond the static reach R_k. So they move at most f(h) = h·Σ w_k·min(R_k, r_k + h·γ_k): convex and
+// piecewise quadratic, a piece starting where a joint's dynamic reach meets its static one.
+struct MotionBound::DynamicBound {
+  static constexpr int kMax = 64;
+  double a = 0.0, c = 0.0;   // f(h) = h·(a + c·h) on the first piece
+  double fixed = 0.0;        // Σ w·R: the static bound for h = 1
+  double cap[kMax], gain[kMax], excess[kMax];  // per piece start: where, w·γ and w·(R − r) there
+  int n = 0;
+
+  // h ↦ the largest step with f(h) ≤ d, never below the static d / fixed.
+  double solve(double d) {
+    for (int i = 1; i < n; ++i)
+      for (int k = i; k > 0 && cap[k] < cap[k - 1]; --k) {
+        std::swap(cap[k], cap[k - 1]);
+        std::swap(gain[k], gain[k - 1]);
+        std::swap(excess[k], excess[k - 1]);
+      }
+    double h = INFINITY;
+    for (int i = 0; i <= n; ++i) {
+      const double end = i < n ? cap[i] : INFINITY;
+      const double root = c > 0.0 ? 2.0 * d / (a + std::sqrt(a * a + 4.0 * c * d)) : a > 0.0 ? d / a : INFINITY;
+      if (root <= end) {
+        h = root;
+        break;
+      }
+      // Past its cap, joint i moves the link by its static reach: c·h gives way to w·(R − r).
+      a += excess[i];
+      c = std::max(0.0, c - gain[i]);
+    }
+    h = std::max(fixed > 0.0 ? d / fixed : INFINITY, h);
+    return std::isnan(h) ? 0.0 : h;
+  }
+};
+
+void MotionBound::addDynamic(int link, std::size_t from, const double* dq, const Pose* poses, DynamicBound& f) const noexcept {
   const std::vector<int>& chain = chain_[link];
   const Vec3 center = poses[link] * sphere_center_[link];
-  constexpr int kMax = 64;
-  double cap[kMax];  // per turning joint: where r_k + h·γ_k reaches R_k
-  double gain[kMax], excess[kMax];  // ... and its w·γ and w·(R − r) there
-  int n = 0;
-  double a = 0.0, c = 0.0, after = 0.0;  // f(h) = h·(a + c·h) on the first piece; after: Σ w·R so far (γ_k)
-  for (std::size_t k = chain.size(); k-- > 0;) {
+  double after = 0.0;  // Σ w·R over the joints below k: γ_k
+  for (std::size_t k = chain.size(); k-- > from;) {
     const int j = chain[k], v = joint_var_[j];
     if (v < 0 || dq[v] == 0.0) continue;
     const double w = joint_mult_[j] * std::abs(dq[v]);
     const double reach = prismatic_[j] ? 1.0 : joint_reach_[link][k];
-    if (prismatic_[j] || n == kMax) {
-      a += w * reach;
+    if (prismatic_[j] || f.n == DynamicBound::kMax) {
+      f.a += w * reach;
     } else {
       const Pose& frame = poses[child_[j]];
       const Vec3 u = frame.R * axis_[j], r = center - frame.t;
       const double now = std::min(reach, (r - r.dot(u) * u).norm() + sphere_radius_[link]);
-      a += w * now;
-      if (now < reach) {
-        if (after > 0.0) {
-          c += w * after;
-          cap[n] = (reach - now) / after, gain[n] = w * after, excess[n] = w * (reach - now);
-          ++n;
-        }
+      f.a += w * now;
+      if (now < reach && after > 0.0) {
+        f.c += w * after;
+        f.cap[f.n] = (reach - now) / after, f.gain[f.n] = w * after, f.excess[f.n] = w * (reach - now);
+        ++f.n;
       }
     }
     after += w * reach;
   }
-  const double fixed = after > 0.0 ? d / after : INFINITY;  // `after` is now link(dq): the static step
-  // Pieces in order of their starts: on each, f(h) = h·(a + c·h); past cap_k joint k turns static,
-  // trading c·h for the constant w·(R − r) in the bracket.
-  for (int i = 1; i < n; ++i)
-    for (int k = i; k > 0 && cap[k] < cap[k - 1]; --k) {
-      std::swap(cap[k], cap[k - 1]);
-      std::swap(gain[k], gain[k - 1]);
-      std::swap(excess[k], excess[k - 1]);
-    }
-  double h = INFINITY;
-  for (int i = 0; i <= n; ++i) {
-    const double end = i < n ? cap[i] : INFINITY;
-    // The root of c·h² + a·h − d on this piece, if it lies before the piece ends.
-    const double root = c > 0.0 ? 2.0 * d / (a + std::sqrt(a * a + 4.0 * c * d)) : a > 0.0 ? d / a : INFINITY;
-    if (root <= end) {
-      h = root;
-      break;
-    }
-    a += excess[i];
-    c -= gain[i];
-    if (c < 0.0) c = 0.0;  // rounding
-  }
-  h = std::max(fixed, h);
-  return std::isnan(h) ? 0.0 : h;
+  f.fixed += after;
+}
+
+double MotionBound::linkStep(int link, const double* dq, const Pose* poses, double d) const noexcept {
+  DynamicBound f;
+  addDynamic(link, 0, dq, poses, f);
+  return f.solve(d);
+}
+
+double MotionBound::pairStep(int a, int b, const double* dq, const Pose* poses, double d) const noexcept {
+  // Watched from the fork: each link moves by the joints below it, from where their axes are now.
+  std::size_t fork = 0;
+  while (fork < chain_[a].size() && fork < chain_[b].size() && chain_[a][fork] == chain_[b][fork]) ++fork;
+  DynamicBound f;
+  addDynamic(a, fork, dq, poses, f);
+  addDynamic(b, fork, dq, poses, f);
+  return f.solve(d);
 }
 
 double MotionBound::pair(int a, int b, const double* dq) const noexcept {
@@ -453,7 +472,10 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
           r.free = false;
           return r;
         }
-        ctx.safe_until[k] = s + (k < n_self ? d / ctx.bound[k] : bound_.linkStep(env_links[k - n_self], ctx.dq.data(), poses, d));
+        // The static bound and the one from the axes' positions now both hold: the larger step wins.
+        ctx.safe_until[k] = s + (k < n_self ? std::max(d / ctx.bound[k], bound_.pairStep(self_items_[k].a, self_items_[k].b,
+                                                                                        ctx.dq.data(), poses, d))
+                                            : bound_.linkStep(env_links[k - n_self], ctx.dq.data(), poses, d));
       }
       next = std::min(next, ctx.safe_until[k]);
     }

@@ -312,6 +312,22 @@ TEST(MotionBound, HoldsOnTheSharedRobots) {
         EXPECT_LE(b, bound.link(p.a, dq.data()) + bound.link(p.b, dq.data()) + 1e-9) << name;
         const auto& va = vertices(p.a);
         const auto& vb = vertices(p.b);
+        // pairStep: over h·dq (and every state on the way) no distance between their vertices changes by d.
+        const double d = std::uniform_real_distribution<double>(0.001, 0.2)(rng);
+        const double h = std::min(1.0, bound.pairStep(p.a, p.b, dq.data(), c0.poses.data(), d));
+        for (double t : {0.5, 1.0}) {
+          std::vector<double> q(n);
+          for (int i = 0; i < n; ++i) q[i] = q0[i] + h * t * dq[i];
+          SceneContext ct = scene->makeContext();
+          scene->computePoses(q.data(), ct);
+          for (std::size_t i = 0; i < va.size(); i += 1 + va.size() / 6)
+            for (std::size_t j = 0; j < vb.size(); j += 1 + vb.size() / 6) {
+              const double before = (c0.poses[p.b] * vb[j] - c0.poses[p.a] * va[i]).norm();
+              const double after = (ct.poses[p.b] * vb[j] - ct.poses[p.a] * va[i]).norm();
+              EXPECT_LE(std::abs(after - before), d + 1e-9) << name << ": " << scene->robot().link(p.a).name << " / "
+                                                            << scene->robot().link(p.b).name << " h " << h;
+            }
+        }
         for (std::size_t i = 0; i < va.size(); i += 1 + va.size() / 12)
           for (std::size_t j = 0; j < vb.size(); j += 1 + vb.size() / 12) {
             const double before = (c0.poses[p.b] * vb[j] - c0.poses[p.a] * va[i]).norm();

@@ -36,10 +36,17 @@ class MotionBound {
   /// from where the joint axes are now, which is much tighter than d / link(dq) for a link near the axes
   /// that turn it. Never below d / link(dq).
   double linkStep(int link, const double* dq, const Pose* poses, double d) const noexcept;
+  /// The same for the distance between links a and b (poses of both and their ancestors needed), watched
+  /// from their common ancestor; where pair() watches from a better link, d / pair(a, b, dq) may be larger.
+  double pairStep(int a, int b, const double* dq, const Pose* poses, double d) const noexcept;
   /// Coefficient of state entry v for link i (metres per radian, or 1 for prismatic).
   double linkCoefficient(int link, int v) const noexcept { return link_coef_[link * dim_ + v]; }
 
  private:
+  struct DynamicBound;  // motion.cpp
+  // Adds to f the joints of link's chain from index `from` on.
+  void addDynamic(int link, std::size_t from, const double* dq, const Pose* poses, DynamicBound& f) const noexcept;
+
   int dim_ = 0, links_ = 0;
   std::vector<double> link_coef_;                 // links × dim
   std::vector<std::vector<int>> chain_;           // per link: the joints from the root, in order
