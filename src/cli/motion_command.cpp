@@ -1,4 +1,4 @@
-// `clearway motion SCENE [--motions FILE] [--mode certified|sampled:RES]`: checks joint-space segments.
+// `clearway motion SCENE [--motions FILE] [--mode certified|cast|sampled:RES]`: checks joint-space segments.
 #include "scene_commands.h"
 
 #include <clearway/motion/motion.h>
@@ -15,14 +15,15 @@ namespace {
 constexpr int kExitOk = 0, kExitBadLine = 1, kExitUsage = 2;
 
 const char* const kMotionUsage =
-    "usage: clearway motion SCENE [--motions FILE] [--mode certified|sampled:RES] [--geometry mesh|hull]\n"
+    "usage: clearway motion SCENE [--motions FILE] [--mode certified|cast|sampled:RES] [--geometry mesh|hull]\n"
     "\n"
     "Checks straight joint-space segments. Each line holds two joint vectors (the group's joints in order,\n"
     "2n numbers separated by spaces or commas; '#' starts a comment); each output line is 'free',\n"
     "'collision F WHAT' (F: the last valid fraction of the segment; WHAT: the links, obstacle or\n"
     "'invalid state'), or 'error REASON'. Without --motions it checks the scene's start -> goal.\n"
     "Modes: certified (default: conservative advancement, never steps over an obstacle, contact within\n"
-    "1 mm), sampled:RES (states every RES in the Euclidean joint norm, as OMPL's DiscreteMotionValidator;\n"
+    "1 mm), cast (certified, with one GJK shape cast for what only translates: prismatic joints),\n"
+    "sampled:RES (states every RES in the Euclidean joint norm, as OMPL's DiscreteMotionValidator;\n"
     "may tunnel). FILE may be - for stdin.\n"
     "Exit status: 0 when every line was a segment, 1 when some line was an error, 2 on a usage error or\n"
     "a scene that does not load.\n";
@@ -67,11 +68,9 @@ int motionCommand(const std::vector<std::string>& args) {
           return kExitUsage;
         }
       } else if (m == "cast") {
-        std::cerr << "clearway motion: mode 'cast' (translation-only shape casts) is not implemented yet; "
-                     "use certified\n";
-        return kExitUsage;
+        motion.mode = MotionMode::Cast;
       } else {
-        std::cerr << "clearway motion: unknown mode '" << m << "' (certified or sampled:RES)\n";
+        std::cerr << "clearway motion: unknown mode '" << m << "' (certified, cast or sampled:RES)\n";
         return kExitUsage;
       }
     } else if (a == "--geometry") {

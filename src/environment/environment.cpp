@@ -14,6 +14,7 @@
 #include <clearway/environment/environment.h>
 
 #include <clearway/narrowphase/epa.h>
+#include <clearway/narrowphase/ray_cast.h>
 #include <clearway/shape/support.h>
 
 #include <algorithm>
@@ -312,6 +313,64 @@ DistanceResult Environment::linkDistance(const LinkGeometry& link, const Pose& p
   // Every item not evaluated was at least the final limit away.
   r.lower_bound = std::min({search.lower, search.limit, r.distance});
   return r;
+}
+
+double Environment::linkCast(const LinkGeometry& link, const Pose& pose, const Vec3& velocity, double margin,
+                             const Tolerances& tol, double max_s, double t,
+                             EnvironmentCounters* counters) const noexcept {
+  constexpr double kNone = std::numeric_limits<double>::infinity();
+  if (!pose.isFinite() || !velocity.allFinite() || !(margin >= 0.0) || !std::isfinite(margin) || !std::isfinite(t) ||
+      !(max_s >= 0.0) || !std::isfinite(max_s))
+    return 0.0;
+  const Aabb start = transformed(link.bounds(), pose).inflated(margin);
+  Aabb swept = start;
+  swept.min += (max_s * velocity).cwiseMin(Vec3::Zero());
+  swept.max += (max_s * velocity).cwiseMax(Vec3::Zero());
+  const double band = bandOf(scale_ + maxAbs(swept), tol);
+  swept = swept.inflated(band);
+  const Margin<ConvexHull> grown{link.hull(), margin};
+  double first = kNone;
+  // One candidate: the slab test of the moving box against its box first (the s interval where they
+  // overlap), then the cast, only as far as the earliest hit so far.
+  const auto visit = [&](const Aabb& box, const auto& shape, const Pose& pose_o) {
+    const double limit = std::min(first, max_s);
+    double enter = 0.0, leave = limit;
+    for (int i = 0; i < 3 && enter <= leave; ++i) {
+      const double lo = box.min[i] - band - start.max[i], hi = box.max[i] + band - start.min[i];  // overlap: lo ≤ s·v ≤ hi
+      const double v = velocity[i];
+      if (v == 0.0) {
+        if (lo > 0.0 || hi < 0.0) return;
+      } else {
+        const double a = lo / v, b = hi / v;
+        enter = std::max(enter, std::min(a, b));
+        leave = std::min(leave, std::max(a, b));
+      }
+    }
+    if (!(enter <= leave)) return;
+    if (counters) ++counters->cast_tests;
+    const CastResult c = gjkShapeCast(grown, pose, velocity, shape, pose_o, limit, tol);
+    if (c.hit) first = std::min(first, std::max(0.0, c.t));
+  };
+  const auto visitObstacle = [&](const Obstacle& o, const Pose& pose_o) {
+    if (o.mesh) visit(obstacleBox(o, pose_o), o.mesh->hull(), pose_o);
+    else std::visit([&](const auto& shape) { visit(obstacleBox(o, pose_o), shape, pose_o); }, o.shape);
+  };
+  static_tree_.query(swept, [&](std::int32_t item) {
+    const Obstacle& o = obstacles_[static_[item]];
+    visitObstacle(o, o.pose);
+  });
+  for (const int k : moving_) {
+    const Pose at = poseAt(obstacles_[k], t);
+    if (!at.isFinite()) return 0.0;
+    visitObstacle(obstacles_[k], at);
+  }
+  if (!voxel_tree_.empty()) {
+    const std::vector<Aabb>& voxels = map_->occupied;
+    voxel_tree_.query(swept, [&](std::int32_t v) {
+      visit(voxels[v], Box(voxels[v].halfExtents()), Pose::translation(voxels[v].center()));
+    });
+  }
+  return first <= max_s ? first : kNone;
 }
 
 double Environment::linkPenetration(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, double padding,

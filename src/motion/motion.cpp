@@ -2,6 +2,7 @@
 
 #include <clearway/kinematics/forward_kinematics.h>
 #include <clearway/narrowphase/gjk.h>
+#include <clearway/narrowphase/ray_cast.h>
 
 #include <algorithm>
 #include <cmath>
@@ -121,6 +122,24 @@ MotionBound::MotionBound(const Scene& scene) : dim_(scene.dimension()), links_(s
       link_coef_[static_cast<std::size_t>(i) * dim_ + joint_var_[j]] += joint_mult_[j] * w;
     }
   }
+}
+
+bool MotionBound::translates(int a, int b, const double* dq) const noexcept {
+  // Joints above the fork move both links alike; only the path between them matters.
+  std::size_t fork = 0;
+  while (fork < chain_[a].size() && fork < chain_[b].size() && chain_[a][fork] == chain_[b][fork]) ++fork;
+  for (const int l : {a, b})
+    for (std::size_t k = fork; k < chain_[l].size(); ++k) {
+      const int j = chain_[l][k], v = joint_var_[j];
+      if (v >= 0 && dq[v] != 0.0 && !prismatic_[j]) return false;
+    }
+  return true;
+}
+
+bool MotionBound::translates(int link, const double* dq) const noexcept {
+  for (const int j : chain_[link])
+    if (joint_var_[j] >= 0 && dq[joint_var_[j]] != 0.0 && !prismatic_[j]) return false;
+  return true;
 }
 
 double MotionBound::link(int link, const double* dq) const noexcept {
@@ -308,6 +327,7 @@ MotionContext MotionChecker::makeContext() const {
   c.hull_cache.resize(self_items_.size());
   c.pose_stamp.assign(scene_->robot().linkCount(), 0);
   c.pose_path.reserve(scene_->robot().linkCount());
+  if (options_.mode == MotionMode::Cast) c.end_poses.resize(scene_->robot().linkCount());
   return c;
 }
 
@@ -316,7 +336,7 @@ void MotionChecker::interpolate(const double* q0, const double* q1, double s, do
 }
 
 MotionResult MotionChecker::check(const double* q0, const double* q1, MotionContext& ctx) const noexcept {
-  return options_.mode == MotionMode::Certified ? certified(q0, q1, ctx) : sampled(q0, q1, ctx);
+  return options_.mode == MotionMode::Sampled ? sampled(q0, q1, ctx) : certified(q0, q1, ctx);
 }
 
 MotionResult MotionChecker::sampled(const double* q0, const double* q1, MotionContext& ctx) const noexcept {
@@ -356,6 +376,47 @@ MotionResult MotionChecker::sampled(const double* q0, const double* q1, MotionCo
   return r;
 }
 
+void MotionChecker::castAhead(const double* q0, const double* q1, int n_items, MotionContext& ctx,
+                              MotionResult& r) const noexcept {
+  const Scene& sc = *scene_;
+  const Tolerances& tol = sc.options().tolerances;
+  const double contact = options_.contact_distance;
+  const int n_self = static_cast<int>(self_items_.size());
+  const std::vector<int>& env_links = sc.environmentLinks();
+  bool posed = false;
+  for (int k = 0; k < n_items; ++k) {
+    if (ctx.safe_until[k] > 0.0) continue;  // does not move
+    const bool self = k < n_self;
+    if (self ? !bound_.translates(self_items_[k].a, self_items_[k].b, ctx.dq.data())
+             : !bound_.translates(env_links[k - n_self], ctx.dq.data()))
+      continue;
+    if (!posed) {  // both ends' poses, once: the end's kept aside, the start's left in the scene context
+      sc.computePoses(q1, ctx.scene);
+      ctx.end_poses = ctx.scene.poses;
+      sc.computePoses(q0, ctx.scene);
+      posed = true;
+    }
+    const std::vector<Pose>& start = ctx.scene.poses;
+    const std::vector<Pose>& end = ctx.end_poses;
+    ++r.distance_queries;
+    double first;  // certified: the grown hulls do not touch before it
+    if (self) {
+      const LinkPair& p = self_items_[k];
+      // In b's frame a translates (the rotations on the path do not change): one cast of a's grown hull.
+      const Pose from = relativePose(start[p.b], start[p.a]);
+      const Vec3 shift = relativePose(end[p.b], end[p.a]).t - from.t;
+      const CastResult c = gjkShapeCast(Margin<ConvexHull>{sc.geometry().link(p.a)->hull(), self_padding_[k] + contact},
+                                        from, shift, sc.geometry().link(p.b)->hull(), Pose::identity(), 1.0, tol);
+      first = c.hit ? std::max(0.0, c.t) : 2.0;
+    } else {
+      const int link = env_links[k - n_self];
+      first = sc.environment().linkCast(*sc.geometry().link(link), start[link], end[link].t - start[link].t,
+                                        sc.linkPadding(link) + contact, tol, 1.0, 0.0, &ctx.scene.counters.environment);
+    }
+    ctx.safe_until[k] = std::min(first, 2.0);
+  }
+}
+
 MotionResult MotionChecker::certified(const double* q0, const double* q1, MotionContext& ctx) const noexcept {
   MotionResult r;
   const Scene& sc = *scene_;
@@ -387,6 +448,7 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
   const RobotGeometry& geometry = sc.geometry();
   const RobotModel& model = sc.robot();
   const std::vector<int>& group = sc.groupVariables();
+  if (options_.mode == MotionMode::Cast) castAhead(q0, q1, n_items, ctx, r);
   // A step usually measures one or two items: only their links' poses (and their ancestors') are computed.
   Pose* poses = ctx.scene.poses.data();
   poses[0] = Pose::identity();

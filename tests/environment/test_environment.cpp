@@ -628,5 +628,82 @@ TEST(Environment, RandomLinksAgreeWithBruteForce) {
   EXPECT_GT(checked_distances, 50);
 }
 
+// ---- Casts: a translating link against obstacles and voxels -------------------------------------------
+
+TEST(Environment, LinkCastAgainstSampledDistances) {
+  // Random links translating through voxels, primitives and a mesh obstacle: before the cast's answer the
+  // hull stays at least `margin` from everything (sampled densely); at the answer it is within the cast
+  // tolerance of `margin`; +∞ only when the whole sweep stays clear.
+  std::mt19937 rng(77);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * unit(rng); };
+  std::vector<Aabb> voxels;
+  for (int i = 0; i < 40; ++i)
+    voxels.push_back(cube(Vec3(std::floor(uniform(-1, 1) / 0.1) * 0.1, std::floor(uniform(-1, 1) / 0.1) * 0.1,
+                               std::floor(uniform(-1, 1) / 0.1) * 0.1), 0.1));
+  std::vector<Obstacle> obstacles(4);
+  obstacles[0].shape = Sphere(0.15), obstacles[0].pose = Pose::translation(Vec3(0.6, -0.6, 0.3));
+  obstacles[1].shape = Cylinder(0.05, 0.8), obstacles[1].pose = Pose::translation(Vec3(-0.6, 0.5, 0.0));
+  obstacles[2].shape = Box(Vec3(0.4, 0.002, 0.4)), obstacles[2].pose = Pose::translation(Vec3(0.0, 3.0, 3.0));  // thin
+  obstacles[3].mesh = std::make_shared<const LinkGeometry>(boxSurface(Vec3(0.1, 0.2, 0.1)));
+  obstacles[3].pose = Pose::translation(Vec3(-0.5, -0.5, -0.5));
+  const Environment env(obstacles, mapOf(voxels));
+  int hits = 0, clear = 0;
+  for (int trial = 0; trial < 120; ++trial) {
+    const Vec3 half(uniform(0.02, 0.15), uniform(0.02, 0.15), uniform(0.02, 0.15));
+    std::unique_ptr<LinkGeometry> link;
+    switch (trial % 3) {
+      case 0: link = std::make_unique<LinkGeometry>(primitiveLink(Box(half))); break;
+      case 1: link = std::make_unique<LinkGeometry>(primitiveLink(Sphere(half.x()), Pose::translation(half))); break;
+      default: link = std::make_unique<LinkGeometry>(boxSurface(half)); break;
+    }
+    const Eigen::Quaterniond q(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1), uniform(-1, 1));
+    Pose pose;
+    pose.R = q.normalized().toRotationMatrix();
+    pose.t = Vec3(uniform(-1.5, 1.5), uniform(-1.5, 1.5), uniform(-1.5, 1.5));
+    const Vec3 velocity(uniform(-2, 2), uniform(-2, 2), uniform(-2, 2));
+    const double margin = trial % 2 ? uniform(0.0, 0.05) : 0.0;
+    const auto hullDistance = [&](double s) {
+      Pose at = pose;
+      at.t += s * velocity;
+      return env.linkDistance(*link, at, kTol, INFINITY, 0.0, 0.0, nullptr, GeometryMode::Hull).distance;
+    };
+    if (hullDistance(0.0) <= margin) continue;  // starts in contact: the answer is 0, nothing to sample
+    const double first = env.linkCast(*link, pose, velocity, margin, kTol);
+    ASSERT_GE(first, 0.0);
+    const double until = std::min(first, 1.0);
+    for (int k = 0; k < 400; ++k) {
+      const double s = until * k / 400.0;
+      ASSERT_GE(hullDistance(s), margin * (1 - 1e-9) - 1e-9) << "trial " << trial << ": contact at " << s
+                                                             << " before the cast's " << first;
+    }
+    if (first <= 1.0) {
+      EXPECT_LE(hullDistance(first), margin + 1e-5 * (1.0 + velocity.norm())) << "trial " << trial;
+      ++hits;
+    } else {
+      EXPECT_TRUE(std::isinf(first));
+      EXPECT_GT(hullDistance(1.0), margin);
+      ++clear;
+    }
+  }
+  EXPECT_GT(hits, 12);
+  EXPECT_GT(clear, 10);
+  // Starting within the margin is time 0; standing still is 0 or +∞; bad input is 0 (never "clear").
+  const LinkGeometry ball = primitiveLink(Sphere(0.1));
+  EXPECT_EQ(env.linkCast(ball, Pose::translation(Vec3(0.6, -0.6, 0.5)), Vec3(1, 0, 0), 0.0, kTol), 0.0);
+  EXPECT_TRUE(std::isinf(env.linkCast(ball, Pose::translation(Vec3(0, 0, 5)), Vec3::Zero(), 0.01, kTol)));
+  EXPECT_EQ(env.linkCast(ball, Pose::translation(Vec3(0, 0, 5)), Vec3(NAN, 0, 0), 0.01, kTol), 0.0);
+  EXPECT_EQ(env.linkCast(ball, Pose::translation(Vec3(0, 0, 5)), Vec3(1, 0, 0), -1.0, kTol), 0.0);
+  // The thin plate is found from far away, where sampling at 1% of the sweep would step over it (a box:
+  // its hull is exact, where a sphere's is a polytope around it).
+  const LinkGeometry cube = primitiveLink(Box(Vec3(0.1, 0.1, 0.1)));
+  const double through = env.linkCast(cube, Pose::translation(Vec3(0.0, -2.0, 3.0)), Vec3(0, 8, 0), 0.0, kTol);
+  EXPECT_NEAR(through, (2.0 + 3.0 - 0.002 - 0.1) / 8.0, 1e-6);
+  EnvironmentCounters counters;
+  env.linkCast(ball, Pose::translation(Vec3(0.0, -2.0, 3.0)), Vec3(0, 8, 0), 0.0, kTol, 1.0, 0.0, &counters);
+  EXPECT_GT(counters.cast_tests, 0);
+  EXPECT_LT(counters.cast_tests, 10) << "the slab test keeps the casts to what the sweep reaches";
+}
+
 }  // namespace
 }  // namespace clearway

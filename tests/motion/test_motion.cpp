@@ -212,11 +212,15 @@ TEST(MotionCertified, BadInput) {
       sliderScene(dir, "    - {name: wall, box: {size: [0.001, 2, 2]}, pose: {position: [0, 0, 0]}}\n");
   const MotionChecker certified(scene);
   MotionContext ctx = certified.makeContext();
+  MotionOptions cast_options;
+  cast_options.mode = MotionMode::Cast;
+  const MotionChecker cast(scene, cast_options);
   const double ok[2] = {-1, 0};
   for (const double bad : {std::nan(""), std::numeric_limits<double>::infinity(), 5.0}) {
     const double q[2] = {-0.5, bad};
     const double p[2] = {bad, 0};
-    for (const MotionChecker* m : {&certified}) {
+    for (const MotionChecker* m : {&certified, &cast}) {
+      MotionContext ctx = m->makeContext();
       EXPECT_FALSE(m->check(ok, q, ctx).free) << bad;
       EXPECT_FALSE(m->check(q, ok, ctx).free) << bad;
       const MotionResult r = m->check(ok, p, ctx);
@@ -230,7 +234,7 @@ TEST(MotionCertified, BadInput) {
   EXPECT_FALSE(coarse.check(nan_end, ok, cc).free);
   // A zero-length motion is its state's verdict, in both modes.
   const double inside[2] = {0.0, 0.0};  // the block in the wall
-  for (const MotionChecker* m : {&certified, &coarse}) {
+  for (const MotionChecker* m : {&certified, &cast, &coarse}) {
     MotionContext c = m->makeContext();
     EXPECT_TRUE(m->check(ok, ok, c).free);
     const MotionResult r = m->check(inside, inside, c);
@@ -263,6 +267,149 @@ TEST(MotionCertified, BadInput) {
   const MotionResult r = tight.check(from, far, tc);
   EXPECT_FALSE(r.free);
   EXPECT_TRUE(r.capped);
+}
+
+// ---- Cast mode: what only translates is measured by one shape cast ---------------------------------------
+
+// A gantry: x, y and z slides carry a ram and a tool that may also spin about z; a column stands on the
+// base where the tool can run into it (a self pair: base/tool).
+const char* kGantryUrdf = R"(<?xml version="1.0"?>
+<robot name="gantry">
+  <link name="base">
+    <collision><origin xyz="0.6 0.6 0.3"/><geometry><box size="0.1 0.1 0.6"/></geometry></collision>
+  </link>
+  <link name="x_carriage"/>
+  <link name="y_carriage"/>
+  <link name="ram">
+    <collision><origin xyz="0 0 0.25"/><geometry><box size="0.06 0.06 0.3"/></geometry></collision>
+  </link>
+  <link name="tool">
+    <collision><origin xyz="0.08 0 0"/><geometry><box size="0.2 0.05 0.05"/></geometry></collision>
+  </link>
+  <joint name="x" type="prismatic">
+    <parent link="base"/><child link="x_carriage"/><axis xyz="1 0 0"/>
+    <limit lower="-1" upper="1" velocity="1" effort="1"/>
+  </joint>
+  <joint name="y" type="prismatic">
+    <parent link="x_carriage"/><child link="y_carriage"/><axis xyz="0 1 0"/>
+    <limit lower="-1" upper="1" velocity="1" effort="1"/>
+  </joint>
+  <joint name="z" type="prismatic">
+    <origin xyz="0 0 0.1"/>
+    <parent link="y_carriage"/><child link="ram"/><axis xyz="0 0 1"/>
+    <limit lower="0" upper="0.5" velocity="1" effort="1"/>
+  </joint>
+  <joint name="spin" type="revolute">
+    <parent link="ram"/><child link="tool"/><axis xyz="0 0 1"/>
+    <limit lower="-3.2" upper="3.2" velocity="1" effort="1"/>
+  </joint>
+</robot>
+)";
+
+// The gantry among a 1 mm wall (x = −0.3), a low block and a ball.
+std::shared_ptr<const Scene> gantryScene(const TempDir& dir) {
+  const std::string urdf = dir.write("gantry.urdf", kGantryUrdf);
+  const std::string scene = dir.write(
+      "gantry.yaml", "format: 1\nname: gantry\nrobot:\n  urdf: " + urdf +
+                         "\n  group: [x, y, z, spin]\nenvironment:\n  obstacles:\n"
+                         "    - {name: wall, box: {size: [0.001, 0.8, 0.4]}, pose: {position: [-0.3, 0, 0.2]}}\n"
+                         "    - {name: block, box: {size: [0.3, 0.3, 0.2]}, pose: {position: [0.3, -0.5, 0.1]}}\n"
+                         "    - {name: ball, sphere: {radius: 0.1}, pose: {position: [-0.6, -0.6, 0.5]}}\n"
+                         "checks: [self, environment, continuous]\nstart: [-0.8, 0, 0, 0]\ngoal: [0.8, 0, 0, 0]\n");
+  return Scene::load(scene);
+}
+
+MotionOptions castMode() {
+  MotionOptions o;
+  o.mode = MotionMode::Cast;
+  return o;
+}
+
+TEST(MotionCast, ThinWallAndColumnInOneCastEach) {
+  TempDir dir;
+  const auto scene = gantryScene(dir);
+  const MotionChecker cast(scene, castMode()), certified(scene);
+  MotionContext xc = cast.makeContext(), cc = certified.makeContext();
+  const MotionChecker coarse(scene, sampled(0.3));
+  MotionContext sc = coarse.makeContext();
+
+  // Through the wall along x at the tool's height: the tool (x from −0.02 to 0.18 about the ram) meets the
+  // wall's face at x = −0.3005 when the ram is at −0.3005 − 0.18 (moving +x from −0.8 to 0.3).
+  const double q0[4] = {-0.8, 0, 0.05, 0}, q1[4] = {0.3, 0, 0.05, 0};
+  EXPECT_TRUE(coarse.check(q0, q1, sc).free) << "the test needs a resolution that tunnels";
+  const MotionResult r = cast.check(q0, q1, xc);
+  const MotionResult c = certified.check(q0, q1, cc);
+  ASSERT_FALSE(r.free);
+  EXPECT_EQ(r.report.kind, CollisionReport::Kind::Environment);
+  const double contact = cast.options().contact_distance;
+  const double touch = (-0.3005 - 0.18 + 0.8) / 1.1;
+  EXPECT_LE(r.first_contact, touch + 1e-9);
+  EXPECT_GE(r.first_contact, touch - contact / 1.1 - 1e-9);
+  EXPECT_NEAR(r.first_contact, c.first_contact, 2 * contact / 1.1);
+  double q[4];
+  cast.interpolate(q0, q1, r.last_valid, q);
+  EXPECT_TRUE(scene->isFree(std::vector<double>(q, q + 4)));
+  // Head on, advancement with an exact bound (a translation) is as quick; the random test below shows
+  // what casts save on glancing approaches.
+  EXPECT_LE(r.distance_queries, c.distance_queries);
+
+  // Into the column (a self pair): the ram at y = 0.6 runs +x; the tool's tip at +0.18 meets the column's
+  // face at x = 0.55 when the ram is at 0.37 (from x = 0, above the block, past the wall).
+  const double a0[4] = {0.0, 0.6, 0.1, 0}, a1[4] = {1.0, 0.6, 0.1, 0};
+  const MotionResult self = cast.check(a0, a1, xc);
+  ASSERT_FALSE(self.free);
+  EXPECT_EQ(self.report.kind, CollisionReport::Kind::Self);
+  EXPECT_LE(self.first_contact, 0.37 + 1e-9);
+  EXPECT_GE(self.first_contact, 0.37 - contact - 1e-9);
+  EXPECT_LE(self.distance_queries, certified.check(a0, a1, cc).distance_queries);
+
+  // Spinning while sliding is not a translation: the certified advancement takes it, with its verdict.
+  const double s1[4] = {0.3, 0, 0.05, 3.0};
+  const MotionResult spun = cast.check(q0, s1, xc), spun_certified = certified.check(q0, s1, cc);
+  EXPECT_FALSE(spun.free);
+  EXPECT_EQ(spun.first_contact, spun_certified.first_contact);
+  EXPECT_EQ(spun.distance_queries, spun_certified.distance_queries);
+
+  // Clear moves are free in one query per moving item.
+  const double b0[4] = {0.0, 0.2, 0.3, 1.0}, b1[4] = {0.3, 0.3, 0.45, 1.0};
+  const MotionResult clear = cast.check(b0, b1, xc);
+  EXPECT_TRUE(clear.free);
+  EXPECT_LE(clear.distance_queries, 4);  // base/ram, base/tool, and the ram and the tool against the environment
+}
+
+TEST(MotionCast, RandomSegmentsAgreeWithDenseSampling) {
+  // Random segments of the gantry, two in three translations only: dense sampling finding a collision
+  // means the cast mode finds one, no later; its verdicts are certified's (both report contact within
+  // contact_distance, so they may differ only on segments that come that close).
+  TempDir dir;
+  const auto scene = gantryScene(dir);
+  const MotionChecker cast(scene, castMode()), certified(scene);
+  MotionContext xc = cast.makeContext(), cc = certified.makeContext();
+  const MotionChecker fine(scene, sampled(1e-3));
+  MotionContext fc = fine.makeContext();
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> xy(-1, 1), z(0, 0.5), spin(-3, 3);
+  int collide = 0, free = 0, agree = 0, total = 0;
+  long cast_queries = 0, certified_queries = 0;
+  for (int trial = 0; trial < 150; ++trial) {
+    const double q0[4] = {xy(rng), xy(rng), z(rng), spin(rng)};
+    double q1[4] = {xy(rng), xy(rng), z(rng), spin(rng)};
+    if (trial % 3) q1[3] = q0[3];
+    if (!scene->isFree(std::vector<double>(q0, q0 + 4)) || !scene->isFree(std::vector<double>(q1, q1 + 4))) continue;
+    const MotionResult x = cast.check(q0, q1, xc), c = certified.check(q0, q1, cc), d = fine.check(q0, q1, fc);
+    if (!d.free) {
+      EXPECT_FALSE(x.free) << "trial " << trial << ": cast missed a collision sampling found";
+      EXPECT_LE(x.first_contact, d.first_contact + 1e-9) << "trial " << trial;
+    }
+    ++total;
+    agree += x.free == c.free;
+    if (trial % 3) cast_queries += x.distance_queries, certified_queries += c.distance_queries;
+    (x.free ? free : collide)++;
+  }
+  EXPECT_GT(collide, 20);
+  EXPECT_GT(free, 20);
+  EXPECT_GE(agree, total - 2) << "cast and certified differ beyond near-contact cases";
+  EXPECT_LT(2 * cast_queries, certified_queries) << "casts should save most queries on translations";
 }
 
 // The bounds on the shared robots, where the reaches come from real meshes, rigid grippers and chains

@@ -61,6 +61,7 @@ struct EnvironmentCounters {
   long long voxel_tests = 0;     ///< voxel-vs-link GJK tests (hull tests, and voxel–triangle pairs in Mesh mode)
   long long distance_tests = 0;  ///< distance computations
   long long penetration_tests = 0;  ///< EPA runs (only for the signed clearance of a colliding link)
+  long long cast_tests = 0;      ///< GJK shape casts (translating links)
 };
 
 /// Obstacles and occupancy, immutable once built; queries are const and thread-safe.
@@ -91,6 +92,14 @@ class Environment {
                               double cutoff = std::numeric_limits<double>::infinity(), double t = 0.0,
                               double relative_error = 0.0, EnvironmentCounters* counters = nullptr,
                               GeometryMode mode = GeometryMode::Mesh) const noexcept;
+
+  /// For a link translating by s·velocity (world frame), s ∈ [0, max_s], with its convex hull grown by
+  /// `margin`: a certified lower bound on the first s at which it touches an obstacle (its hull, for a mesh
+  /// obstacle) or an occupied voxel, obstacles held where they are at time t; +∞ when nothing is touched
+  /// up to max_s. Each candidate the swept box reaches costs one GJK shape cast. 0 for non-finite input.
+  double linkCast(const LinkGeometry& link, const Pose& pose, const Vec3& velocity, double margin,
+                  const Tolerances& tol, double max_s = 1.0, double t = 0.0,
+                  EnvironmentCounters* counters = nullptr) const noexcept;
 
   /// How deep the link penetrates the environment: over the obstacles and voxels its exact geometry
   /// (grown by padding) touches, the largest EPA depth of its convex hull into them, plus padding. The
