@@ -15,40 +15,65 @@ namespace clearway {
 
 MotionBound::MotionBound(const Scene& scene) : dim_(scene.dimension()), links_(scene.robot().linkCount()) {
   const RobotModel& model = scene.robot();
-  // Which state entry drives each joint (through a mimic too), and by how much.
+  // Which state entry drives each joint variable (through a mimic too).
   std::vector<int> var_to_state(model.variableCount(), -1);
   for (int i = 0; i < dim_; ++i) var_to_state[scene.groupVariables()[i]] = i;
+  // The farthest a slide driven by state entry v (or, without one, a variable held still) goes.
+  const auto travel = [&](int v, const JointVariable& var) {
+    const double lo = v >= 0 ? scene.lower(v) : var.lower, hi = v >= 0 ? scene.upper(v) : var.upper;
+    return std::max(std::abs(lo), std::abs(hi));
+  };
+  // Elements: one per joint of one variable; a planar joint is two slides and a turn about its axis; a
+  // floating joint is three slides and a spin about its origin, one element per quaternion entry (the
+  // angle turned is at most kSpin times the quaternions' distance).
   const int joints = model.jointCount();
-  joint_var_.assign(joints, -1);
-  joint_mult_.assign(joints, 1.0);
-  prismatic_.assign(joints, 0);
-  step_.assign(joints, 0.0);
-  axis_.assign(joints, Vec3::UnitX());
-  child_.assign(joints, -1);
+  std::vector<std::vector<int>> elements_of(joints);
   for (int j = 0; j < joints; ++j) {
     const Joint& joint = model.joint(j);
-    axis_[j] = joint.axis.normalized();
-    child_[j] = joint.child_link;
-    // The offset from the parent link's frame to the child's: the origin, plus a prismatic joint's travel.
-    step_[j] = joint.origin.t.norm();
-    if (joint.type == JointType::Prismatic) step_[j] += std::max(std::abs(joint.lower), std::abs(joint.upper));
-    if (joint.type == JointType::Planar || joint.type == JointType::Floating) step_[j] = std::numeric_limits<double>::infinity();
     const Joint& owner = joint.isMimic() ? model.joint(joint.mimic.joint) : joint;
-    if (owner.first_variable < 0) continue;
-    const int v = var_to_state[owner.first_variable];
-    if (v < 0) continue;
-    if (joint.type == JointType::Planar || joint.type == JointType::Floating)
-      throw std::invalid_argument("MotionBound: joint '" + joint.name + "' is " + jointTypeName(joint.type) +
-                                  ": continuous checks support revolute, continuous and prismatic joints");
-    joint_var_[j] = v;
-    prismatic_[j] = joint.type == JointType::Prismatic;
-    if (joint.isMimic()) joint_mult_[j] = std::abs(joint.mimic.multiplier);
+    const auto add = [&](int k, Kind kind, double step) {
+      const int var = owner.first_variable >= 0 ? owner.first_variable + k : -1;
+      const int v = var >= 0 ? var_to_state[var] : -1;
+      elements_of[j].push_back(static_cast<int>(joint_var_.size()));
+      joint_of_.push_back(j);
+      joint_var_.push_back(v);
+      kind_.push_back(static_cast<char>(kind));
+      joint_mult_.push_back(kind == Kind::Spin ? kSpin : joint.isMimic() ? std::abs(joint.mimic.multiplier) : 1.0);
+      step_.push_back(step);
+      axis_.push_back(joint.axis.normalized());
+      child_.push_back(joint.child_link);
+    };
+    const double origin = joint.origin.t.norm();
+    const std::vector<JointVariable>& vars = model.variables();
+    const auto slide = [&](int k) {
+      const int var = owner.first_variable >= 0 ? owner.first_variable + k : -1;
+      return var >= 0 ? travel(var_to_state[var], vars[var]) : 0.0;
+    };
+    switch (joint.type) {
+      case JointType::Fixed: add(-1, Kind::Revolute, origin); break;  // (no variable: never moves)
+      case JointType::Revolute:
+      case JointType::Continuous: add(0, Kind::Revolute, origin); break;
+      case JointType::Prismatic:
+        add(0, Kind::Prismatic,
+            origin + (joint.isMimic() ? std::abs(joint.mimic.multiplier) * slide(0) + std::abs(joint.mimic.offset) : slide(0)));
+        break;
+      case JointType::Planar:
+        add(0, Kind::Prismatic, origin + slide(0));
+        add(1, Kind::Prismatic, slide(1));
+        add(2, Kind::Revolute, 0.0);
+        break;
+      case JointType::Floating:
+        for (int k = 0; k < 3; ++k) add(k, Kind::Prismatic, (k ? 0.0 : origin) + slide(k));
+        for (int k = 3; k < 7; ++k) add(k, Kind::Spin, 0.0);
+        break;
+    }
   }
+  const int elements = static_cast<int>(joint_var_.size());
   // A revolute joint's axis is fixed in the links rigidly attached to either side of it (through joints
   // the group does not move): their distances from it are exact, so a link turning about a nearby axis
   // (a base about its own turntable, a gripper about the wrist) barely counts. The rigid transforms
-  // come from the poses at one reference state.
-  exact_.assign(static_cast<std::size_t>(links_) * joints, std::numeric_limits<double>::infinity());
+  // come from the poses at one reference state, which also give a still joint's exact offset.
+  exact_.assign(static_cast<std::size_t>(links_) * elements, std::numeric_limits<double>::infinity());
   // The farthest hull vertex of a link from a line (point o, unit direction u) in the link's frame.
   const auto axisReach = [&](int link, const Vec3& o, const Vec3& u) {
     const LinkGeometry* g = scene.geometry().link(link);
@@ -69,25 +94,36 @@ MotionBound::MotionBound(const Scene& scene) : dim_(scene.dimension()), links_(s
     SceneContext ctx = scene.makeContext();
     scene.computePoses(reference.data(), ctx);
     // Links joined through joints without a state entry form rigid bodies.
+    const auto still = [&](int j) {
+      for (const int e : elements_of[j])
+        if (joint_var_[e] >= 0) return false;
+      return true;
+    };
     std::vector<int> body(links_);
     for (int l = 0; l < links_; ++l) body[l] = l;
     const auto find = [&](int l) {
       while (body[l] != l) l = body[l] = body[body[l]];
       return l;
     };
-    for (int j = 0; j < joints; ++j)
-      if (joint_var_[j] < 0 && model.joint(j).parent_link >= 0 && model.joint(j).child_link >= 0)
-        body[find(model.joint(j).parent_link)] = find(model.joint(j).child_link);
     for (int j = 0; j < joints; ++j) {
       const Joint& joint = model.joint(j);
-      if (joint_var_[j] < 0 || prismatic_[j] || joint.child_link < 0 || joint.parent_link < 0) continue;
+      if (!still(j) || joint.parent_link < 0 || joint.child_link < 0) continue;
+      body[find(joint.parent_link)] = find(joint.child_link);
+      // Held where the reference state has it (a held planar or floating joint has no limits to bound it).
+      const double offset = relativePose(ctx.poses[joint.parent_link], ctx.poses[joint.child_link]).t.norm();
+      for (const int e : elements_of[j]) step_[e] = e == elements_of[j].front() ? offset * (1.0 + 1e-12) : 0.0;
+    }
+    for (int e = 0; e < elements; ++e) {
+      const Joint& joint = model.joint(joint_of_[e]);
+      if (joint_var_[e] < 0 || kind_[e] != static_cast<char>(Kind::Revolute) || joint.child_link < 0 || joint.parent_link < 0)
+        continue;
       const Pose& child = ctx.poses[joint.child_link];  // the joint frame, turned by q about the axis
-      const Vec3 point = child.t, dir = child.R * joint.axis.normalized();
+      const Vec3 point = child.t, dir = child.R * axis_[e];
       for (int l = 0; l < links_; ++l) {
         const int root = find(l);
         if (root != find(joint.child_link) && root != find(joint.parent_link)) continue;
         const Pose& pose = ctx.poses[l];
-        exact_[static_cast<std::size_t>(l) * joints + j] =
+        exact_[static_cast<std::size_t>(l) * elements + e] =
             axisReach(l, pose.R.transpose() * (point - pose.t), pose.R.transpose() * dir);
       }
     }
@@ -100,7 +136,10 @@ MotionBound::MotionBound(const Scene& scene) : dim_(scene.dimension()), links_(s
   sphere_radius_.assign(links_, 0.0);
   link_coef_.assign(static_cast<std::size_t>(links_) * dim_, 0.0);
   for (int i = 0; i < links_; ++i) {
-    for (int l = i; model.link(l).parent_joint >= 0; l = model.parentLink(l)) chain_[i].push_back(model.link(l).parent_joint);
+    for (int l = i; model.link(l).parent_joint >= 0; l = model.parentLink(l)) {
+      const std::vector<int>& e = elements_of[model.link(l).parent_joint];
+      chain_[i].insert(chain_[i].end(), e.rbegin(), e.rend());
+    }
     std::reverse(chain_[i].begin(), chain_[i].end());
     const LinkGeometry* g = scene.geometry().link(i);
     radius_[i] = g ? g->boundingRadius() : 0.0;
@@ -118,7 +157,7 @@ MotionBound::MotionBound(const Scene& scene) : dim_(scene.dimension()), links_(s
     for (std::size_t k = 0; k < n; ++k) {
       const int j = chain_[i][k];
       if (joint_var_[j] < 0) continue;
-      const double w = prismatic_[j] ? 1.0 : joint_reach_[i][k];
+      const double w = isSlide(j) ? 1.0 : joint_reach_[i][k];
       link_coef_[static_cast<std::size_t>(i) * dim_ + joint_var_[j]] += joint_mult_[j] * w;
     }
   }
@@ -131,14 +170,14 @@ bool MotionBound::translates(int a, int b, const double* dq) const noexcept {
   for (const int l : {a, b})
     for (std::size_t k = fork; k < chain_[l].size(); ++k) {
       const int j = chain_[l][k], v = joint_var_[j];
-      if (v >= 0 && dq[v] != 0.0 && !prismatic_[j]) return false;
+      if (v >= 0 && dq[v] != 0.0 && !isSlide(j)) return false;
     }
   return true;
 }
 
 bool MotionBound::translates(int link, const double* dq) const noexcept {
   for (const int j : chain_[link])
-    if (joint_var_[j] >= 0 && dq[joint_var_[j]] != 0.0 && !prismatic_[j]) return false;
+    if (joint_var_[j] >= 0 && dq[joint_var_[j]] != 0.0 && !isSlide(j)) return false;
   return true;
 }
 
@@ -195,8 +234,8 @@ void MotionBound::addDynamic(int link, std::size_t from, const double* dq, const
     const int j = chain[k], v = joint_var_[j];
     if (v < 0 || dq[v] == 0.0) continue;
     const double w = joint_mult_[j] * std::abs(dq[v]);
-    const double reach = prismatic_[j] ? 1.0 : joint_reach_[link][k];
-    if (prismatic_[j] || f.n == DynamicBound::kMax) {
+    const double reach = isSlide(j) ? 1.0 : joint_reach_[link][k];
+    if (kind_[j] != static_cast<char>(Kind::Revolute) || f.n == DynamicBound::kMax) {  // slides, spins: static
       f.a += w * reach;
     } else {
       const Pose& frame = poses[child_[j]];
@@ -251,8 +290,8 @@ double MotionBound::pair(int a, int b, const double* dq) const noexcept {
     const int v = joint_var_[j];
     if (v < 0 || dq[v] == 0.0) return;
     const double w = joint_mult_[j] * std::abs(dq[v]);
-    cost_a[n] = (prismatic_[j] ? 1.0 : reach_a) * w;
-    cost_b[n] = (prismatic_[j] ? 1.0 : reach_b) * w;
+    cost_a[n] = (isSlide(j) ? 1.0 : reach_a) * w;
+    cost_b[n] = (isSlide(j) ? 1.0 : reach_b) * w;
     ++n;
   };
   if (na - fork + nb - fork > kMaxPath) {  // beyond any real robot: watched from the fork
@@ -261,7 +300,7 @@ double MotionBound::pair(int a, int b, const double* dq) const noexcept {
       const int l = side ? b : a;
       for (std::size_t k = fork; k < chain_[l].size(); ++k) {
         const int j = chain_[l][k], v = joint_var_[j];
-        if (v >= 0 && dq[v] != 0.0) bound += joint_mult_[j] * std::abs(dq[v]) * (prismatic_[j] ? 1.0 : joint_reach_[l][k]);
+        if (v >= 0 && dq[v] != 0.0) bound += joint_mult_[j] * std::abs(dq[v]) * (isSlide(j) ? 1.0 : joint_reach_[l][k]);
       }
     }
     return bound;
@@ -308,6 +347,13 @@ MotionChecker::MotionChecker(std::shared_ptr<const Scene> scene, MotionOptions o
   if (scene_->effects().moving && scene_->environment().hasMovingObstacles())
     throw std::invalid_argument("MotionChecker: scene '" + scene_->name() +
                                 "' has moving obstacles; segment checks against moving obstacles are not supported");
+  // A floating joint's quaternion turns along the great arc (slerp), as OMPL's SO(3) interpolates.
+  const RobotModel& model = scene_->robot();
+  for (int i = 0; i < scene_->dimension(); ++i) {
+    const int v = scene_->groupVariables()[i];
+    const Joint& joint = model.joint(model.variables()[v].joint);
+    if (joint.type == JointType::Floating && v == joint.first_variable + 3) quaternions_.push_back(i);
+  }
   const SelfCollision& self = scene_->selfCollision();
   if (scene_->effects().self)
     for (int k = 0; k < static_cast<int>(self.pairs().size()); ++k) {
@@ -331,8 +377,31 @@ MotionContext MotionChecker::makeContext() const {
   return c;
 }
 
+namespace {
+
+// The unit quaternions of q0[0..3] and q1[0..3], the second on the first's side (the short arc).
+void alignedUnit(const double* q0, const double* q1, Eigen::Vector4d& a, Eigen::Vector4d& b) noexcept {
+  a = Eigen::Vector4d(q0[0], q0[1], q0[2], q0[3]);
+  b = Eigen::Vector4d(q1[0], q1[1], q1[2], q1[3]);
+  a.normalize();
+  b.normalize();
+  if (a.dot(b) < 0.0) b = -b;
+}
+
+}  // namespace
+
 void MotionChecker::interpolate(const double* q0, const double* q1, double s, double* out) const noexcept {
   for (int i = 0; i < scene_->dimension(); ++i) out[i] = q0[i] + s * (q1[i] - q0[i]);
+  for (const int k : quaternions_) {
+    Eigen::Vector4d a, b;
+    alignedUnit(q0 + k, q1 + k, a, b);
+    const double angle = std::acos(std::clamp(a.dot(b), -1.0, 1.0));
+    // Slerp; nearly equal ends interpolate linearly (then renormalized), where sin(angle) loses digits.
+    Eigen::Vector4d q = angle > 1e-9 ? Eigen::Vector4d((std::sin((1 - s) * angle) * a + std::sin(s * angle) * b) / std::sin(angle))
+                                     : Eigen::Vector4d(a + s * (b - a));
+    q.normalize();
+    for (int c = 0; c < 4; ++c) out[k + c] = q[c];
+  }
 }
 
 MotionResult MotionChecker::check(const double* q0, const double* q1, MotionContext& ctx) const noexcept {
@@ -426,6 +495,11 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
   r.steps = 1;
   if (!sc.isFree(q0, ctx.scene, &r.report)) return r;  // first_contact = last_valid = 0
   for (int i = 0; i < sc.dimension(); ++i) ctx.dq[i] = q1[i] - q0[i];
+  for (const int k : quaternions_) {  // the change of the unit quaternions slerp runs between
+    Eigen::Vector4d a, b;
+    alignedUnit(q0 + k, q1 + k, a, b);
+    for (int c = 0; c < 4; ++c) ctx.dq[k + c] = b[c] - a[c];
+  }
   for (int i = 0; i < sc.dimension(); ++i)
     if (!std::isfinite(ctx.dq[i])) {
       r.report.kind = CollisionReport::Kind::Invalid;

@@ -5,6 +5,7 @@
 #include <clearway/kinematics/forward_kinematics.h>
 #include <clearway/load/robot_loader.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -98,6 +99,25 @@ void Scene::init() {
     if (!(var.lower <= 0.0 && 0.0 <= var.upper) && std::isfinite(var.lower) && std::isfinite(var.upper))
       base_q_[v] = 0.5 * (var.lower + var.upper);
     if (var.name.size() > 3 && var.name.compare(var.name.size() - 3, 3, "/qw") == 0) base_q_[v] = 1.0;
+  }
+  for (const int v : group_variables_) {
+    lower_.push_back(model.variables()[v].lower);
+    upper_.push_back(model.variables()[v].upper);
+  }
+  for (const auto& [name, range] : description_.bounds) {
+    const std::string key = "robot.bounds." + name;
+    const int v = model.variableIndex(name);
+    const auto it = std::find(group_variables_.begin(), group_variables_.end(), v);
+    if (v < 0 || it == group_variables_.end())
+      fail(key, "'" + name + "' is not a variable of the group (planar and floating joints name theirs joint/x, joint/y, ...)");
+    const std::size_t i = static_cast<std::size_t>(it - group_variables_.begin());
+    const auto [lo, hi] = range;
+    if (!std::isfinite(lo) || !std::isfinite(hi) || !(lo < hi)) fail(key, "expected finite [lower, upper] with lower < upper");
+    if (lo < lower_[i] || hi > upper_[i])
+      fail(key, "[" + std::to_string(lo) + ", " + std::to_string(hi) + "] is outside the joint's limits [" +
+                    std::to_string(lower_[i]) + ", " + std::to_string(upper_[i]) + "]");
+    lower_[i] = lo;
+    upper_[i] = hi;
   }
   std::vector<std::pair<int, double>> mimic_holds;
   for (const auto& [name, value] : description_.hold) {
@@ -237,14 +257,15 @@ bool Scene::validState(const double* state, std::string* why) const {
   for (std::size_t i = 0; i < group_variables_.size(); ++i) {
     const JointVariable& var = model.variables()[group_variables_[i]];
     const double x = state[i];
+    const double lo = lower_[i], hi = upper_[i];
     if (!std::isfinite(x)) {
       if (why) *why = "state[" + std::to_string(i) + "] (" + var.name + ") is not finite";
       return false;
     }
-    if (x < var.lower - kJointLimitTolerance || x > var.upper + kJointLimitTolerance) {
+    if (x < lo - kJointLimitTolerance || x > hi + kJointLimitTolerance) {
       if (why)
         *why = "state[" + std::to_string(i) + "] (" + var.name + ") = " + std::to_string(x) + " is outside [" +
-               std::to_string(var.lower) + ", " + std::to_string(var.upper) + "]";
+               std::to_string(lo) + ", " + std::to_string(hi) + "]";
       return false;
     }
   }
@@ -253,9 +274,8 @@ bool Scene::validState(const double* state, std::string* why) const {
 
 bool Scene::withinBounds(const double* state) const noexcept {
   for (std::size_t i = 0; i < group_variables_.size(); ++i) {
-    const JointVariable& var = robot().variables()[group_variables_[i]];
     // Written so that a NaN fails.
-    if (!(state[i] >= var.lower - kJointLimitTolerance && state[i] <= var.upper + kJointLimitTolerance)) return false;
+    if (!(state[i] >= lower_[i] - kJointLimitTolerance && state[i] <= upper_[i] + kJointLimitTolerance)) return false;
   }
   return true;
 }

@@ -155,7 +155,7 @@ class Parser {
 
     const YAML::Node robot = root["robot"];
     if (!robot) fail("robot", "missing");
-    requireMap(robot, "robot", {"urdf", "srdf", "group", "hold", "allow", "padding"});
+    requireMap(robot, "robot", {"urdf", "srdf", "group", "hold", "allow", "padding", "bounds"});
     if (!robot["urdf"]) fail("robot.urdf", "missing");
     d.urdf = path(robot["urdf"], "robot.urdf");
     if (robot["srdf"] && !robot["srdf"].IsNull()) d.srdf = path(robot["srdf"], "robot.srdf");
@@ -167,6 +167,14 @@ class Parser {
       for (const auto& kv : h) {
         const std::string j = kv.first.as<std::string>();
         d.hold.emplace_back(j, number(kv.second, "robot.hold." + j));
+      }
+    }
+    if (const YAML::Node b = robot["bounds"]; b && !b.IsNull()) {
+      if (!b.IsMap()) fail("robot.bounds", "expected a mapping of variable: [lower, upper]" + where(b));
+      for (const auto& kv : b) {
+        const std::string v = kv.first.as<std::string>(), k = "robot.bounds." + v;
+        if (!kv.second.IsSequence() || kv.second.size() != 2) fail(k, "expected [lower, upper]" + where(kv.second));
+        d.bounds.emplace_back(v, std::make_pair(number(kv.second[0], k), number(kv.second[1], k)));
       }
     }
     if (const YAML::Node a = robot["allow"]; a && !a.IsNull()) {
@@ -213,9 +221,10 @@ class Parser {
     if (any_moving && !d.effects.moving)
       fail("checks", "an obstacle has a velocity but 'moving' is not among the checks");
 
-    const int n = static_cast<int>(d.group.size());
-    if (root["start"]) d.start = numbers(root["start"], "start", n);
-    if (root["goal"]) d.goal = numbers(root["goal"], "goal", n);
+    // Their lengths are checked against the group's variables by the Scene (a planar joint has 3, a
+    // floating one 7): the file alone does not say.
+    if (root["start"]) d.start = numbers(root["start"], "start");
+    if (root["goal"]) d.goal = numbers(root["goal"], "goal");
     return d;
   }
 

@@ -412,6 +412,119 @@ TEST(MotionCast, RandomSegmentsAgreeWithDenseSampling) {
   EXPECT_LT(2 * cast_queries, certified_queries) << "casts should save most queries on translations";
 }
 
+// ---- Planar and floating joints ----------------------------------------------------------------------
+
+// The rover (robots/rover: a planar joint and a revolute boom) between two thin walls, and the free flyer
+// (robots/flyer: a floating joint) over a thin plate, by a thin post (robots/scenes).
+std::shared_ptr<const Scene> roverScene(const TempDir&) {
+  return Scene::load(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/rover_gap.yaml");
+}
+
+std::shared_ptr<const Scene> flyerScene(const TempDir&) {
+  return Scene::load(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/flyer_post.yaml");
+}
+
+// A random state of the scene: within bounds, a random unit quaternion for a floating joint.
+std::vector<double> randomState(const Scene& scene, std::mt19937& rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> normal;
+  std::vector<double> q(scene.dimension());
+  for (int i = 0; i < scene.dimension(); ++i) {
+    const double lo = std::isfinite(scene.lower(i)) ? scene.lower(i) : -M_PI;
+    const double hi = std::isfinite(scene.upper(i)) ? scene.upper(i) : M_PI;
+    q[i] = lo + (hi - lo) * unit(rng);
+  }
+  const std::string& name = scene.robot().variables()[scene.groupVariables().back()].name;
+  if (name.size() > 3 && name.compare(name.size() - 3, 3, "/qw") == 0)
+    for (int c = 0; c < 4; ++c) q[scene.dimension() - 4 + c] = normal(rng);  // (normalized by the check)
+  return q;
+}
+
+TEST(MotionBound, HoldsForPlanarAndFloatingJoints) {
+  // Along the interpolated path (slerp for the quaternion), no hull vertex moves farther than s·link(dq)
+  // with dq the change between the path's normalized ends; and the path's ends are the states.
+  TempDir dir;
+  for (const auto& scene : {roverScene(dir), flyerScene(dir)}) {
+    const MotionChecker checker(scene);
+    const int n = scene->dimension();
+    SceneContext ctx = scene->makeContext();
+    std::mt19937 rng(3);
+    std::vector<double> q(n), a(n), b(n), dq(n);
+    double tightest = 0.0;
+    for (int trial = 0; trial < 60; ++trial) {
+      const std::vector<double> q0 = randomState(*scene, rng), q1 = randomState(*scene, rng);
+      checker.interpolate(q0.data(), q1.data(), 0.0, a.data());
+      checker.interpolate(q0.data(), q1.data(), 1.0, b.data());
+      for (int i = 0; i < n; ++i) dq[i] = b[i] - a[i];
+      std::vector<std::vector<Vec3>> start;
+      scene->computePoses(a.data(), ctx);
+      const std::vector<Pose> p0 = ctx.poses;
+      for (int k = 1; k <= 20; ++k) {
+        const double t = k / 20.0;
+        checker.interpolate(q0.data(), q1.data(), t, q.data());
+        scene->computePoses(q.data(), ctx);
+        for (int link = 0; link < scene->robot().linkCount(); ++link) {
+          const LinkGeometry* g = scene->geometry().link(link);
+          if (!g) continue;
+          const double bound = t * checker.bound().link(link, dq.data());
+          for (const Vec3& v : g->hull().vertices()) {
+            const double moved = (ctx.poses[link] * v - p0[link] * v).norm();
+            ASSERT_LE(moved, bound * (1 + 1e-9) + 1e-12) << scene->name() << " trial " << trial << " link " << link;
+            tightest = std::max(tightest, moved / bound);
+          }
+        }
+      }
+      // The ends: the states themselves (a quaternion up to its sign and norm).
+      scene->computePoses(q1.data(), ctx);
+      const std::vector<Pose> end = ctx.poses;
+      scene->computePoses(b.data(), ctx);
+      for (int link = 0; link < scene->robot().linkCount(); ++link)
+        EXPECT_LT((ctx.poses[link].t - end[link].t).norm() + (ctx.poses[link].R - end[link].R).norm(), 1e-9);
+    }
+    EXPECT_GT(tightest, 0.3) << scene->name() << ": a bound this loose would make the check slow";
+  }
+}
+
+TEST(MotionCertified, PlanarAndFloatingNeverMissWhatDenseSamplingFinds) {
+  // The rover between thin walls, the flyer through a thin plate: random segments between free states.
+  TempDir dir;
+  for (const auto& scene : {roverScene(dir), flyerScene(dir)}) {
+    const MotionChecker certified(scene);
+    MotionContext ctx = certified.makeContext();
+    const MotionChecker fine(scene, sampled(2e-3));
+    MotionContext fc = fine.makeContext();
+    std::mt19937 rng(8);
+    int collide = 0, free = 0;
+    for (int trial = 0; trial < 150; ++trial) {
+      const std::vector<double> q0 = randomState(*scene, rng), q1 = randomState(*scene, rng);
+      if (!scene->isFree(q0) || !scene->isFree(q1)) continue;
+      const MotionResult c = certified.check(q0.data(), q1.data(), ctx);
+      const MotionResult d = fine.check(q0.data(), q1.data(), fc);
+      if (!d.free) {
+        EXPECT_FALSE(c.free) << scene->name() << " trial " << trial << ": certified missed a collision";
+        EXPECT_LE(c.first_contact, d.first_contact + 1e-9);
+      }
+      EXPECT_FALSE(c.capped);
+      (c.free ? free : collide)++;
+    }
+    EXPECT_GT(collide, 15) << scene->name();
+    EXPECT_GT(free, 15) << scene->name();
+  }
+  // Past the post, along x above the plate: sampling at 0.5 steps over it; the certified check finds
+  // the plate's edge (x + 0.15) meeting the post's side (x = 0.69).
+  const auto flyer = flyerScene(dir);
+  const double a0[7] = {-1, 0.7, 0.5, 0, 0, 0, 1}, a1[7] = {2, 0.7, 0.5, 0, 0, 0, 1};
+  const MotionChecker coarse(flyer, sampled(0.5));
+  MotionContext cc = coarse.makeContext();
+  EXPECT_TRUE(coarse.check(a0, a1, cc).free) << "the test needs a resolution that tunnels";
+  const MotionChecker certified(flyer);
+  MotionContext ctx = certified.makeContext();
+  const MotionResult r = certified.check(a0, a1, ctx);
+  ASSERT_FALSE(r.free);
+  EXPECT_LE(r.first_contact, (0.69 - 0.15 + 1) / 3 + 1e-9);
+  EXPECT_GE(r.first_contact, (0.69 - 0.15 + 1 - certified.options().contact_distance) / 3 - 1e-9);
+}
+
 // The bounds on the shared robots, where the reaches come from real meshes, rigid grippers and chains
 // that fork: over random steps, no hull vertex of a link moves farther than link() says, and no distance
 // between hull vertices of a checked pair changes by more than pair() says.

@@ -1,4 +1,4 @@
-// The OMPL plugin: state spaces (bounded joints and SO(2)), the validity checker agreeing with the
+// The OMPL plugin: state spaces (bounded joints, SO(2), SE(2) and SE(3)), the validity checker agreeing with the
 // scene, the continuous motion validator's lastValid, planning end to end on the bundled scene, and
 // many threads on one checker.
 #include <clearway/ompl/collision_checking.h>
@@ -6,6 +6,8 @@
 #include "load/robot_files.h"
 
 #include <ompl/base/spaces/RealVectorStateSpace.h>
+#include <ompl/base/spaces/SE2StateSpace.h>
+#include <ompl/base/spaces/SE3StateSpace.h>
 #include <ompl/base/spaces/SO2StateSpace.h>
 #include <ompl/geometric/SimpleSetup.h>
 #include <ompl/geometric/planners/prm/PRM.h>
@@ -148,8 +150,9 @@ TEST(OmplPlugin, MotionValidatorTakesTheShortWayAndReportsLastValid) {
 
 // Plans on the bundled scene with the given planner and checks the path independently: every segment
 // certified free, and dense samples along it valid.
-void planAndCertify(const std::function<ob::PlannerPtr(const ob::SpaceInformationPtr&)>& makePlanner) {
-  const auto scene = Scene::load(bundledScene());
+void planAndCertify(const std::function<ob::PlannerPtr(const ob::SpaceInformationPtr&)>& makePlanner,
+                    const std::string& scene_file = bundledScene()) {
+  const auto scene = Scene::load(scene_file);
   og::SimpleSetup setup(makeStateSpace(*scene));
   const CollisionChecking c = setupCollisionChecking(setup.getSpaceInformation(), scene);
   const StateMap map(*scene);
@@ -162,7 +165,7 @@ void planAndCertify(const std::function<ob::PlannerPtr(const ob::SpaceInformatio
   setup.simplifySolution();
   og::PathGeometric& path = setup.getSolutionPath();
   ASSERT_GE(path.getStateCount(), 2u);
-  // The straight line is blocked by the wall: the planner had to find a way round.
+  // The straight line is blocked: the planner had to find a way round.
   EXPECT_FALSE(setup.getSpaceInformation()->checkMotion(start.get(), goal.get()));
   const MotionChecker certified(scene);
   MotionOptions dense;
@@ -174,10 +177,75 @@ void planAndCertify(const std::function<ob::PlannerPtr(const ob::SpaceInformatio
   for (std::size_t i = 0; i + 1 < path.getStateCount(); ++i) {
     map.toVector(path.getState(i), q0.data());
     map.toVector(path.getState(i + 1), q1.data());
+    map.unwrap(q0.data(), q1.data());
     EXPECT_TRUE(certified.check(q0.data(), q1.data(), cc).free) << "segment " << i;
     EXPECT_TRUE(sampled.check(q0.data(), q1.data(), sc).free) << "segment " << i;
   }
   EXPECT_GT(c.motion->counters().motions.load(), 0u);
+}
+
+std::string ourScene(const std::string& name) { return std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/" + name; }
+
+TEST(OmplPlugin, PlanarAndFloatingJointsAreSE2AndSE3) {
+  const auto rover = Scene::load(ourScene("rover_gap.yaml"));
+  const auto flyer = Scene::load(ourScene("flyer_post.yaml"));
+  const ob::StateSpacePtr rs = makeStateSpace(*rover), fs = makeStateSpace(*flyer);
+  ASSERT_TRUE(rs->isCompound());
+  ASSERT_EQ(rs->as<ob::CompoundStateSpace>()->getSubspaceCount(), 2u);
+  const auto* se2 = dynamic_cast<ob::SE2StateSpace*>(rs->as<ob::CompoundStateSpace>()->getSubspace(0).get());
+  ASSERT_NE(se2, nullptr);
+  EXPECT_EQ(se2->getBounds().low[0], -2.0);
+  EXPECT_EQ(se2->getBounds().high[1], 2.0);
+  ASSERT_TRUE(fs->isCompound());
+  ASSERT_EQ(fs->as<ob::CompoundStateSpace>()->getSubspaceCount(), 1u);
+  EXPECT_NE(dynamic_cast<ob::SE3StateSpace*>(fs->as<ob::CompoundStateSpace>()->getSubspace(0).get()), nullptr);
+
+  // The segment the motion validator checks is the one OMPL's planners interpolate: SE(2)'s yaw the
+  // short way round, SE(3)'s rotation by slerp the short way.
+  for (const auto& scene : {rover, flyer}) {
+    const ob::StateSpacePtr space = makeStateSpace(*scene);
+    const StateMap map(*scene);
+    const MotionChecker checker(scene);
+    const int n = scene->dimension();
+    ob::ScopedState<> a(space), b(space), c(space);
+    auto sampler = space->allocStateSampler();
+    std::vector<double> qa(n), qb(n), qc(n), ours(n), back(n);
+    for (int trial = 0; trial < 200; ++trial) {
+      sampler->sampleUniform(a.get());
+      sampler->sampleUniform(b.get());
+      const double t = (trial % 9 + 1) / 10.0;
+      space->interpolate(a.get(), b.get(), t, c.get());
+      map.toVector(a.get(), qa.data());
+      map.toVector(b.get(), qb.data());
+      map.toVector(c.get(), qc.data());
+      map.unwrap(qa.data(), qb.data());
+      checker.interpolate(qa.data(), qb.data(), t, ours.data());
+      map.fromVector(ours.data(), c.get());  // (wraps the angle the way OMPL keeps it)
+      map.toVector(c.get(), back.data());
+      for (int i = 0; i < n; ++i) ASSERT_NEAR(back[i], qc[i], 1e-9) << scene->name() << " trial " << trial << " entry " << i;
+    }
+  }
+
+  // A planar joint without bounds on its position cannot be sampled: a clear error.
+  TempDir dir;
+  const std::string urdf = std::string(CLEARWAY_SOURCE_DIR) + "/robots/rover/rover.urdf";
+  const auto unbounded = Scene::load(dir.write("u.yaml", "format: 1\nname: unbounded\nrobot:\n  urdf: " + urdf +
+                                                          "\n  group: [drive]\nchecks: [self]\n"));
+  try {
+    makeStateSpace(*unbounded);
+    ADD_FAILURE() << "no error for an unbounded planar joint";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("drive/x"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("robot.bounds"), std::string::npos) << e.what();
+  }
+}
+
+TEST(OmplPlugin, PlansForARoverAndAFreeFlyer) {
+  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+  ompl::RNG::setSeed(42);
+  const auto rrt = [](const ob::SpaceInformationPtr& si) { return std::make_shared<og::RRTConnect>(si); };
+  planAndCertify(rrt, ourScene("rover_gap.yaml"));
+  planAndCertify(rrt, ourScene("flyer_post.yaml"));
 }
 
 TEST(OmplPlugin, PlansOnTheBundledScene) {

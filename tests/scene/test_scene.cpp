@@ -78,7 +78,6 @@ TEST(SceneFile, BadInputNamesFileAndKey) {
       {replaced("checks:", "colour: red\nchecks:"), "key 'colour'", "unknown key"},
       {replaced("  group:", "  paddin: 0.1\n  group:"), "key 'robot.paddin'", "unknown key"},
       {replaced("planar_arm.urdf", "nowhere.urdf"), "key 'robot.urdf'", "file not found"},
-      {replaced("start: [1.5, 0]", "start: [1.5, 0, 3]"), "key 'start'", "expected 2 numbers, got 3"},
       {replaced("goal: [-1.5, 0]", "goal: [-1.5, .nan]"), "key 'goal[1]'", "not a finite number"},
       {replaced("goal: [-1.5, 0]", "goal: [-1.5, zero]"), "key 'goal[1]'", "not a number"},
       {replaced("[self, environment]", "[self, gravity]"), "key 'checks'", "unknown check 'gravity'"},
@@ -88,6 +87,9 @@ TEST(SceneFile, BadInputNamesFileAndKey) {
       {replaced("position: [1.2, 0, 0]}", "position: [1.2, 0, 0], orientation: [0, 0, 0, 2]}"),
        "key 'environment.obstacles[0].pose.orientation'", "norm"},
       {replaced("format: 1", "format: 2"), "key 'format'", "unsupported format"},
+      {replaced("  group:", "  bounds: {elbow: [0]}\n  group:"), "key 'robot.bounds.elbow'", "expected [lower, upper]"},
+      {replaced("  group:", "  bounds: {elbow: [0, .nan]}\n  group:"), "key 'robot.bounds.elbow'", "not a finite number"},
+      {replaced("  group:", "  bounds: [elbow]\n  group:"), "key 'robot.bounds'", "expected a mapping"},
       {"format: 1\nrobot: [\n", "", "not valid YAML"},
       {replaced("environment:\n  obstacles:", "environment:\n  octomap: missing.bt\n  obstacles:"),
        "key 'environment.octomap'", "file not found"},
@@ -110,6 +112,10 @@ TEST(Scene, BadRobotReferencesNameTheKey) {
       {"", "[shoulder, tool_joint]", "key 'robot.group[1]'", "fixed"},
       {"  hold: {shoulder: 0.3}\n", "[shoulder, elbow]", "key 'robot.hold.shoulder'", "in the group"},
       {"  allow: [[base_link, hand]]\n", "[shoulder, elbow]", "key 'robot.allow[0]'", "link 'hand' is not in robot"},
+      {"  bounds: {wrist: [0, 1]}\n", "[shoulder, elbow]", "key 'robot.bounds.wrist'", "not a variable of the group"},
+      {"", "[shoulder]", "key 'start'", "has 2 values for 1 group variables"},
+      {"  bounds: {elbow: [1, 0]}\n", "[shoulder, elbow]", "key 'robot.bounds.elbow'", "lower < upper"},
+      {"  bounds: {elbow: [-9, 0]}\n", "[shoulder, elbow]", "key 'robot.bounds.elbow'", "outside the joint's limits"},
   };
   for (const Case& c : cases) {
     std::string text = planarScene("[self]", "", c.robot_extra);
@@ -117,6 +123,16 @@ TEST(Scene, BadRobotReferencesNameTheKey) {
     const std::string path = dir.write("bad.yaml", text);
     EXPECT_LOAD_ERROR(Scene(parseSceneFile(path)), path, c.key, c.reason);
   }
+}
+
+TEST(Scene, BoundsNarrowTheStateSpace) {
+  TempDir dir;
+  const auto scene = Scene::load(dir.write("b.yaml", planarScene("[self]", "", "  bounds: {elbow: [-1, 0.5]}\n")));
+  EXPECT_EQ(scene->lower(1), -1.0);
+  EXPECT_EQ(scene->upper(1), 0.5);
+  EXPECT_TRUE(scene->validState(std::vector<double>{0.0, 0.5}.data()));
+  EXPECT_FALSE(scene->validState(std::vector<double>{0.0, 0.6}.data()));
+  EXPECT_FALSE(scene->isFree(std::vector<double>{0.0, -1.2}));
 }
 
 TEST(Scene, PlanarArmAgainstAWall) {

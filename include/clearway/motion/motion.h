@@ -7,7 +7,9 @@
 // over the joints of A's chain that variable v drives, the joint's reach: for a revolute joint, the
 // largest distance from its axis to A's geometry (a configuration-independent bound: the lengths of
 // the joint offsets in between plus A's radius, or exact when A is rigid with the axis); for a
-// prismatic joint, 1. Two links of one robot move relative to each other only through the joints on
+// prismatic joint, 1. A planar joint is two slides and a turn; a floating joint three slides and a spin
+// about its origin, whose quaternion entries (both ends normalized, the end on the start's side)
+// turn it by at most π/√2 times their change. Two links of one robot move relative to each other only through the joints on
 // the path between them, and may be watched from any link on that path: the joints on one side of it
 // move A, the others B; the pair's bound is that of the cheapest such link. If a pair is d apart at s,
 // it cannot touch before s + d / B_pair. Each pair keeps the parameter it is safe until and is measured
@@ -24,7 +26,7 @@ namespace clearway {
 /// Per-link and per-pair coefficients of the motion bound of one scene's group.
 class MotionBound {
  public:
-  /// Throws std::invalid_argument when a group joint is planar or floating (not supported by the bound).
+  /// A planar or floating joint's slides are bounded by the scene's limits of its x, y (and z) entries.
   explicit MotionBound(const Scene& scene);
 
   /// Upper bound on how far any point of link `link` moves (world frame) for the state step dq.
@@ -44,6 +46,9 @@ class MotionBound {
   bool translates(int a, int b, const double* dq) const noexcept;
   /// True when the step dq moves link `link` in the world by a pure translation.
   bool translates(int link, const double* dq) const noexcept;
+  /// The spin of a floating joint: the angle between unit quaternions on one side is at most this times
+  /// their Euclidean distance (4·asin(c/2) ≤ (π/√2)·c for c ≤ √2).
+  static constexpr double kSpin = 2.2214414690791831;
   /// Coefficient of state entry v for link i (metres per radian, or 1 for prismatic).
   double linkCoefficient(int link, int v) const noexcept { return link_coef_[link * dim_ + v]; }
 
@@ -59,8 +64,13 @@ class MotionBound {
   std::vector<std::vector<double>> joint_reach_;  // per link: per joint of its chain, its reach to the link
   std::vector<double> radius_;                    // per link: farthest hull vertex from the link's origin
   std::vector<int> joint_var_;                    // per joint: the state entry that drives it, -1 if none
-  std::vector<double> joint_mult_;                // per joint: |multiplier| of a mimic, 1 otherwise
-  std::vector<char> prismatic_;                   // per joint
+  // The arrays "per joint" below are per element: a joint of one variable is one element, a planar joint
+  // three and a floating joint seven (see the constructor); chains list elements.
+  enum class Kind : char { Revolute, Prismatic, Spin };
+  std::vector<double> joint_mult_;                // per joint: |multiplier| of a mimic, kSpin for a spin, else 1
+  std::vector<char> kind_;                        // per joint: a Kind
+  std::vector<int> joint_of_;                     // per joint: the robot's joint
+  bool isSlide(int j) const noexcept { return kind_[j] == static_cast<char>(Kind::Prismatic); }
   std::vector<double> step_;                      // per joint: largest parent-to-child frame offset
   std::vector<Vec3> axis_;                        // per joint: unit axis in the joint (child link) frame
   std::vector<int> child_;                        // per joint: child link
@@ -124,8 +134,8 @@ struct MotionContext {
 /// of bounds) anywhere makes the segment not free. Thread-safe given one context per thread.
 class MotionChecker {
  public:
-  /// Throws std::invalid_argument for options out of range, a planar or floating group joint, or a scene
-  /// with moving obstacles (segments have no time axis yet).
+  /// Throws std::invalid_argument for options out of range or a scene with moving obstacles (segments have
+  /// no time axis yet).
   MotionChecker(std::shared_ptr<const Scene> scene, MotionOptions options = {});
 
   const Scene& scene() const noexcept { return *scene_; }
@@ -135,7 +145,8 @@ class MotionChecker {
 
   /// The verdict on q0 → q1 (each of scene().dimension() values).
   MotionResult check(const double* q0, const double* q1, MotionContext& context) const noexcept;
-  /// The state at parameter s of q0 → q1, into out.
+  /// The state at parameter s of q0 → q1, into out: linear, except that a floating joint's quaternion
+  /// follows the short great arc at constant speed (slerp, as OMPL's SO(3) space), normalized.
   void interpolate(const double* q0, const double* q1, double s, double* out) const noexcept;
 
  private:
@@ -149,6 +160,7 @@ class MotionChecker {
   MotionBound bound_;
   std::vector<LinkPair> self_items_;
   std::vector<double> self_padding_;
+  std::vector<int> quaternions_;  // state entries where a floating joint's quaternion starts (qx)
 };
 
 }  // namespace clearway

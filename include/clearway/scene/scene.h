@@ -60,6 +60,9 @@ struct SceneDescription {
   std::string urdf, srdf;
   std::vector<std::string> group;                          ///< planned joints, in state order
   std::vector<std::pair<std::string, double>> hold;        ///< other one-variable joints, fixed
+  /// Narrower limits for group variables, by variable name ("base/x"): planar and floating joints have
+  /// none of their own, and a planner needs them to sample positions.
+  std::vector<std::pair<std::string, std::pair<double, double>>> bounds;
   std::vector<std::pair<std::string, std::string>> allow;  ///< extra link pairs never checked
   double padding = 0.0;                                    ///< metres around every link
   std::string octomap;                                     ///< "" when none
@@ -123,9 +126,9 @@ class Scene {
   int dimension() const noexcept { return static_cast<int>(group_variables_.size()); }
   /// Index in the robot's joint vector of each state entry.
   const std::vector<int>& groupVariables() const noexcept { return group_variables_; }
-  /// Limits of each state entry (±infinity for continuous joints).
-  double lower(int i) const noexcept { return robot().variables()[group_variables_[i]].lower; }
-  double upper(int i) const noexcept { return robot().variables()[group_variables_[i]].upper; }
+  /// Limits of each state entry: the joint's, or the scene's robot.bounds (±infinity when unbounded).
+  double lower(int i) const noexcept { return lower_[i]; }
+  double upper(int i) const noexcept { return upper_[i]; }
   /// Links with geometry whose pose depends on the state (others never move, so self pairs among
   /// them never change; they still meet obstacles).
   const std::vector<int>& movingLinks() const noexcept { return moving_links_; }
@@ -178,6 +181,7 @@ class Scene {
   CollisionFilter filter_;
   SelfCollision self_;
   std::vector<int> group_variables_;
+  std::vector<double> lower_, upper_;  // per state entry
   std::vector<double> base_q_;  // held values and defaults; group entries overwritten per query
   std::vector<int> moving_links_, env_links_;
   std::vector<double> link_padding_;

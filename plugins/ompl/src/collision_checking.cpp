@@ -3,10 +3,13 @@
 #include <clearway/detail/per_thread.h>
 
 #include <ompl/base/spaces/RealVectorStateSpace.h>
+#include <ompl/base/spaces/SE2StateSpace.h>
+#include <ompl/base/spaces/SE3StateSpace.h>
 #include <ompl/base/spaces/SO2StateSpace.h>
 
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
 
 namespace clearway {
 
@@ -45,13 +48,35 @@ bool isContinuous(const Scene& scene, int i) {
   return !std::isfinite(scene.lower(i)) || !std::isfinite(scene.upper(i));
 }
 
+JointType typeOf(const Scene& scene, int i) {
+  const RobotModel& model = scene.robot();
+  return model.joint(model.variables()[scene.groupVariables()[i]].joint).type;
+}
+
+// The subspaces of a scene's group in state order: each entry one, a planar joint's three one SE(2),
+// a floating joint's seven one SE(3).
+std::vector<StateMap::Part> partsOf(const Scene& scene) {
+  std::vector<StateMap::Part> parts;
+  for (int i = 0; i < scene.dimension();) {
+    const JointType type = typeOf(scene, i);
+    const StateMap::Kind kind = type == JointType::Planar     ? StateMap::Kind::SE2
+                                : type == JointType::Floating ? StateMap::Kind::SE3
+                                : isContinuous(scene, i)      ? StateMap::Kind::SO2
+                                                              : StateMap::Kind::Real;
+    parts.push_back({kind, i});
+    i += kind == StateMap::Kind::SE2 ? 3 : kind == StateMap::Kind::SE3 ? 7 : 1;
+  }
+  return parts;
+}
+
 }  // namespace
 
 ob::StateSpacePtr makeStateSpace(const Scene& scene) {
   const int n = scene.dimension();
-  bool all_bounded = true;
-  for (int i = 0; i < n; ++i) all_bounded &= !isContinuous(scene, i);
-  if (all_bounded) {
+  const std::vector<StateMap::Part> parts = partsOf(scene);
+  bool all_real = true;
+  for (const StateMap::Part& p : parts) all_real &= p.kind == StateMap::Kind::Real;
+  if (all_real) {
     auto space = std::make_shared<ob::RealVectorStateSpace>(n);
     ob::RealVectorBounds bounds(n);
     for (int i = 0; i < n; ++i) {
@@ -62,61 +87,119 @@ ob::StateSpacePtr makeStateSpace(const Scene& scene) {
     space->setBounds(bounds);
     return space;
   }
+  // A planar or floating joint's position needs bounds to be sampled: the scene's robot.bounds.
+  const auto positionBounds = [&](int first, int count) {
+    ob::RealVectorBounds bounds(count);
+    for (int k = 0; k < count; ++k) {
+      if (isContinuous(scene, first + k))
+        throw std::invalid_argument(
+            "makeStateSpace: scene '" + scene.name() + "': " + scene.robot().variables()[scene.groupVariables()[first + k]].name +
+            " is unbounded; give it robot.bounds in the scene file (a planner samples positions within them)");
+      bounds.setLow(k, scene.lower(first + k));
+      bounds.setHigh(k, scene.upper(first + k));
+    }
+    return bounds;
+  };
   auto compound = std::make_shared<ob::CompoundStateSpace>();
-  for (int i = 0; i < n; ++i) {
-    if (isContinuous(scene, i)) {
-      compound->addSubspace(std::make_shared<ob::SO2StateSpace>(), 1.0);
-    } else {
-      auto r = std::make_shared<ob::RealVectorStateSpace>(1);
-      r->setBounds(scene.lower(i), scene.upper(i));
-      compound->addSubspace(r, 1.0);
+  for (const StateMap::Part& p : parts) {
+    switch (p.kind) {
+      case StateMap::Kind::SO2: compound->addSubspace(std::make_shared<ob::SO2StateSpace>(), 1.0); break;
+      case StateMap::Kind::Real: {
+        auto r = std::make_shared<ob::RealVectorStateSpace>(1);
+        r->setBounds(scene.lower(p.first), scene.upper(p.first));
+        compound->addSubspace(r, 1.0);
+        break;
+      }
+      case StateMap::Kind::SE2: {
+        auto se2 = std::make_shared<ob::SE2StateSpace>();
+        se2->setBounds(positionBounds(p.first, 2));
+        compound->addSubspace(se2, 1.0);
+        break;
+      }
+      case StateMap::Kind::SE3: {
+        auto se3 = std::make_shared<ob::SE3StateSpace>();
+        se3->setBounds(positionBounds(p.first, 3));
+        compound->addSubspace(se3, 1.0);
+        break;
+      }
     }
   }
   compound->lock();
   return compound;
 }
 
-StateMap::StateMap(const Scene& scene) : continuous_(scene.dimension()) {
-  for (int i = 0; i < scene.dimension(); ++i) {
-    continuous_[i] = isContinuous(scene, i);
-    compound_ = compound_ || continuous_[i];
-  }
+StateMap::StateMap(const Scene& scene) : parts_(partsOf(scene)), dimension_(scene.dimension()) {
+  compound_ = false;
+  for (const Part& p : parts_) compound_ = compound_ || p.kind != Kind::Real;
 }
 
 void StateMap::toVector(const ob::State* state, double* out) const noexcept {
-  const int n = dimension();
   if (!compound_) {
     const double* v = state->as<ob::RealVectorStateSpace::StateType>()->values;
-    for (int i = 0; i < n; ++i) out[i] = v[i];
+    for (int i = 0; i < dimension_; ++i) out[i] = v[i];
     return;
   }
   const auto* c = state->as<ob::CompoundState>();
-  for (int i = 0; i < n; ++i)
-    out[i] = continuous_[i] ? c->as<ob::SO2StateSpace::StateType>(i)->value
-                            : c->as<ob::RealVectorStateSpace::StateType>(i)->values[0];
+  for (std::size_t k = 0; k < parts_.size(); ++k) {
+    double* o = out + parts_[k].first;
+    switch (parts_[k].kind) {
+      case Kind::Real: o[0] = c->as<ob::RealVectorStateSpace::StateType>(k)->values[0]; break;
+      case Kind::SO2: o[0] = c->as<ob::SO2StateSpace::StateType>(k)->value; break;
+      case Kind::SE2: {
+        const auto* se2 = c->as<ob::SE2StateSpace::StateType>(k);
+        o[0] = se2->getX(), o[1] = se2->getY(), o[2] = se2->getYaw();
+        break;
+      }
+      case Kind::SE3: {
+        const auto* se3 = c->as<ob::SE3StateSpace::StateType>(k);
+        const auto& r = se3->rotation();
+        o[0] = se3->getX(), o[1] = se3->getY(), o[2] = se3->getZ();
+        o[3] = r.x, o[4] = r.y, o[5] = r.z, o[6] = r.w;
+        break;
+      }
+    }
+  }
 }
 
 void StateMap::fromVector(const double* values, ob::State* state) const noexcept {
-  const int n = dimension();
   if (!compound_) {
     double* v = state->as<ob::RealVectorStateSpace::StateType>()->values;
-    for (int i = 0; i < n; ++i) v[i] = values[i];
+    for (int i = 0; i < dimension_; ++i) v[i] = values[i];
     return;
   }
   auto* c = state->as<ob::CompoundState>();
-  for (int i = 0; i < n; ++i) {
-    if (continuous_[i]) {
-      // Into SO(2)'s [−π, π).
-      c->as<ob::SO2StateSpace::StateType>(i)->value = std::remainder(values[i], 2.0 * M_PI);
-    } else {
-      c->as<ob::RealVectorStateSpace::StateType>(i)->values[0] = values[i];
+  for (std::size_t k = 0; k < parts_.size(); ++k) {
+    const double* v = values + parts_[k].first;
+    switch (parts_[k].kind) {
+      case Kind::Real: c->as<ob::RealVectorStateSpace::StateType>(k)->values[0] = v[0]; break;
+      case Kind::SO2: c->as<ob::SO2StateSpace::StateType>(k)->value = std::remainder(v[0], 2.0 * M_PI); break;  // [−π, π)
+      case Kind::SE2: {
+        auto* se2 = c->as<ob::SE2StateSpace::StateType>(k);
+        se2->setXY(v[0], v[1]);
+        se2->setYaw(std::remainder(v[2], 2.0 * M_PI));
+        break;
+      }
+      case Kind::SE3: {
+        auto* se3 = c->as<ob::SE3StateSpace::StateType>(k);
+        se3->setXYZ(v[0], v[1], v[2]);
+        // OMPL keeps unit quaternions; a zero one stays zero (and invalid) rather than becoming a rotation.
+        const double norm = std::sqrt(v[3] * v[3] + v[4] * v[4] + v[5] * v[5] + v[6] * v[6]);
+        const double scale = norm > 0.0 ? 1.0 / norm : 1.0;
+        auto& r = se3->rotation();
+        r.x = v[3] * scale, r.y = v[4] * scale, r.z = v[5] * scale, r.w = v[6] * scale;
+        break;
+      }
     }
   }
 }
 
 void StateMap::unwrap(const double* from, double* to) const noexcept {
-  for (int i = 0; i < dimension(); ++i)
-    if (continuous_[i]) to[i] = from[i] + std::remainder(to[i] - from[i], 2.0 * M_PI);
+  for (const Part& p : parts_) {
+    if (p.kind == Kind::SO2 || p.kind == Kind::SE2) {
+      const int i = p.kind == Kind::SO2 ? p.first : p.first + 2;
+      to[i] = from[i] + std::remainder(to[i] - from[i], 2.0 * M_PI);
+    }
+  }
 }
 
 // ---- ValidityChecker ----------------------------------------------------------------------------------

@@ -19,26 +19,33 @@
 namespace clearway {
 
 /// The OMPL state space of a scene's group: bounded joints are real-vector dimensions with the joint
-/// limits; continuous joints are SO(2). All bounded: one RealVectorStateSpace; otherwise a compound
-/// space with one subspace per state entry, in state order.
+/// limits; continuous joints are SO(2); a planar joint is SE(2) and a floating joint SE(3), their
+/// positions bounded by the scene's robot.bounds (std::invalid_argument when it gives none). All
+/// bounded one-variable joints: one RealVectorStateSpace; otherwise a compound space, in state order.
 ompl::base::StateSpacePtr makeStateSpace(const Scene& scene);
 
 /// Converts between OMPL states of makeStateSpace(scene) and Clearway state vectors, allocation-free.
 class StateMap {
  public:
+  enum class Kind { Real, SO2, SE2, SE3 };
+  struct Part {
+    Kind kind;
+    int first;  ///< its first state entry
+  };
   explicit StateMap(const Scene& scene);
-  /// Writes the state's scene-dimension values to out.
+  /// Writes the state's scene-dimension values to out (SE(3): x, y, z, qx, qy, qz, qw).
   void toVector(const ompl::base::State* state, double* out) const noexcept;
-  /// Writes the values into an OMPL state.
+  /// Writes the values into an OMPL state (angles wrapped into [−π, π), quaternions normalized).
   void fromVector(const double* values, ompl::base::State* state) const noexcept;
-  /// After toVector of the two ends: shifts continuous entries of `to` so that the segment turns the
-  /// short way, as OMPL's SO(2) interpolation does.
+  /// After toVector of the two ends: shifts the SO(2) and SE(2) angles of `to` so that the segment turns
+  /// the short way, as OMPL's interpolation does (quaternions: MotionChecker takes the short arc itself).
   void unwrap(const double* from, double* to) const noexcept;
-  int dimension() const noexcept { return static_cast<int>(continuous_.size()); }
+  int dimension() const noexcept { return dimension_; }
 
  private:
+  std::vector<Part> parts_;
+  int dimension_ = 0;
   bool compound_ = false;
-  std::vector<char> continuous_;
 };
 
 /// Counters readable by benchmarks (all cumulative).
