@@ -561,6 +561,25 @@ TEST(Environment, MeshObstacle) {
   EXPECT_NEAR(env.linkDistance(ball, Pose::translation(Vec3(0, 0, 0.2)), kTol).distance, 0.2, 1e-9);
 }
 
+// One of three kinds of link with half extents `half`: a box, an offset ball, a closed box mesh.
+std::unique_ptr<LinkGeometry> randomLink(int kind, const Vec3& half) {
+  switch (kind) {
+    case 0: return std::make_unique<LinkGeometry>(primitiveLink(Box(half)));
+    case 1: return std::make_unique<LinkGeometry>(primitiveLink(Sphere(half.x()), Pose::translation(half)));
+    default: return std::make_unique<LinkGeometry>(boxSurface(half));
+  }
+}
+
+// A random rotation and a position within ±extent per axis, drawn by uniform(lo, hi).
+template <class Uniform>
+Pose randomPose(Uniform& uniform, double extent) {
+  const Eigen::Quaterniond q(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1), uniform(-1, 1));
+  Pose p;
+  p.R = q.normalized().toRotationMatrix();
+  p.t = Vec3(uniform(-extent, extent), uniform(-extent, extent), uniform(-extent, extent));
+  return p;
+}
+
 // ---- Differential: every voxel by brute force -----------------------------------------------------------
 
 TEST(Environment, RandomLinksAgreeWithBruteForce) {
@@ -575,23 +594,11 @@ TEST(Environment, RandomLinksAgreeWithBruteForce) {
     voxels.push_back(cube(lo, edge));
   }
   const Environment env({}, mapOf(voxels));
-  const auto randomPose = [&] {
-    const Eigen::Quaterniond q(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1), uniform(-1, 1));
-    Pose p;
-    p.R = q.normalized().toRotationMatrix();
-    p.t = Vec3(uniform(-0.7, 0.7), uniform(-0.7, 0.7), uniform(-0.7, 0.7));
-    return p;
-  };
   int hits = 0, misses = 0, checked_distances = 0;
   for (int trial = 0; trial < 240; ++trial) {
     const Vec3 half(uniform(0.02, 0.3), uniform(0.02, 0.3), uniform(0.02, 0.3));
-    std::unique_ptr<LinkGeometry> link;
-    switch (trial % 3) {
-      case 0: link = std::make_unique<LinkGeometry>(primitiveLink(Box(half))); break;
-      case 1: link = std::make_unique<LinkGeometry>(primitiveLink(Sphere(half.x()), Pose::translation(half))); break;
-      default: link = std::make_unique<LinkGeometry>(boxSurface(half)); break;
-    }
-    const Pose pose = randomPose();
+    const std::unique_ptr<LinkGeometry> link = randomLink(trial % 3, half);
+    const Pose pose = randomPose(uniform, 0.7);
     const double padding = trial % 4 == 0 ? uniform(0.0, 0.05) : 0.0;
     for (const GeometryMode mode : kModes) {
       bool brute = false;
@@ -651,16 +658,8 @@ TEST(Environment, LinkCastAgainstSampledDistances) {
   int hits = 0, clear = 0;
   for (int trial = 0; trial < 120; ++trial) {
     const Vec3 half(uniform(0.02, 0.15), uniform(0.02, 0.15), uniform(0.02, 0.15));
-    std::unique_ptr<LinkGeometry> link;
-    switch (trial % 3) {
-      case 0: link = std::make_unique<LinkGeometry>(primitiveLink(Box(half))); break;
-      case 1: link = std::make_unique<LinkGeometry>(primitiveLink(Sphere(half.x()), Pose::translation(half))); break;
-      default: link = std::make_unique<LinkGeometry>(boxSurface(half)); break;
-    }
-    const Eigen::Quaterniond q(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1), uniform(-1, 1));
-    Pose pose;
-    pose.R = q.normalized().toRotationMatrix();
-    pose.t = Vec3(uniform(-1.5, 1.5), uniform(-1.5, 1.5), uniform(-1.5, 1.5));
+    const std::unique_ptr<LinkGeometry> link = randomLink(trial % 3, half);
+    const Pose pose = randomPose(uniform, 1.5);
     const Vec3 velocity(uniform(-2, 2), uniform(-2, 2), uniform(-2, 2));
     const double margin = trial % 2 ? uniform(0.0, 0.05) : 0.0;
     const auto hullDistance = [&](double s) {

@@ -532,32 +532,47 @@ TEST(RandomNarrowphase, NearContactPairs) {
   st.print();
 }
 
-// A pair moving smoothly (translation along a line that passes through A, slow rotation), with one
-// SimplexCache reused over the sequence: the warm answer equals the cold one and the reference.
+// Two hulls: a0 still, b0 moving smoothly (translation along a line that passes through A, slow
+// rotation) as u runs over [0, 1].
+struct SmoothMotion {
+  double sa, sb;  // (drawn first: the order of the draws makes the sequence)
+  Body a0, b0;
+  Vec3 start, axis;
+  Mat3 r0;
+  explicit SmoothMotion(Rng& g)
+      : sa(logUniform(g, 1e-2, 1e2)),
+        sb(sa * logUniform(g, 0.2, 5.0)),
+        a0(makeBody(Kind::Hull, sa, randomPose(g, 3 * sa), g)),
+        b0(makeBody(Kind::Hull, sb, Pose(), g)),
+        start(unitVector(g) * (1.6 * (a0.size + b0.size)) + inBall(g, 0.3 * (a0.size + b0.size))),
+        axis(unitVector(g)),
+        r0(randomRotation(g)) {}
+  const ConvexHull& hullA() const { return std::get<ConvexHull>(a0.shape); }
+  const ConvexHull& hullB() const { return std::get<ConvexHull>(b0.shape); }
+  // B at u, with its reference mesh.
+  Body b(double u) const {
+    Body b = b0;
+    b.pose.R = Eigen::AngleAxisd(0.8 * u, axis).toRotationMatrix() * r0;
+    b.pose.t = a0.pose.t + (1.0 - 2.0 * u) * start;
+    b.inner = b.outer = ref::meshFromHull(hullB(), b.pose);
+    return b;
+  }
+};
+
+// A pair moving smoothly, with one SimplexCache reused over the sequence: the warm answer equals the
+// cold one and the reference.
 TEST(RandomNarrowphase, WarmCacheAlongSmoothMotion) {
   Rng g(0x3A53ull);
   const Tolerances tol;
   int steps = 0, warm_iterations = 0, cold_iterations = 0, checked = 0;
   for (int seq = 0; seq < 30 && !tooManyFailures(); ++seq) {
-    const double sa = logUniform(g, 1e-2, 1e2), sb = sa * logUniform(g, 0.2, 5.0);
-    const Body a0 = makeBody(Kind::Hull, sa, randomPose(g, 3 * sa), g);
-    const Body b0 = makeBody(Kind::Hull, sb, Pose(), g);
-    const ConvexHull& hull_b = std::get<ConvexHull>(b0.shape);
-    const double reach = 1.6 * (a0.size + b0.size);
-    const Vec3 start = unitVector(g) * reach + inBall(g, 0.3 * (a0.size + b0.size));
-    const Vec3 axis = unitVector(g);
-    const Mat3 r0 = randomRotation(g);
+    const SmoothMotion m(g);
+    const Body& a0 = m.a0;
     SimplexCache cache;
     constexpr int kSteps = 40;
     for (int k = 0; k <= kSteps; ++k) {
       SCOPED_TRACE("sequence " + std::to_string(seq) + " step " + std::to_string(k));
-      const double u = static_cast<double>(k) / kSteps;
-      Pose pb;
-      pb.R = Eigen::AngleAxisd(0.8 * u, axis).toRotationMatrix() * r0;
-      pb.t = a0.pose.t + (1.0 - 2.0 * u) * start;
-      Body b = b0;
-      b.pose = pb;
-      b.inner = b.outer = ref::meshFromHull(hull_b, pb);
+      const Body b = m.b(static_cast<double>(k) / kSteps);
       const Bracket ref = signedBracket(a0, b);
       const Scales sc = scalesOf(a0, b);
       const IntersectResult warm = gjkIntersect(a0.shape, a0.pose, b.shape, b.pose, tol, cache);
@@ -586,31 +601,20 @@ TEST(RandomNarrowphase, LowerBoundAlongSmoothMotion) {
   const Tolerances tol;
   int steps = 0, stopped_early = 0;
   for (int seq = 0; seq < 40 && !tooManyFailures(); ++seq) {
-    const double sa = logUniform(g, 1e-2, 1e2), sb = sa * logUniform(g, 0.2, 5.0);
-    const Body a0 = makeBody(Kind::Hull, sa, randomPose(g, 3 * sa), g);
-    const Body b0 = makeBody(Kind::Hull, sb, Pose(), g);
-    const ConvexHull& hull_a = std::get<ConvexHull>(a0.shape);
-    const ConvexHull& hull_b = std::get<ConvexHull>(b0.shape);
-    const double reach = 1.6 * (a0.size + b0.size);
-    const Vec3 start = unitVector(g) * reach + inBall(g, 0.3 * (a0.size + b0.size));
-    const Vec3 axis = unitVector(g);
-    const Mat3 r0 = randomRotation(g);
+    const SmoothMotion m(g);
+    const Body &a0 = m.a0, &b0 = m.b0;
     SimplexCache cache;
     cache.axis = unitVector(g);  // stale: from some other pair
     cache.valid = true;
     constexpr int kSteps = 40;
     for (int k = 0; k <= kSteps; ++k) {
       SCOPED_TRACE("sequence " + std::to_string(seq) + " step " + std::to_string(k));
-      const double u = static_cast<double>(k) / kSteps;
-      Body b = b0;
-      b.pose.R = Eigen::AngleAxisd(0.8 * u, axis).toRotationMatrix() * r0;
-      b.pose.t = a0.pose.t + (1.0 - 2.0 * u) * start;
-      b.inner = b.outer = ref::meshFromHull(hull_b, b.pose);
+      const Body b = m.b(static_cast<double>(k) / kSteps);
       const Bracket ref = signedBracket(a0, b);
       const Scales sc = scalesOf(a0, b);
       const double enough = k % 3 == 0 ? INFINITY : logUniform(g, 1e-3, 1.0) * (a0.size + b0.size);
       const double relative = k % 2 ? 0.25 : 1e-3;
-      const double lower = gjkLowerBound(hull_a, a0.pose, hull_b, b.pose, tol, cache, enough, relative);
+      const double lower = gjkLowerBound(m.hullA(), a0.pose, m.hullB(), b.pose, tol, cache, enough, relative);
       ++steps;
       EXPECT_GE(lower, 0.0);
       EXPECT_LE(lower, std::max(ref.hi, 0.0) + sc.tiny) << "ref " << ref.lo << " … " << ref.hi;
