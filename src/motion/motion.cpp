@@ -11,10 +11,34 @@
 
 namespace clearway {
 
+namespace {
+
+// A state inside the scene's bounds (their midpoints) with unit quaternions, where the poses are defined.
+std::vector<double> referenceState(const Scene& scene) {
+  const RobotModel& model = scene.robot();
+  std::vector<double> q(scene.dimension());
+  for (int i = 0; i < scene.dimension(); ++i) {
+    const double lo = scene.lower(i), hi = scene.upper(i);
+    q[i] = std::isfinite(lo) && std::isfinite(hi) ? 0.5 * (lo + hi) : std::isfinite(lo) ? lo : std::isfinite(hi) ? hi : 0.0;
+    const int v = scene.groupVariables()[i];
+    const Joint& joint = model.joint(model.variables()[v].joint);
+    if (joint.type == JointType::Floating && v >= joint.first_variable + 3) q[i] = v == joint.first_variable + 6 ? 1.0 : 0.0;
+  }
+  return q;
+}
+
+}  // namespace
+
 // ---- MotionBound --------------------------------------------------------------------------------------
 
-MotionBound::MotionBound(const Scene& scene) : dim_(scene.dimension()), links_(scene.robot().linkCount()) {
+MotionBound::MotionBound(const Scene& scene, const std::vector<Body>& bodies)
+    : dim_(scene.dimension()), links_(scene.robot().linkCount() + static_cast<int>(bodies.size())) {
   const RobotModel& model = scene.robot();
+  const int model_links = model.linkCount();
+  // A body is one more link: its merged geometry in the frame of its anchor link.
+  frame_.resize(links_);
+  for (int i = 0; i < links_; ++i) frame_[i] = i < model_links ? i : bodies[i - model_links].anchor;
+  const auto geometry = [&](int i) { return i < model_links ? scene.geometry().link(i) : bodies[i - model_links].geometry; };
   // Which state entry drives each joint variable (through a mimic too).
   std::vector<int> var_to_state(model.variableCount(), -1);
   for (int i = 0; i < dim_; ++i) var_to_state[scene.groupVariables()[i]] = i;
@@ -76,7 +100,7 @@ MotionBound::MotionBound(const Scene& scene) : dim_(scene.dimension()), links_(s
   exact_.assign(static_cast<std::size_t>(links_) * elements, std::numeric_limits<double>::infinity());
   // The farthest hull vertex of a link from a line (point o, unit direction u) in the link's frame.
   const auto axisReach = [&](int link, const Vec3& o, const Vec3& u) {
-    const LinkGeometry* g = scene.geometry().link(link);
+    const LinkGeometry* g = geometry(link);
     double r = 0.0;
     if (g)
       for (const Vec3& v : g->hull().vertices()) {
@@ -86,21 +110,16 @@ MotionBound::MotionBound(const Scene& scene) : dim_(scene.dimension()), links_(s
     return r * (1.0 + 1e-12) + 1e-12 * (g ? g->boundingRadius() + o.norm() : 0.0);  // rounding
   };
   {
-    std::vector<double> reference(dim_);
-    for (int i = 0; i < dim_; ++i) {
-      const double lo = scene.lower(i), hi = scene.upper(i);
-      reference[i] = std::isfinite(lo) && std::isfinite(hi) ? 0.5 * (lo + hi) : std::isfinite(lo) ? lo : std::isfinite(hi) ? hi : 0.0;
-    }
     SceneContext ctx = scene.makeContext();
-    scene.computePoses(reference.data(), ctx);
+    scene.computePoses(referenceState(scene).data(), ctx);
     // Links joined through joints without a state entry form rigid bodies.
     const auto still = [&](int j) {
       for (const int e : elements_of[j])
         if (joint_var_[e] >= 0) return false;
       return true;
     };
-    std::vector<int> body(links_);
-    for (int l = 0; l < links_; ++l) body[l] = l;
+    std::vector<int> body(model_links);
+    for (int l = 0; l < model_links; ++l) body[l] = l;
     const auto find = [&](int l) {
       while (body[l] != l) l = body[l] = body[body[l]];
       return l;
@@ -120,9 +139,9 @@ MotionBound::MotionBound(const Scene& scene) : dim_(scene.dimension()), links_(s
       const Pose& child = ctx.poses[joint.child_link];  // the joint frame, turned by q about the axis
       const Vec3 point = child.t, dir = child.R * axis_[e];
       for (int l = 0; l < links_; ++l) {
-        const int root = find(l);
+        const int root = find(frame_[l]);
         if (root != find(joint.child_link) && root != find(joint.parent_link)) continue;
-        const Pose& pose = ctx.poses[l];
+        const Pose& pose = ctx.poses[frame_[l]];
         exact_[static_cast<std::size_t>(l) * elements + e] =
             axisReach(l, pose.R.transpose() * (point - pose.t), pose.R.transpose() * dir);
       }
@@ -136,12 +155,12 @@ MotionBound::MotionBound(const Scene& scene) : dim_(scene.dimension()), links_(s
   sphere_radius_.assign(links_, 0.0);
   link_coef_.assign(static_cast<std::size_t>(links_) * dim_, 0.0);
   for (int i = 0; i < links_; ++i) {
-    for (int l = i; model.link(l).parent_joint >= 0; l = model.parentLink(l)) {
+    for (int l = frame_[i]; model.link(l).parent_joint >= 0; l = model.parentLink(l)) {
       const std::vector<int>& e = elements_of[model.link(l).parent_joint];
       chain_[i].insert(chain_[i].end(), e.rbegin(), e.rend());
     }
     std::reverse(chain_[i].begin(), chain_[i].end());
-    const LinkGeometry* g = scene.geometry().link(i);
+    const LinkGeometry* g = geometry(i);
     radius_[i] = g ? g->boundingRadius() : 0.0;
     if (g) sphere_center_[i] = g->sphereCenter(), sphere_radius_[i] = g->sphereRadius();
     const std::size_t n = chain_[i].size();
@@ -228,7 +247,7 @@ struct MotionBound::DynamicBound {
 
 void MotionBound::addDynamic(int link, std::size_t from, const double* dq, const Pose* poses, DynamicBound& f) const noexcept {
   const std::vector<int>& chain = chain_[link];
-  const Vec3 center = poses[link] * sphere_center_[link];
+  const Vec3 center = poses[frame_[link]] * sphere_center_[link];
   double after = 0.0;  // Σ w·R over the joints below k: γ_k
   for (std::size_t k = chain.size(); k-- > from;) {
     const int j = chain[k], v = joint_var_[j];
@@ -334,8 +353,59 @@ namespace clearway {
 // ---- MotionChecker ------------------------------------------------------------------------------------
 
 
+namespace {
+
+// Per link: the link nearest the root that it moves rigidly with (joined by joints the group does not move).
+std::vector<int> rigidAnchors(const Scene& scene) {
+  const RobotModel& model = scene.robot();
+  std::vector<char> in_group(model.variableCount(), 0);
+  for (const int v : scene.groupVariables()) in_group[v] = 1;
+  const auto still = [&](const Joint& joint) {
+    const Joint& owner = joint.isMimic() ? model.joint(joint.mimic.joint) : joint;
+    for (int k = 0; owner.first_variable >= 0 && k < jointVariableCount(owner.type); ++k)
+      if (in_group[owner.first_variable + k]) return false;
+    return true;
+  };
+  std::vector<int> anchor(model.linkCount());
+  for (int l = 0; l < model.linkCount(); ++l) {
+    int a = l;
+    while (model.link(a).parent_joint >= 0 && still(model.joint(model.link(a).parent_joint))) a = model.parentLink(a);
+    anchor[l] = a;
+  }
+  return anchor;
+}
+
+}  // namespace
+
+MotionChecker::Bodies MotionChecker::mergeBodies(const Scene& scene) {
+  const RobotModel& model = scene.robot();
+  Bodies out;
+  out.anchor = rigidAnchors(scene);
+  out.index.assign(model.linkCount(), -1);
+  std::vector<std::vector<int>> members(model.linkCount());
+  for (const int l : scene.geometry().geometricLinks()) members[out.anchor[l]].push_back(l);
+  SceneContext ctx = scene.makeContext();
+  scene.computePoses(referenceState(scene).data(), ctx);
+  for (int anchor = 0; anchor < model.linkCount(); ++anchor) {
+    if (members[anchor].size() < 2) continue;
+    // Every member's elements, placed in the anchor's frame (fixed: the joints in between do not move).
+    std::vector<CollisionElement> elements;
+    for (const int l : members[anchor]) {
+      const Pose in_anchor = relativePose(ctx.poses[anchor], ctx.poses[l]);
+      for (CollisionElement e : model.link(l).collisions) {
+        e.origin = in_anchor * e.origin;
+        elements.push_back(std::move(e));
+      }
+    }
+    for (const int l : members[anchor]) out.index[l] = static_cast<int>(out.list.size());
+    out.geometry.push_back(std::make_unique<const LinkGeometry>(elements, model.meshes()));
+    out.list.push_back({anchor, out.geometry.back().get()});
+  }
+  return out;
+}
+
 MotionChecker::MotionChecker(std::shared_ptr<const Scene> scene, MotionOptions options)
-    : scene_(std::move(scene)), options_(options), bound_(*scene_) {
+    : scene_(std::move(scene)), options_(options), bodies_(mergeBodies(*scene_)), bound_(*scene_, bodies_.list) {
   if (!(options_.contact_distance > 0.0) || !std::isfinite(options_.contact_distance))
     throw std::invalid_argument("MotionChecker: contact_distance must be finite and > 0");
   if (!(options_.resolution > 0.0) || !std::isfinite(options_.resolution))
@@ -354,12 +424,125 @@ MotionChecker::MotionChecker(std::shared_ptr<const Scene> scene, MotionOptions o
     const Joint& joint = model.joint(model.variables()[v].joint);
     if (joint.type == JointType::Floating && v == joint.first_variable + 3) quaternions_.push_back(i);
   }
-  const SelfCollision& self = scene_->selfCollision();
-  if (scene_->effects().self)
-    for (int k = 0; k < static_cast<int>(self.pairs().size()); ++k) {
-      self_items_.push_back(self.pairs()[k]);
-      self_padding_.push_back(self.pairPadding(k));
+  buildItems();
+}
+
+void MotionChecker::buildItems() {
+  const Scene& sc = *scene_;
+  const RobotModel& model = sc.robot();
+  const int n_links = model.linkCount();
+  const std::vector<int>& anchor = bodies_.anchor;
+  std::vector<int> geometric(n_links, 0);  // per anchor: its links with geometry
+  for (const int l : sc.geometry().geometricLinks()) ++geometric[anchor[l]];
+  // A link's body as one link of the bound: merged, or the link itself when it is the body's only one.
+  const auto whole = [&](int link, Item& item, bool second) {
+    const int body = bodies_.index[link];
+    const int index = body >= 0 ? n_links + body : link;
+    const int frame = body >= 0 ? bodies_.list[body].anchor : link;
+    const LinkGeometry* g = body >= 0 ? bodies_.list[body].geometry : sc.geometry().link(link);
+    (second ? item.b : item.a) = index;
+    (second ? item.frame_b : item.frame_a) = frame;
+    (second ? item.gb : item.ga) = g;
+  };
+  // Groups of members (indices into `single`): the members follow their group, in order.
+  const auto emit = [&](const std::vector<Item>& single, const std::vector<std::vector<int>>& groups,
+                        const std::vector<Item>& heads) {
+    std::vector<char> taken(single.size(), 0);
+    std::vector<Item> tail;
+    for (std::size_t g = 0; g < groups.size(); ++g) items_.push_back(heads[g]);
+    const std::size_t first_group = items_.size() - groups.size();
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      Item& head = items_[first_group + g];
+      head.first = static_cast<int>(items_.size() + tail.size());
+      for (const int m : groups[g]) {
+        Item member = single[m];
+        member.group = static_cast<int>(first_group + g);
+        tail.push_back(member);
+        taken[m] = 1;
+      }
+      head.last = static_cast<int>(items_.size() + tail.size());
     }
+    items_.insert(items_.end(), tail.begin(), tail.end());
+    for (std::size_t m = 0; m < single.size(); ++m)
+      if (!taken[m]) items_.push_back(single[m]);
+  };
+
+  // Self pairs. Two bodies whose every link pair is checked are one item: the least distance over those
+  // pairs is the distance of the merged geometries (padding: the largest of the pairs').
+  std::vector<Item> single, heads;
+  std::vector<std::vector<int>> groups;
+  if (sc.effects().self) {
+    const SelfCollision& self = sc.selfCollision();
+    std::vector<std::pair<std::pair<int, int>, int>> keyed;  // (anchors, index in single)
+    SceneContext ctx = sc.makeContext();
+    sc.computePoses(referenceState(sc).data(), ctx);
+    for (int k = 0; k < static_cast<int>(self.pairs().size()); ++k) {
+      const LinkPair& p = self.pairs()[k];
+      if (anchor[p.a] == anchor[p.b]) {  // one rigid body: as at every state
+        if (rigid_collision_.kind == CollisionReport::Kind::None &&
+            meshesIntersect(*sc.geometry().link(p.a), ctx.poses[p.a], *sc.geometry().link(p.b), ctx.poses[p.b],
+                            sc.options().tolerances, sc.options().mode, self.pairPadding(k))) {
+          rigid_collision_.kind = CollisionReport::Kind::Self;
+          rigid_collision_.link = p.a;
+          rigid_collision_.other_link = p.b;
+        }
+        continue;
+      }
+      Item item;
+      item.a = item.frame_a = p.a;
+      item.b = item.frame_b = p.b;
+      item.ga = sc.geometry().link(p.a);
+      item.gb = sc.geometry().link(p.b);
+      item.padding = self.pairPadding(k);
+      keyed.push_back({std::minmax(anchor[p.a], anchor[p.b]), static_cast<int>(single.size())});
+      single.push_back(item);
+    }
+    std::sort(keyed.begin(), keyed.end());
+    for (std::size_t i = 0, j; i < keyed.size(); i = j) {
+      for (j = i; j < keyed.size() && keyed[j].first == keyed[i].first; ++j) {}
+      const auto [x, y] = keyed[i].first;
+      const std::size_t n = j - i;
+      if (x == y || n < 2 || n != static_cast<std::size_t>(geometric[x]) * geometric[y]) continue;
+      Item head;
+      whole(single[keyed[i].second].a, head, false);
+      whole(single[keyed[i].second].b, head, true);
+      groups.emplace_back();
+      for (std::size_t m = i; m < j; ++m) {
+        groups.back().push_back(keyed[m].second);
+        head.padding = std::max(head.padding, single[keyed[m].second].padding);
+      }
+      heads.push_back(head);
+    }
+  }
+  emit(single, groups, heads);
+  env_begin_ = static_cast<int>(items_.size());
+
+  // Environment links. A body whose every geometric link is checked is one item.
+  single.clear(), heads.clear(), groups.clear();
+  const std::vector<int>& env_links = sc.environmentLinks();
+  std::vector<int> checked(n_links, 0);
+  for (const int l : env_links) ++checked[anchor[l]];
+  std::vector<int> group_of(n_links, -1);
+  for (std::size_t k = 0; k < env_links.size(); ++k) {
+    const int l = env_links[k];
+    Item item;
+    item.a = item.frame_a = l;
+    item.ga = sc.geometry().link(l);
+    item.padding = sc.linkPadding(l);
+    single.push_back(item);
+    const int x = anchor[l];
+    if (checked[x] < 2 || checked[x] != geometric[x]) continue;
+    if (group_of[x] < 0) {
+      group_of[x] = static_cast<int>(groups.size());
+      groups.emplace_back();
+      Item head;
+      whole(l, head, false);
+      heads.push_back(head);
+    }
+    groups[group_of[x]].push_back(static_cast<int>(k));
+    heads[group_of[x]].padding = std::max(heads[group_of[x]].padding, item.padding);
+  }
+  emit(single, groups, heads);
 }
 
 MotionContext MotionChecker::makeContext() const {
@@ -367,10 +550,9 @@ MotionContext MotionChecker::makeContext() const {
   c.scene = scene_->makeContext();
   c.q.resize(scene_->dimension());
   c.dq.resize(scene_->dimension());
-  const std::size_t items = self_items_.size() + scene_->environmentLinks().size();
-  c.safe_until.resize(items);
-  c.bound.resize(items);
-  c.hull_cache.resize(self_items_.size());
+  c.safe_until.resize(items_.size());
+  c.bound.resize(items_.size());
+  c.hull_cache.resize(env_begin_);
   c.pose_stamp.assign(scene_->robot().linkCount(), 0);
   c.pose_path.reserve(scene_->robot().linkCount());
   if (options_.mode == MotionMode::Cast) c.end_poses.resize(scene_->robot().linkCount());
@@ -450,15 +632,12 @@ void MotionChecker::castAhead(const double* q0, const double* q1, int n_items, M
   const Scene& sc = *scene_;
   const Tolerances& tol = sc.options().tolerances;
   const double contact = options_.contact_distance;
-  const int n_self = static_cast<int>(self_items_.size());
-  const std::vector<int>& env_links = sc.environmentLinks();
   bool posed = false;
   for (int k = 0; k < n_items; ++k) {
-    if (ctx.safe_until[k] > 0.0) continue;  // does not move
-    const bool self = k < n_self;
-    if (self ? !bound_.translates(self_items_[k].a, self_items_[k].b, ctx.dq.data())
-             : !bound_.translates(env_links[k - n_self], ctx.dq.data()))
-      continue;
+    if (ctx.safe_until[k] > 0.0) continue;  // does not move, or its group measures it
+    const Item& it = items_[k];
+    const bool self = it.b >= 0;
+    if (self ? !bound_.translates(it.a, it.b, ctx.dq.data()) : !bound_.translates(it.a, ctx.dq.data())) continue;
     if (!posed) {  // both ends' poses, once: the end's kept aside, the start's left in the scene context
       sc.computePoses(q1, ctx.scene);
       ctx.end_poses = ctx.scene.poses;
@@ -470,17 +649,15 @@ void MotionChecker::castAhead(const double* q0, const double* q1, int n_items, M
     ++r.distance_queries;
     double first;  // certified: the grown hulls do not touch before it
     if (self) {
-      const LinkPair& p = self_items_[k];
       // In b's frame a translates (the rotations on the path do not change): one cast of a's grown hull.
-      const Pose from = relativePose(start[p.b], start[p.a]);
-      const Vec3 shift = relativePose(end[p.b], end[p.a]).t - from.t;
-      const CastResult c = gjkShapeCast(Margin<ConvexHull>{sc.geometry().link(p.a)->hull(), self_padding_[k] + contact},
-                                        from, shift, sc.geometry().link(p.b)->hull(), Pose::identity(), 1.0, tol);
+      const Pose from = relativePose(start[it.frame_b], start[it.frame_a]);
+      const Vec3 shift = relativePose(end[it.frame_b], end[it.frame_a]).t - from.t;
+      const CastResult c = gjkShapeCast(Margin<ConvexHull>{it.ga->hull(), it.padding + contact}, from, shift,
+                                        it.gb->hull(), Pose::identity(), 1.0, tol);
       first = c.hit ? std::max(0.0, c.t) : 2.0;
     } else {
-      const int link = env_links[k - n_self];
-      first = sc.environment().linkCast(*sc.geometry().link(link), start[link], end[link].t - start[link].t,
-                                        sc.linkPadding(link) + contact, tol, 1.0, 0.0, &ctx.scene.counters.environment);
+      first = sc.environment().linkCast(*it.ga, start[it.frame_a], end[it.frame_a].t - start[it.frame_a].t,
+                                        it.padding + contact, tol, 1.0, 0.0, &ctx.scene.counters.environment);
     }
     ctx.safe_until[k] = std::min(first, 2.0);
   }
@@ -493,7 +670,16 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
   const double contact = options_.contact_distance;
   const bool hull_mode = sc.options().mode == GeometryMode::Hull;
   r.steps = 1;
-  if (!sc.isFree(q0, ctx.scene, &r.report)) return r;  // first_contact = last_valid = 0
+  // q0's collisions are found by the advancement's first step (every item is measured at s = 0), except
+  // those no state changes. (first_contact = last_valid = 0)
+  if (!sc.validState(q0)) {
+    r.report.kind = CollisionReport::Kind::Invalid;
+    return r;
+  }
+  if (sc.staticCollision().kind != CollisionReport::Kind::None || rigid_collision_.kind != CollisionReport::Kind::None) {
+    r.report = sc.staticCollision().kind != CollisionReport::Kind::None ? sc.staticCollision() : rigid_collision_;
+    return r;
+  }
   for (int i = 0; i < sc.dimension(); ++i) ctx.dq[i] = q1[i] - q0[i];
   for (const int k : quaternions_) {  // the change of the unit quaternions slerp runs between
     Eigen::Vector4d a, b;
@@ -509,17 +695,21 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
   // after the advancement has looked for an earlier contact.
   const bool end_invalid = !sc.validState(q1);
 
-  const std::vector<int>& env_links = sc.environmentLinks();
   const bool check_env = sc.effects().environment && !sc.environment().empty();
-  const int n_self = static_cast<int>(self_items_.size());
-  const int n_items = n_self + (check_env ? static_cast<int>(env_links.size()) : 0);
+  const int n_items = check_env ? static_cast<int>(items_.size()) : env_begin_;
+  const auto itemBound = [&](const Item& it) {
+    return it.b >= 0 ? bound_.pair(it.a, it.b, ctx.dq.data()) : bound_.link(it.a, ctx.dq.data());
+  };
+  // Members wait (at 3) until their group comes within contact.
   for (int k = 0; k < n_items; ++k) {
-    ctx.bound[k] = k < n_self ? bound_.pair(self_items_[k].a, self_items_[k].b, ctx.dq.data())
-                              : bound_.link(env_links[k - n_self], ctx.dq.data());
-    ctx.safe_until[k] = ctx.bound[k] > 0.0 ? 0.0 : 2.0;  // a pair that does not move stays as q0 had it
+    if (items_[k].group >= 0) {
+      ctx.safe_until[k] = 3.0;
+      continue;
+    }
+    ctx.bound[k] = itemBound(items_[k]);  // (one that does not move on this segment: measured at s = 0 only)
+    ctx.safe_until[k] = 0.0;
   }
 
-  const RobotGeometry& geometry = sc.geometry();
   const RobotModel& model = sc.robot();
   const std::vector<int>& group = sc.groupVariables();
   if (options_.mode == MotionMode::Cast) castAhead(q0, q1, n_items, ctx, r);
@@ -541,64 +731,71 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
     double next = 2.0;
     for (int k = 0; k < n_items; ++k) {
       if (ctx.safe_until[k] <= s) {
-        // How far this item can still move on the rest of the segment: nothing farther matters.
-        const double remaining = ctx.bound[k] * (1.0 - s);
+        const Item& it = items_[k];
+        const bool head = it.last > it.first;
+        // How far this item can still move on the rest of the segment: nothing farther matters, except
+        // that a clearance must exceed the contact distance to count (an item that stays still).
+        const double remaining = std::max(ctx.bound[k] * (1.0 - s), 2.0 * contact);
         double d;  // a certified lower bound on the clearance (padding removed)
         ++r.distance_queries;
-        if (k < n_self) {
-          const LinkPair& p = self_items_[k];
-          pose(p.a);
-          pose(p.b);
-          const LinkGeometry& a = *geometry.link(p.a);
-          const LinkGeometry& b = *geometry.link(p.b);
+        pose(it.frame_a);
+        const Pose& pa = poses[it.frame_a];
+        if (it.b >= 0) {
+          pose(it.frame_b);
+          const Pose& pb = poses[it.frame_b];
+          const LinkGeometry& a = *it.ga;
+          const LinkGeometry& b = *it.gb;
           // Ever tighter and dearer lower bounds, each only when the one before cannot certify the rest of
           // the segment (`enough`), and computed only as far as that needs: the bounding balls, the
-          // hulls (warm-started GJK), the convex parts, and last the triangles.
-          const double enough = remaining + self_padding_[k];
-          double lower = (poses[p.a] * a.sphereCenter() - poses[p.b] * b.sphereCenter()).norm() - a.sphereRadius() -
-                         b.sphereRadius();
+          // hulls (warm-started GJK), the convex parts, and last the triangles. A group stops at the hulls.
+          const double enough = remaining + it.padding;
+          double lower = (pa * a.sphereCenter() - pb * b.sphereCenter()).norm() - a.sphereRadius() - b.sphereRadius();
           if (!(lower >= enough))  // (the GJK bound first in max(): it is a number even if the balls' is not)
-            lower = std::max(gjkLowerBound(a.hull(), poses[p.a], b.hull(), poses[p.b], tol, ctx.hull_cache[k], enough,
+            lower = std::max(gjkLowerBound(a.hull(), pa, b.hull(), pb, tol, ctx.hull_cache[k], enough,
                                            options_.distance_relative_error),
                              lower);
-          d = lower - self_padding_[k];
-          if (d <= contact && !hull_mode)
-            d = std::max(partsLowerBound(a, poses[p.a], b, poses[p.b], tol, enough, options_.distance_relative_error) -
-                             self_padding_[k],
-                         d);
-          if (d <= contact && !hull_mode) {
-            const DistanceResult m = meshDistance(a, poses[p.a], b, poses[p.b], tol, options_.distance_relative_error);
-            d = isFailure(m.status) ? 0.0 : m.lower_bound - self_padding_[k];
+          d = lower - it.padding;
+          if (d <= contact && !hull_mode && !head)
+            d = std::max(partsLowerBound(a, pa, b, pb, tol, enough, options_.distance_relative_error) - it.padding, d);
+          if (d <= contact && !hull_mode && !head) {
+            const DistanceResult m = meshDistance(a, pa, b, pb, tol, options_.distance_relative_error);
+            d = isFailure(m.status) ? 0.0 : m.lower_bound - it.padding;
           }
-          if (d <= contact) {
+          if (d <= contact && !head) {
             r.report.kind = CollisionReport::Kind::Self;
-            r.report.link = p.a;
-            r.report.other_link = p.b;
+            r.report.link = it.a;
+            r.report.other_link = it.b;
           }
         } else {
-          const int link = env_links[k - n_self];
-          pose(link);
-          const double pad = sc.linkPadding(link);
-          const double cutoff = remaining + pad + contact;
+          const double cutoff = remaining + it.padding + contact;
           // As for pairs: the hull's distance first, the exact geometry only when the hull comes close.
-          const DistanceResult h = sc.environment().linkDistance(*geometry.link(link), poses[link], tol, cutoff, 0.0, 0.0,
+          const DistanceResult h = sc.environment().linkDistance(*it.ga, pa, tol, cutoff, 0.0, 0.0,
                                                                  &ctx.scene.counters.environment, GeometryMode::Hull);
-          d = isFailure(h.status) ? 0.0 : h.lower_bound - pad;
-          if (d <= contact && !hull_mode && !isFailure(h.status)) {
-            const DistanceResult e = sc.environment().linkDistance(*geometry.link(link), poses[link], tol, cutoff, 0.0,
+          d = isFailure(h.status) ? 0.0 : h.lower_bound - it.padding;
+          if (d <= contact && !hull_mode && !head && !isFailure(h.status)) {
+            const DistanceResult e = sc.environment().linkDistance(*it.ga, pa, tol, cutoff, 0.0,
                                                                    options_.distance_relative_error,
                                                                    &ctx.scene.counters.environment);
-            d = isFailure(e.status) ? 0.0 : e.lower_bound - pad;
+            d = isFailure(e.status) ? 0.0 : e.lower_bound - it.padding;
           }
-          if (d <= contact) {
+          if (d <= contact && !head) {
             r.report.kind = CollisionReport::Kind::Environment;
-            r.report.link = link;
+            r.report.link = it.a;
             // Which obstacle or voxel (for the report only): one within the contact distance, widened by
             // the relative error the distance's lower bound was allowed.
-            sc.environment().linkIntersects(*geometry.link(link), poses[link], tol, sc.options().mode,
-                                            pad + (contact + 1e-9) * (1.0 + options_.distance_relative_error),
+            sc.environment().linkIntersects(*it.ga, pa, tol, sc.options().mode,
+                                            it.padding + (contact + 1e-9) * (1.0 + options_.distance_relative_error),
                                             0.0, &r.report.hit);
           }
+        }
+        if (d <= contact && head) {
+          // The merged geometry is near: its members measure themselves from here, exactly (later in this pass).
+          for (int m = it.first; m < it.last; ++m) {
+            ctx.bound[m] = itemBound(items_[m]);
+            ctx.safe_until[m] = s;
+          }
+          ctx.safe_until[k] = 3.0;
+          continue;
         }
         if (d <= contact) {
           r.first_contact = s;
@@ -609,9 +806,8 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
           return r;
         }
         // The static bound and the one from the axes' positions now both hold: the larger step wins.
-        ctx.safe_until[k] = s + (k < n_self ? std::max(d / ctx.bound[k], bound_.pairStep(self_items_[k].a, self_items_[k].b,
-                                                                                        ctx.dq.data(), poses, d))
-                                            : bound_.linkStep(env_links[k - n_self], ctx.dq.data(), poses, d));
+        ctx.safe_until[k] = s + (it.b >= 0 ? std::max(d / ctx.bound[k], bound_.pairStep(it.a, it.b, ctx.dq.data(), poses, d))
+                                           : bound_.linkStep(it.a, ctx.dq.data(), poses, d));
       }
       next = std::min(next, ctx.safe_until[k]);
     }

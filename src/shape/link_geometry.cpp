@@ -491,10 +491,10 @@ template <class S>
 void shapeTrianglesDistance(const S& s, const Pose& shape_in_link, const LinkGeometry& link, const Tolerances& tol,
                             DistanceMin& m, bool shape_is_a, const Pose& link_in_a) {
   if (link.triangles().empty()) return;
-  const Aabb box = shapeBox(s, shape_in_link);
   const std::vector<Triangle>& tris = link.triangles();
-  // The tree is in the link's frame; the results go to A's frame (identity when the shape is B's).
-  link.tree().forEachWithin(box, m.cutoff, [&](std::int32_t i) {
+  // The tree is in the link's frame; the results go to A's frame (identity when the shape is B's). The
+  // shape's own box, turned, prunes far more than its bounds in the link frame (a slab seen askew).
+  link.tree().forEachWithin(shapeBox(s, Pose::identity()), shape_in_link, m.cutoff, [&](std::int32_t i) {
     DistanceResult r = shape_is_a ? gjkDistance(s, shape_in_link, tris[i], Pose::identity(), tol)
                                   : gjkDistance(tris[i], Pose::identity(), s, shape_in_link, tol);
     r.point_a = link_in_a * r.point_a;

@@ -14,11 +14,15 @@
 // move A, the others B; the pair's bound is that of the cheapest such link. If a pair is d apart at s,
 // it cannot touch before s + d / B_pair. Each pair keeps the parameter it is safe until and is measured
 // again only when the segment reaches it, with bounds ever tighter and dearer (balls, hulls, convex
-// parts, triangles) computed only until one certifies the rest of the segment. Every step advances by
+// parts, triangles) computed only until one certifies the rest of the segment. Links joined by joints
+// the group does not move (a gripper on its flange) are one rigid body: two bodies whose every link pair
+// is checked are measured as one item on their merged hulls, and a body against the environment likewise,
+// until the merged hulls come within contact; the member pairs then take over. Every step advances by
 // at least contact_distance / B, so the loop ends; a cap on the number of distance queries ends it too
 // (reported as a collision).
 #include <clearway/scene/scene.h>
 
+#include <memory>
 #include <vector>
 
 namespace clearway {
@@ -26,8 +30,15 @@ namespace clearway {
 /// Per-link and per-pair coefficients of the motion bound of one scene's group.
 class MotionBound {
  public:
+  /// Links that move as one (joined by joints the group does not move), seen as one more link: their
+  /// merged geometry in the frame of the anchor link (the one nearest the root).
+  struct Body {
+    int anchor = 0;
+    const LinkGeometry* geometry = nullptr;
+  };
   /// A planar or floating joint's slides are bounded by the scene's limits of its x, y (and z) entries.
-  explicit MotionBound(const Scene& scene);
+  /// Body k takes the link index scene.robot().linkCount() + k in every call below.
+  explicit MotionBound(const Scene& scene, const std::vector<Body>& bodies = {});
 
   /// Upper bound on how far any point of link `link` moves (world frame) for the state step dq.
   double link(int link, const double* dq) const noexcept;
@@ -58,6 +69,7 @@ class MotionBound {
   void addDynamic(int link, std::size_t from, const double* dq, const Pose* poses, DynamicBound& f) const noexcept;
 
   int dim_ = 0, links_ = 0;
+  std::vector<int> frame_;                        // per link: the link whose pose places it (a body's anchor)
   std::vector<double> link_coef_;                 // links × dim
   std::vector<std::vector<int>> chain_;           // per link: the joints from the root, in order
   std::vector<std::vector<double>> prefix_;       // per link: running sum of step_ along its chain
@@ -123,7 +135,7 @@ struct MotionContext {
   std::vector<double> q, dq;
   std::vector<double> safe_until;  // per item: self pairs, then environment links
   std::vector<double> bound;       // per item: its motion bound for this segment
-  std::vector<SimplexCache> hull_cache;  // per self pair: the hulls' last GJK axis (warm starts, kept across segments)
+  std::vector<SimplexCache> hull_cache;  // per self item: the hulls' last GJK axis (warm starts, kept across segments)
   std::vector<std::uint64_t> pose_stamp;  // per link: the step its pose in scene.poses was computed for
   std::vector<int> pose_path;             // scratch: links whose poses are due, deepest first
   std::vector<Pose> end_poses;            // Cast: the link poses at the segment's end
@@ -155,11 +167,35 @@ class MotionChecker {
   // Cast mode: items that only translate on the segment start from their shape cast's time of impact.
   void castAhead(const double* q0, const double* q1, int n_items, MotionContext& ctx, MotionResult& r) const noexcept;
 
+  // Links that move rigidly together: those with geometry merged, per body of two or more.
+  struct Bodies {
+    std::vector<int> anchor;  // per link: the link nearest the root that it moves rigidly with
+    std::vector<int> index;   // per link: its body in `list` when merged, else -1
+    std::vector<std::unique_ptr<const LinkGeometry>> geometry;
+    std::vector<MotionBound::Body> list;
+  };
+  static Bodies mergeBodies(const Scene& scene);
+  // What certified mode measures: a self pair (b ≥ 0) or a link against the environment (b < 0); or a
+  // group of them (the pairs between two bodies, or one body's links), measured as one on the merged
+  // geometry until it comes within contact, when its members take over.
+  struct Item {
+    int a = -1, b = -1;              // links of the bound (a merged body: past the robot's links)
+    int frame_a = -1, frame_b = -1;  // the links whose poses place them
+    const LinkGeometry* ga = nullptr;
+    const LinkGeometry* gb = nullptr;
+    double padding = 0.0;
+    int first = 0, last = 0;  // a group: its members, items [first, last)
+    int group = -1;           // a member: its group
+  };
+  void buildItems();
+
   std::shared_ptr<const Scene> scene_;
   MotionOptions options_;
+  Bodies bodies_;
   MotionBound bound_;
-  std::vector<LinkPair> self_items_;
-  std::vector<double> self_padding_;
+  std::vector<Item> items_;  // self groups and their members, other self pairs; then the same for the environment
+  int env_begin_ = 0;        // the first environment item
+  CollisionReport rigid_collision_;  // a self pair within one rigid body that collides (then every state does)
   std::vector<int> quaternions_;  // state entries where a floating joint's quaternion starts (qx)
 };
 

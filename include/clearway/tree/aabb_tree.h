@@ -90,8 +90,18 @@ class AabbTree {
   /// true to stop. Every item within the final cutoff is visited.
   template <class F>
   bool forEachWithin(const Aabb& box, double& cutoff, F&& on_item) const;
+  /// The same for an oriented box: `box` in its own frame, placed in the tree's frame by `box_in_tree`.
+  /// Each node is within reach when both its distance to the placed box's bounds and the oriented
+  /// boxes' gap (SAT axes, see OrientedBoxTest::gap) are: a turned slab no longer reaches everything
+  /// inside its axis-aligned bounds.
+  template <class F>
+  bool forEachWithin(const Aabb& box, const Pose& box_in_tree, double& cutoff, F&& on_item) const;
 
  private:
+  // forEachWithin with the node-to-query lower bound `dist(box)`.
+  template <class D, class F>
+  bool forEachWithinBy(D&& dist, double& cutoff, F&& on_item) const;
+
   void build(std::int32_t node, std::int32_t begin, std::int32_t end, int depth, const std::vector<Aabb>& boxes,
              const std::vector<Vec3>& centers, const TreeBuildOptions& options);
   void refitNodes() noexcept;
@@ -202,10 +212,11 @@ class OrientedBoxTest {
   /// 6 face normals and the line through the centres, minus the margin, at least 0 (a gap along any
   /// unit axis never exceeds the distance; the centre line makes the bound tight for distant boxes,
   /// where the face normals see only about 1/√3 of a diagonal offset).
-  double gap(const Aabb& a, const Aabb& b) const noexcept {
+  double gap(const Aabb& a, const Aabb& b) const noexcept { return gap(a, place(b)); }
+  /// The same with B's box placed once (a query against many boxes A).
+  double gap(const Aabb& a, const PlacedB& p) const noexcept {
     double ca[3], ha[3];
     centerHalf(a, ca, ha);
-    const PlacedB p = place(b);
     double T[3], Ta[3], Tba[3];
     double g = -std::numeric_limits<double>::infinity();
     for (int i = 0; i < 3; ++i) {
@@ -268,6 +279,21 @@ bool AabbTree::query(const Aabb& box, F&& on_item) const {
 
 template <class F>
 bool AabbTree::forEachWithin(const Aabb& box, double& cutoff, F&& on_item) const {
+  return forEachWithinBy([&](const Aabb& node) { return boxDistance(node, box); }, cutoff, on_item);
+}
+
+template <class F>
+bool AabbTree::forEachWithin(const Aabb& box, const Pose& box_in_tree, double& cutoff, F&& on_item) const {
+  if (nodes_.empty()) return false;
+  const Aabb bounds = transformed(box, box_in_tree);
+  const detail::OrientedBoxTest test(box_in_tree, 0.0, detail::treePairScale(nodes_[0].box, box, box_in_tree));
+  const detail::OrientedBoxTest::PlacedB placed = test.place(box);
+  return forEachWithinBy([&](const Aabb& node) { return std::max(boxDistance(node, bounds), test.gap(node, placed)); },
+                         cutoff, on_item);
+}
+
+template <class D, class F>
+bool AabbTree::forEachWithinBy(D&& dist, double& cutoff, F&& on_item) const {
   if (nodes_.empty()) return false;
   struct Entry {
     std::int32_t node;
@@ -275,19 +301,17 @@ bool AabbTree::forEachWithin(const Aabb& box, double& cutoff, F&& on_item) const
   };
   Entry stack[kMaxDepth + 1];
   int top = 0;
-  stack[top++] = {0, boxDistance(nodes_[0].box, box)};
+  stack[top++] = {0, dist(nodes_[0].box)};
   while (top > 0) {
     const Entry e = stack[--top];
     if (!(e.dist <= cutoff)) continue;
     const Node& n = nodes_[e.node];
     if (n.isLeaf()) {
       for (std::int32_t s = n.first; s < n.first + n.count; ++s)
-        if ((n.count == 1 || boxDistance(slot_boxes_[s], box) <= cutoff) &&
-            detail::callbackStops(on_item, items_[s]))
-          return true;
+        if ((n.count == 1 || dist(slot_boxes_[s]) <= cutoff) && detail::callbackStops(on_item, items_[s])) return true;
     } else {
-      const Entry l{n.first, boxDistance(nodes_[n.first].box, box)};
-      const Entry r{n.first + 1, boxDistance(nodes_[n.first + 1].box, box)};
+      const Entry l{n.first, dist(nodes_[n.first].box)};
+      const Entry r{n.first + 1, dist(nodes_[n.first + 1].box)};
       // The nearer child goes on top: it is visited first and lowers the cutoff for the other.
       if (l.dist <= r.dist) { stack[top++] = r; stack[top++] = l; }
       else { stack[top++] = l; stack[top++] = r; }
