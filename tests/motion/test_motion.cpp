@@ -177,6 +177,101 @@ TEST(MotionCertified, ThinPostAnalyticContact) {
   EXPECT_GE(back.first_contact, back_touch - 1e-3 / 1.4 / 3.0 * 2);
 }
 
+// A turning arm with a two-fingered gripper on a wrist: the palm and its fingers are fixed together
+// (one rigid body), and so are the base and a tower beside it. Arm from x = 0.15 to 1.15, palm at
+// x = 1.25, fingers from x = 1.28 to 1.48 with inner faces at y = ±0.10 (at pan = wrist = 0).
+const char* kGripperUrdf = R"(<?xml version="1.0"?>
+<robot name="gripper">
+  <link name="base"><collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
+  <link name="tower"><collision><geometry><box size="0.1 0.1 0.6"/></geometry></collision></link>
+  <link name="arm">
+    <collision><origin xyz="0.65 0 0"/><geometry><box size="1.0 0.08 0.08"/></geometry></collision>
+  </link>
+  <link name="palm"><collision><geometry><box size="0.06 0.3 0.08"/></geometry></collision></link>
+  <link name="finger_l"><collision><geometry><box size="0.2 0.04 0.08"/></geometry></collision></link>
+  <link name="finger_r"><collision><geometry><box size="0.2 0.04 0.08"/></geometry></collision></link>
+  <joint name="tower_fix" type="fixed"><parent link="base"/><child link="tower"/><origin xyz="-0.6 0 0"/></joint>
+  <joint name="pan" type="revolute">
+    <parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" velocity="1" effort="1"/>
+  </joint>
+  <joint name="wrist" type="revolute">
+    <parent link="arm"/><child link="palm"/><origin xyz="1.25 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" velocity="1" effort="1"/>
+  </joint>
+  <joint name="finger_l_fix" type="fixed"><parent link="palm"/><child link="finger_l"/><origin xyz="0.13 LEFT 0"/></joint>
+  <joint name="finger_r_fix" type="fixed"><parent link="palm"/><child link="finger_r"/><origin xyz="0.13 -0.12 0"/></joint>
+</robot>
+)";
+
+std::shared_ptr<const Scene> gripperScene(const TempDir& dir, const std::string& obstacle, const std::string& checks,
+                                          const std::string& left = "0.12") {
+  std::string urdf = kGripperUrdf;
+  urdf.replace(urdf.find("LEFT"), 4, left);
+  const std::string file = dir.write("gripper.urdf", urdf);
+  return Scene::load(dir.write("gripper.yaml", "format: 1\nname: gripper\nrobot:\n  urdf: " + file +
+                                                   "\n  group: [pan, wrist]\nenvironment:\n  obstacles:\n    - " +
+                                                   obstacle + "\nchecks: " + checks + "\nstart: [0, 0]\ngoal: [0.02, 0]\n"));
+}
+
+TEST(MotionCertified, RigidBodiesAreOneItemUntilNear) {
+  TempDir dir;
+  // Far from everything: one query per item. The environment sees the arm and the gripper body (not its
+  // three links); self-collision the base body against the gripper body (six link pairs in one), the
+  // tower against the arm, and the arm against each finger (still on this segment: measured once).
+  {
+    const auto scene = gripperScene(dir, "{name: far, box: {size: [0.2, 0.2, 0.2]}, pose: {position: [0, 2.5, 0]}}",
+                                     "[self, environment, continuous]");
+    const MotionChecker certified(scene);
+    MotionContext ctx = certified.makeContext();
+    const double q0[2] = {0, 0}, q1[2] = {0.02, 0};
+    const MotionResult r = certified.check(q0, q1, ctx);
+    EXPECT_TRUE(r.free);
+    EXPECT_EQ(r.distance_queries, 2 + 4) << "link by link it would be 4 + 9";
+  }
+  // A post between the fingers: the gripper's merged hull covers it, so the fingers take over and
+  // decide exactly. Panning ±0.03 keeps the post 38 mm from either finger: free, as dense sampling says.
+  const auto scene = gripperScene(dir, "{name: post, cylinder: {radius: 0.02, length: 1}, pose: {position: [1.4, 0, 0]}}",
+                                   "[environment, continuous]");
+  const MotionChecker certified(scene);
+  const MotionChecker fine(scene, sampled(1e-3));
+  MotionContext ctx = certified.makeContext(), fc = fine.makeContext();
+  const double a0[2] = {-0.03, 0}, a1[2] = {0.03, 0};
+  const MotionResult straddle = certified.check(a0, a1, ctx);
+  EXPECT_TRUE(fine.check(a0, a1, fc).free);
+  EXPECT_TRUE(straddle.free);
+  EXPECT_GT(straddle.distance_queries, 2) << "the merged hull touches the post: the fingers must be measured";
+  // Panning on to 0.1 brings the right finger's inner face onto the post: in the palm's frame the post's
+  // centre is at y = −1.4·sin(pan), so the gap 0.10 − 0.02 closes at pan = asin(0.08 / 1.4).
+  const double b1[2] = {0.1, 0};
+  const MotionResult hit = certified.check(a0, b1, ctx);
+  ASSERT_FALSE(hit.free);
+  EXPECT_EQ(hit.report.kind, CollisionReport::Kind::Environment);
+  EXPECT_EQ(hit.report.link, scene->robot().linkIndex("finger_r")) << "a member link is reported, never the body";
+  const auto s_at = [](double gap) { return (std::asin((0.08 - gap) / 1.4) + 0.03) / 0.13; };
+  EXPECT_LE(hit.first_contact, s_at(0.0) + 1e-9);
+  EXPECT_GE(hit.first_contact, s_at(certified.options().contact_distance) - 1e-9);
+  EXPECT_LE(hit.first_contact, fine.check(a0, b1, fc).first_contact + 1e-9);
+}
+
+TEST(MotionCertified, RigidPairThatOverlapsCollidesEverywhere) {
+  // Both fingers at y = −0.12: they overlap, and no joint of the group can part them.
+  TempDir dir;
+  const auto scene = gripperScene(dir, "{name: far, box: {size: [0.2, 0.2, 0.2]}, pose: {position: [0, 2.5, 0]}}",
+                                   "[self, continuous]", "-0.12");
+  const MotionChecker certified(scene);
+  MotionContext ctx = certified.makeContext();
+  const double q0[2] = {0, 0}, q1[2] = {1, -1};
+  const MotionResult r = certified.check(q0, q1, ctx);
+  ASSERT_FALSE(r.free);
+  EXPECT_EQ(r.first_contact, 0.0);
+  EXPECT_EQ(r.last_valid, 0.0);
+  EXPECT_EQ(r.report.kind, CollisionReport::Kind::Self);
+  const int l = scene->robot().linkIndex("finger_l"), rr = scene->robot().linkIndex("finger_r");
+  EXPECT_EQ(std::minmax(r.report.link, r.report.other_link), std::minmax(l, rr));
+  EXPECT_FALSE(scene->isFree(std::vector<double>{0.5, 0.5})) << "the discrete check agrees";
+}
+
 TEST(MotionCertified, RandomSegmentsNeverMissWhatDenseSamplingFinds) {
   // The planar arm among two posts: random segments between free states. Dense sampling finding a
   // collision means the certified check must find one, no later along the segment.

@@ -1,6 +1,7 @@
 // Aabb operations and AabbTree: build invariants for both splits and every leaf size, box queries,
 // tree-vs-tree descent and the distance-pruned traversals against brute force over random cases
 // (fixed seeds), refit.
+#include <clearway/narrowphase/gjk.h>
 #include <clearway/tree/aabb_tree.h>
 
 #include <gtest/gtest.h>
@@ -274,6 +275,42 @@ TEST(AabbTree, ForEachWithinFindsTheNearestBox) {
           if (boxDistance(boxes[i], query) <= 0.3) ASSERT_TRUE(found.count(static_cast<int>(i))) << i;
       }
     }
+}
+
+TEST(AabbTree, ForEachWithinAnOrientedBoxMissesNoBoxWithinTheCutoff) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-3.0, 3.0), h(0.0, 0.6), angle(-M_PI, M_PI);
+  const std::vector<Aabb> boxes = randomBoxes(rng, 300);
+  const AabbTree tree(boxes, {TreeSplit::Sah, 3});
+  for (int q = 0; q < 300; ++q) {
+    const Vec3 half(h(rng), h(rng), 0.01 + h(rng));
+    const Aabb local = Aabb::fromCenterHalf(Vec3::Zero(), half);
+    const Pose pose{Mat3(Eigen::AngleAxisd(angle(rng), Vec3(u(rng), u(rng), u(rng)).normalized())),
+                    Vec3(u(rng), u(rng), u(rng))};
+    double cutoff = 0.25;
+    std::set<int> found;
+    tree.forEachWithin(local, pose, cutoff, [&](int item) { found.insert(item); });
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+      const Vec3 c = 0.5 * (boxes[i].min + boxes[i].max), bh = 0.5 * (boxes[i].max - boxes[i].min);
+      const DistanceResult d = gjkDistance(Box(half), pose, Box(bh), Pose{Mat3::Identity(), c});
+      if (d.distance <= 0.25 - 1e-9) ASSERT_TRUE(found.count(static_cast<int>(i))) << "query " << q << " box " << i;
+    }
+  }
+  // A slab turned 45° about z reaches everything inside its axis-aligned bounds, but only the boxes along
+  // its diagonal are near it.
+  std::vector<Aabb> grid;
+  for (int x = -10; x <= 10; ++x)
+    for (int y = -10; y <= 10; ++y) grid.push_back(Aabb::fromCenterHalf(Vec3(0.1 * x, 0.1 * y, 0), Vec3::Constant(0.01)));
+  const AabbTree flat(grid, {});
+  const Aabb slab = Aabb::fromCenterHalf(Vec3::Zero(), Vec3(1.5, 0.005, 0.5));
+  const Pose turned{Mat3(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitZ())), Vec3::Zero()};
+  int oriented = 0, aligned = 0;
+  double c1 = 0.02, c2 = 0.02;
+  flat.forEachWithin(slab, turned, c1, [&](int) { ++oriented; });
+  flat.forEachWithin(transformed(slab, turned), c2, [&](int) { ++aligned; });
+  EXPECT_EQ(aligned, 21 * 21);
+  EXPECT_LE(oriented, 3 * 21) << "the turned slab's own axes prune the grid off its diagonal";
+  EXPECT_GE(oriented, 21);
 }
 
 // ---- Tree vs tree ----------------------------------------------------------------------------------------
