@@ -769,10 +769,10 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
         } else {
           const double cutoff = remaining + it.padding + contact;
           // As for pairs: the hull's distance first, the exact geometry only when the hull comes close.
-          const DistanceResult h = sc.environment().linkDistance(*it.ga, pa, tol, cutoff, 0.0, 0.0,
-                                                                 &ctx.scene.counters.environment, GeometryMode::Hull);
-          d = isFailure(h.status) ? 0.0 : h.lower_bound - it.padding;
-          if (d <= contact && !hull_mode && !head && !isFailure(h.status)) {
+          const double h = sc.environment().hullLowerBound(*it.ga, pa, tol, cutoff, options_.distance_relative_error, 0.0,
+                                                           &ctx.scene.counters.environment);
+          d = h - it.padding;
+          if (d <= contact && !hull_mode && !head && h > 0.0) {
             const DistanceResult e = sc.environment().linkDistance(*it.ga, pa, tol, cutoff, 0.0,
                                                                    options_.distance_relative_error,
                                                                    &ctx.scene.counters.environment);

@@ -93,6 +93,14 @@ class Environment {
                               double relative_error = 0.0, EnvironmentCounters* counters = nullptr,
                               GeometryMode mode = GeometryMode::Mesh) const noexcept;
 
+  /// A certified lower bound on the distance from the link's convex hull to the nearest obstacle (a mesh
+  /// obstacle's hull) or voxel, computed only as far as `enough`: the answer is at least `enough` when
+  /// nothing is nearer. One GJK per item within reach of the link's oriented box, each stopping once it
+  /// proves the item beyond the nearest so far, or within `relative` of its distance. Conservative
+  /// advancement needs no more. 0 for non-finite input or when the hull touches.
+  double hullLowerBound(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, double enough,
+                        double relative, double t = 0.0, EnvironmentCounters* counters = nullptr) const noexcept;
+
   /// For a link translating by s·velocity (world frame), s ∈ [0, max_s], with its convex hull grown by
   /// `margin`: a certified lower bound on the first s at which it touches an obstacle (its hull, for a mesh
   /// obstacle) or an occupied voxel, obstacles held where they are at time t; +∞ when nothing is touched
