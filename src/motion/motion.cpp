@@ -555,6 +555,7 @@ MotionContext MotionChecker::makeContext() const {
   c.hull_cache.resize(env_begin_);
   c.pose_stamp.assign(scene_->robot().linkCount(), 0);
   c.pose_path.reserve(scene_->robot().linkCount());
+  c.intervals.reserve(256);
   if (options_.mode == MotionMode::Cast) c.end_poses.resize(scene_->robot().linkCount());
   return c;
 }
@@ -663,15 +664,187 @@ void MotionChecker::castAhead(const double* q0, const double* q1, int n_items, M
   }
 }
 
+// One certified check in progress. Each item covers [0, limit] on its own with balls: a clearance d
+// measured at s clears s ± d / B (B the item's motion bound; or the larger reach its axes allow). An
+// interval is measured at its middle, and what the ball leaves uncovered on either side is an interval
+// again, left first; a measurement within contact_distance makes the item step from the interval's left
+// end by conservative advancement to its first contact, which becomes the limit: nothing after it
+// matters to any item. So a free segment costs about one measurement per ball of twice the radius that
+// advancement alone would use, and the first contact is exact all the same.
+struct MotionChecker::Sweep {
+  const MotionChecker& mc;
+  MotionContext& ctx;
+  MotionResult& r;
+  const double* q0;
+  const double* q1;
+  double limit = 1.0;         // the first contact found so far, or the segment's end
+  bool hit = false;           // a contact at `limit`
+  double clear_before = 0.0;  // a parameter before `limit` the contacting item was measured clear at
+  bool capped = false;
+  int contacts = 0;           // how often the limit was lowered
+  double at_s = -1.0;         // the parameter ctx.scene.q holds
+
+  Sweep(const MotionChecker& checker, MotionContext& c, MotionResult& result, const double* from, const double* to)
+      : mc(checker), ctx(c), r(result), q0(from), q1(to) {
+    ctx.scene.poses[0] = Pose::identity();
+  }
+
+  // The link's pose (and its ancestors') at parameter s.
+  const Pose& pose(double s, int link) {
+    if (s != at_s) {
+      mc.interpolate(q0, q1, s, ctx.q.data());
+      const std::vector<int>& group = mc.scene_->groupVariables();
+      for (std::size_t i = 0; i < group.size(); ++i) ctx.scene.q[group[i]] = ctx.q[i];
+      ++ctx.step_stamp;
+      ++r.steps;
+      at_s = s;
+    }
+    const RobotModel& model = mc.scene_->robot();
+    Pose* poses = ctx.scene.poses.data();
+    for (int l = link; l > 0 && ctx.pose_stamp[l] != ctx.step_stamp; l = model.parentLink(l)) ctx.pose_path.push_back(l);
+    for (; !ctx.pose_path.empty(); ctx.pose_path.pop_back()) {
+      computeLinkPose(model, ctx.scene.q.data(), poses, ctx.pose_path.back());
+      ctx.pose_stamp[ctx.pose_path.back()] = ctx.step_stamp;
+    }
+    return poses[link];
+  }
+
+  // A certified lower bound on item k's clearance at s (padding removed), computed only as far as `need`
+  // (beyond it, the answer only has to say so). A contact fills `report`.
+  double measure(int k, double s, double need, CollisionReport& report) {
+    const Scene& sc = *mc.scene_;
+    const Tolerances& tol = sc.options().tolerances;
+    const double contact = mc.options_.contact_distance, relative = mc.options_.distance_relative_error;
+    const bool exact = sc.options().mode != GeometryMode::Hull;
+    const Item& it = mc.items_[k];
+    const bool head = it.last > it.first;  // a group stops at the merged hulls: its members decide the rest
+    ++r.distance_queries;
+    need = std::max(need, 2.0 * contact);  // a clearance must exceed the contact distance to count
+    const Pose pa = pose(s, it.frame_a);
+    double d;
+    if (it.b >= 0) {
+      const Pose& pb = pose(s, it.frame_b);
+      const LinkGeometry& a = *it.ga;
+      const LinkGeometry& b = *it.gb;
+      // Ever tighter and dearer lower bounds, each only when the one before falls short of `enough`: the
+      // bounding balls, the hulls (warm-started GJK), the convex parts, and last the triangles.
+      const double enough = need + it.padding;
+      double lower = (pa * a.sphereCenter() - pb * b.sphereCenter()).norm() - a.sphereRadius() - b.sphereRadius();
+      if (!(lower >= enough))  // (the GJK bound first in max(): it is a number even if the balls' is not)
+        lower = std::max(gjkLowerBound(a.hull(), pa, b.hull(), pb, tol, ctx.hull_cache[k], enough, relative), lower);
+      d = lower - it.padding;
+      if (d <= contact && exact && !head) d = std::max(partsLowerBound(a, pa, b, pb, tol, enough, relative) - it.padding, d);
+      if (d <= contact && exact && !head) {
+        const DistanceResult m = meshDistance(a, pa, b, pb, tol, relative);
+        d = isFailure(m.status) ? 0.0 : m.lower_bound - it.padding;
+      }
+      if (d <= contact && !head) {
+        report = CollisionReport{};
+        report.kind = CollisionReport::Kind::Self;
+        report.link = it.a;
+        report.other_link = it.b;
+      }
+    } else {
+      const double cutoff = need + it.padding + contact;
+      // As for pairs: the hull's bound first, the exact geometry only when the hull comes close.
+      const double h = sc.environment().hullLowerBound(*it.ga, pa, tol, cutoff, relative, 0.0, &ctx.scene.counters.environment);
+      d = h - it.padding;
+      if (d <= contact && exact && !head && h > 0.0) {
+        const DistanceResult e =
+            sc.environment().linkDistance(*it.ga, pa, tol, cutoff, 0.0, relative, &ctx.scene.counters.environment);
+        d = isFailure(e.status) ? 0.0 : e.lower_bound - it.padding;
+      }
+      if (d <= contact && !head) {
+        report = CollisionReport{};
+        report.kind = CollisionReport::Kind::Environment;
+        report.link = it.a;
+        // Which obstacle or voxel (for the report only): one within the contact distance, widened by the
+        // relative error the distance's lower bound was allowed.
+        sc.environment().linkIntersects(*it.ga, pa, tol, sc.options().mode,
+                                        it.padding + (contact + 1e-9) * (1.0 + relative), 0.0, &report.hit);
+      }
+    }
+    if (r.distance_queries >= mc.options_.max_queries) capped = true;
+    return d;
+  }
+
+  // How far from s a clearance d of item k reaches, either way.
+  double reach(int k, double d) {
+    const Item& it = mc.items_[k];
+    const double* dq = ctx.dq.data();
+    const Pose* poses = ctx.scene.poses.data();  // (at the parameter d was measured at)
+    return it.b >= 0 ? std::max(d / ctx.bound[k], mc.bound_.pairStep(it.a, it.b, dq, poses, d))
+                     : mc.bound_.linkStep(it.a, dq, poses, d);
+  }
+
+  // Covers [a, b] ∩ [0, limit] for item k (all of [0, a) is covered already).
+  void cover(int k, double a, double b, double witness) {
+    const Item& it = mc.items_[k];
+    const std::size_t base = ctx.intervals.size();
+    ctx.intervals.push_back({a, b, witness});
+    CollisionReport report;
+    while (ctx.intervals.size() > base && !capped) {
+      const MotionContext::Interval iv = ctx.intervals.back();
+      ctx.intervals.pop_back();
+      const double hi = std::min(iv.b, limit);
+      if (iv.a > hi || (hit && iv.a >= hi)) continue;
+      const double m = 0.5 * (iv.a + hi);
+      const double d = measure(k, m, ctx.bound[k] * 0.5 * (hi - iv.a), report);
+      if (d <= mc.options_.contact_distance) {
+        if (it.last > it.first) {  // a group within contact: its members take over here, exactly
+          for (int member = it.first; member < it.last && !capped; ++member) {
+            ctx.bound[member] = mc.itemBound(mc.items_[member], ctx.dq.data());
+            cover(member, iv.a, hi, iv.witness);
+          }
+          continue;
+        }
+        if (advance(k, iv.a, iv.witness, hi)) {
+          ctx.intervals.resize(base);  // all to the right of the contact
+          return;
+        }
+        continue;
+      }
+      const double rad = reach(k, d);
+      if (m + rad < hi) ctx.intervals.push_back({m + rad, hi, m});
+      if (m - rad > iv.a) ctx.intervals.push_back({iv.a, m - rad, iv.witness});
+    }
+    ctx.intervals.resize(base);
+  }
+
+  // Conservative advancement of item k from a (clear at `witness`) towards `until`: true when it meets a
+  // contact there (which becomes the limit); false when [a, until] is clear.
+  bool advance(int k, double a, double witness, double until) {
+    CollisionReport report;
+    double s = a, prev = std::max(witness, 0.0);
+    while (!capped) {
+      const double d = measure(k, s, ctx.bound[k] * (until - s), report);
+      if (d <= mc.options_.contact_distance) {
+        if (!hit || s < limit) {
+          limit = s;
+          hit = true;
+          ++contacts;
+          clear_before = prev;
+          r.report = report;
+        }
+        return true;
+      }
+      prev = s;
+      s += reach(k, d);  // at least contact_distance / B: the loop ends
+      if (!(s < until)) return false;
+    }
+    return false;
+  }
+};
+
+double MotionChecker::itemBound(const Item& it, const double* dq) const noexcept {
+  return it.b >= 0 ? bound_.pair(it.a, it.b, dq) : bound_.link(it.a, dq);
+}
+
 MotionResult MotionChecker::certified(const double* q0, const double* q1, MotionContext& ctx) const noexcept {
   MotionResult r;
   const Scene& sc = *scene_;
-  const Tolerances& tol = sc.options().tolerances;
-  const double contact = options_.contact_distance;
-  const bool hull_mode = sc.options().mode == GeometryMode::Hull;
-  r.steps = 1;
-  // q0's collisions are found by the advancement's first step (every item is measured at s = 0), except
-  // those no state changes. (first_contact = last_valid = 0)
+  // q0's collisions are found by the items' coverage of the segment, except those no state changes.
+  // (first_contact = last_valid = 0)
   if (!sc.validState(q0)) {
     r.report.kind = CollisionReport::Kind::Invalid;
     return r;
@@ -697,135 +870,53 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
 
   const bool check_env = sc.effects().environment && !sc.environment().empty();
   const int n_items = check_env ? static_cast<int>(items_.size()) : env_begin_;
-  const auto itemBound = [&](const Item& it) {
-    return it.b >= 0 ? bound_.pair(it.a, it.b, ctx.dq.data()) : bound_.link(it.a, ctx.dq.data());
-  };
-  // Members wait (at 3) until their group comes within contact.
+  // Members wait until their group comes within contact.
   for (int k = 0; k < n_items; ++k) {
-    if (items_[k].group >= 0) {
-      ctx.safe_until[k] = 3.0;
-      continue;
-    }
-    ctx.bound[k] = itemBound(items_[k]);  // (one that does not move on this segment: measured at s = 0 only)
+    if (items_[k].group >= 0) continue;
+    ctx.bound[k] = itemBound(items_[k], ctx.dq.data());  // (0 when still on this segment: measured once)
     ctx.safe_until[k] = 0.0;
   }
 
-  const RobotModel& model = sc.robot();
-  const std::vector<int>& group = sc.groupVariables();
   if (options_.mode == MotionMode::Cast) castAhead(q0, q1, n_items, ctx, r);
-  // A step usually measures one or two items: only their links' poses (and their ancestors') are computed.
-  Pose* poses = ctx.scene.poses.data();
-  poses[0] = Pose::identity();
-  const auto pose = [&](int link) {
-    for (int l = link; l > 0 && ctx.pose_stamp[l] != ctx.step_stamp; l = model.parentLink(l)) ctx.pose_path.push_back(l);
-    for (; !ctx.pose_path.empty(); ctx.pose_path.pop_back()) {
-      computeLinkPose(model, ctx.scene.q.data(), poses, ctx.pose_path.back());
-      ctx.pose_stamp[ctx.pose_path.back()] = ctx.step_stamp;
-    }
-  };
-  double s = 0.0, last_certified = 0.0;
-  while (true) {
-    interpolate(q0, q1, s, ctx.q.data());
-    for (std::size_t i = 0; i < group.size(); ++i) ctx.scene.q[group[i]] = ctx.q[i];
-    ++ctx.step_stamp;
-    double next = 2.0;
-    for (int k = 0; k < n_items; ++k) {
-      if (ctx.safe_until[k] <= s) {
-        const Item& it = items_[k];
-        const bool head = it.last > it.first;
-        // How far this item can still move on the rest of the segment: nothing farther matters, except
-        // that a clearance must exceed the contact distance to count (an item that stays still).
-        const double remaining = std::max(ctx.bound[k] * (1.0 - s), 2.0 * contact);
-        double d;  // a certified lower bound on the clearance (padding removed)
-        ++r.distance_queries;
-        pose(it.frame_a);
-        const Pose& pa = poses[it.frame_a];
-        if (it.b >= 0) {
-          pose(it.frame_b);
-          const Pose& pb = poses[it.frame_b];
-          const LinkGeometry& a = *it.ga;
-          const LinkGeometry& b = *it.gb;
-          // Ever tighter and dearer lower bounds, each only when the one before cannot certify the rest of
-          // the segment (`enough`), and computed only as far as that needs: the bounding balls, the
-          // hulls (warm-started GJK), the convex parts, and last the triangles. A group stops at the hulls.
-          const double enough = remaining + it.padding;
-          double lower = (pa * a.sphereCenter() - pb * b.sphereCenter()).norm() - a.sphereRadius() - b.sphereRadius();
-          if (!(lower >= enough))  // (the GJK bound first in max(): it is a number even if the balls' is not)
-            lower = std::max(gjkLowerBound(a.hull(), pa, b.hull(), pb, tol, ctx.hull_cache[k], enough,
-                                           options_.distance_relative_error),
-                             lower);
-          d = lower - it.padding;
-          if (d <= contact && !hull_mode && !head)
-            d = std::max(partsLowerBound(a, pa, b, pb, tol, enough, options_.distance_relative_error) - it.padding, d);
-          if (d <= contact && !hull_mode && !head) {
-            const DistanceResult m = meshDistance(a, pa, b, pb, tol, options_.distance_relative_error);
-            d = isFailure(m.status) ? 0.0 : m.lower_bound - it.padding;
-          }
-          if (d <= contact && !head) {
-            r.report.kind = CollisionReport::Kind::Self;
-            r.report.link = it.a;
-            r.report.other_link = it.b;
-          }
-        } else {
-          const double cutoff = remaining + it.padding + contact;
-          // As for pairs: the hull's distance first, the exact geometry only when the hull comes close.
-          const double h = sc.environment().hullLowerBound(*it.ga, pa, tol, cutoff, options_.distance_relative_error, 0.0,
-                                                           &ctx.scene.counters.environment);
-          d = h - it.padding;
-          if (d <= contact && !hull_mode && !head && h > 0.0) {
-            const DistanceResult e = sc.environment().linkDistance(*it.ga, pa, tol, cutoff, 0.0,
-                                                                   options_.distance_relative_error,
-                                                                   &ctx.scene.counters.environment);
-            d = isFailure(e.status) ? 0.0 : e.lower_bound - it.padding;
-          }
-          if (d <= contact && !head) {
-            r.report.kind = CollisionReport::Kind::Environment;
-            r.report.link = it.a;
-            // Which obstacle or voxel (for the report only): one within the contact distance, widened by
-            // the relative error the distance's lower bound was allowed.
-            sc.environment().linkIntersects(*it.ga, pa, tol, sc.options().mode,
-                                            it.padding + (contact + 1e-9) * (1.0 + options_.distance_relative_error),
-                                            0.0, &r.report.hit);
-          }
-        }
-        if (d <= contact && head) {
-          // The merged geometry is near: its members measure themselves from here, exactly (later in this pass).
-          for (int m = it.first; m < it.last; ++m) {
-            ctx.bound[m] = itemBound(items_[m]);
-            ctx.safe_until[m] = s;
-          }
-          ctx.safe_until[k] = 3.0;
-          continue;
-        }
-        if (d <= contact) {
-          r.first_contact = s;
-          // The state at s is within contact_distance of touching: if it is still free, it is the last
-          // valid one; otherwise the last parameter every item had certified.
-          r.last_valid = sc.isFree(ctx.q.data(), ctx.scene) ? s : last_certified;
-          r.free = false;
-          return r;
-        }
-        // The static bound and the one from the axes' positions now both hold: the larger step wins.
-        ctx.safe_until[k] = s + (it.b >= 0 ? std::max(d / ctx.bound[k], bound_.pairStep(it.a, it.b, ctx.dq.data(), poses, d))
-                                           : bound_.linkStep(it.a, ctx.dq.data(), poses, d));
-      }
-      next = std::min(next, ctx.safe_until[k]);
-    }
-    last_certified = s;
-    ++r.steps;
-    if (next >= 1.0) break;
-    if (r.distance_queries >= options_.max_queries) {
-      r.capped = true;
-      r.first_contact = r.last_valid = s;
-      r.report = CollisionReport{};
-      r.report.kind = CollisionReport::Kind::Invalid;
-      return r;
-    }
-    s = next;
+  Sweep sweep{*this, ctx, r, q0, q1};
+  // The item that met the last contact goes first: a planner's next segment often meets it again, and a
+  // contact found early bounds every other item's work.
+  const int lead = ctx.lead >= 0 && ctx.lead < n_items ? ctx.lead : -1;
+  for (int n = -1; n < n_items && !sweep.capped; ++n) {
+    const int k = n < 0 ? lead : n;
+    if (k < 0 || (n >= 0 && k == lead) || items_[k].group >= 0) continue;
+    const double start = ctx.safe_until[k];  // 0, or where a shape cast says the item is clear until
+    if (start > 1.0) continue;
+    const int before = sweep.contacts;
+    sweep.cover(k, start, 1.0, start > 0.0 ? start : -1.0);
+    if (sweep.contacts > before) ctx.lead = k;
+  }
+  if (sweep.capped) {
+    r.capped = true;
+    r.first_contact = r.last_valid = 0.0;
+    r.report = CollisionReport{};
+    r.report.kind = CollisionReport::Kind::Invalid;
+    return r;
+  }
+  if (sweep.hit) {
+    r.free = false;
+    r.first_contact = sweep.limit;
+    // The state at the contact is within contact_distance of touching: if it is still free, it is the last
+    // valid one; otherwise the last parameter the contacting item was measured clear at.
+    interpolate(q0, q1, sweep.limit, ctx.q.data());
+    r.last_valid = sc.isFree(ctx.q.data(), ctx.scene) ? sweep.limit : sweep.clear_before;
+    return r;
   }
   if (end_invalid) {
+    // Clear all the way, but the end is out of bounds: valid up to where the segment leaves them.
     r.first_contact = 1.0;
-    r.last_valid = last_certified;
+    r.last_valid = 1.0;
+    for (int i = 0; i < sc.dimension(); ++i) {
+      const double lo = sc.lower(i) - kJointLimitTolerance, hi = sc.upper(i) + kJointLimitTolerance;
+      if (q1[i] > hi && ctx.dq[i] > 0.0) r.last_valid = std::min(r.last_valid, (hi - q0[i]) / ctx.dq[i]);
+      if (q1[i] < lo && ctx.dq[i] < 0.0) r.last_valid = std::min(r.last_valid, (lo - q0[i]) / ctx.dq[i]);
+    }
+    r.last_valid = std::clamp(r.last_valid, 0.0, 1.0);
     r.report = CollisionReport{};
     r.report.kind = CollisionReport::Kind::Invalid;
     return r;

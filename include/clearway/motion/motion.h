@@ -12,14 +12,17 @@
 // turn it by at most π/√2 times their change. Two links of one robot move relative to each other only through the joints on
 // the path between them, and may be watched from any link on that path: the joints on one side of it
 // move A, the others B; the pair's bound is that of the cheapest such link. If a pair is d apart at s,
-// it cannot touch before s + d / B_pair. Each pair keeps the parameter it is safe until and is measured
-// again only when the segment reaches it, with bounds ever tighter and dearer (balls, hulls, convex
-// parts, triangles) computed only until one certifies the rest of the segment. Links joined by joints
-// the group does not move (a gripper on its flange) are one rigid body: two bodies whose every link pair
-// is checked are measured as one item on their merged hulls, and a body against the environment likewise,
-// until the merged hulls come within contact; the member pairs then take over. Every step advances by
-// at least contact_distance / B, so the loop ends; a cap on the number of distance queries ends it too
-// (reported as a collision).
+// it cannot touch within s ± d / B_pair. Each item (a pair, or a link against the environment) covers
+// the segment on its own with such balls: measured at the middle of what is left, it leaves up to two
+// shorter intervals, left first, so a free segment costs one measurement per ball twice as wide as
+// one-sided advancement's. A measurement within contact_distance switches the item to advancement from
+// the interval's left end, whose first contact then bounds every item's work (nothing after it matters).
+// Bounds get tighter and dearer (balls, hulls, convex parts, triangles) only until one clears what is
+// asked. Links joined by joints the group does not move (a gripper on its flange) are one rigid body:
+// two bodies whose every link pair is checked are measured as one item on their merged hulls, and a body
+// against the environment likewise, until the merged hulls come within contact; the member pairs then
+// cover that interval. Every ball is at least contact_distance / B wide, so the loops end; a cap on the
+// number of distance queries ends them too (reported as a collision).
 #include <clearway/scene/scene.h>
 
 #include <memory>
@@ -133,13 +136,19 @@ struct MotionResult {
 struct MotionContext {
   SceneContext scene;
   std::vector<double> q, dq;
-  std::vector<double> safe_until;  // per item: self pairs, then environment links
+  std::vector<double> safe_until;  // per item: where its coverage starts (Cast: where its shape cast reached)
   std::vector<double> bound;       // per item: its motion bound for this segment
   std::vector<SimplexCache> hull_cache;  // per self item: the hulls' last GJK axis (warm starts, kept across segments)
   std::vector<std::uint64_t> pose_stamp;  // per link: the step its pose in scene.poses was computed for
   std::vector<int> pose_path;             // scratch: links whose poses are due, deepest first
   std::vector<Pose> end_poses;            // Cast: the link poses at the segment's end
   std::uint64_t step_stamp = 0;
+  struct Interval {
+    double a, b;
+    double witness;  // a parameter ≤ a the item was measured clear at (−1: none)
+  };
+  std::vector<Interval> intervals;  // scratch: what items have yet to cover
+  int lead = -1;                    // the item that met the last contact: measured first
 };
 
 /// Checks the segment. Both ends must be states of the scene's dimension; an invalid state (NaN, out
@@ -188,6 +197,8 @@ class MotionChecker {
     int group = -1;           // a member: its group
   };
   void buildItems();
+  double itemBound(const Item& item, const double* dq) const noexcept;
+  struct Sweep;  // motion.cpp
 
   std::shared_ptr<const Scene> scene_;
   MotionOptions options_;
