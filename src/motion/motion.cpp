@@ -552,6 +552,7 @@ MotionContext MotionChecker::makeContext() const {
   c.dq.resize(scene_->dimension());
   c.safe_until.resize(items_.size());
   c.bound.resize(items_.size());
+  c.first_reach.resize(items_.size());
   c.hull_cache.resize(env_begin_);
   c.pose_stamp.assign(scene_->robot().linkCount(), 0);
   c.pose_path.reserve(scene_->robot().linkCount());
@@ -735,7 +736,8 @@ struct MotionChecker::Sweep {
       d = lower - it.padding;
       if (d <= contact && exact && !head) d = std::max(partsLowerBound(a, pa, b, pb, tol, enough, relative) - it.padding, d);
       if (d <= contact && exact && !head) {
-        const DistanceResult m = meshDistance(a, pa, b, pb, tol, relative);
+        // The convex pieces are within contact: the triangles are near, and measuring them far costs dear.
+        const DistanceResult m = meshDistance(a, pa, b, pb, tol, relative, std::min(enough, it.padding + 8.0 * contact));
         d = isFailure(m.status) ? 0.0 : m.lower_bound - it.padding;
       }
       if (d <= contact && !head) {
@@ -775,6 +777,13 @@ struct MotionChecker::Sweep {
     const Pose* poses = ctx.scene.poses.data();  // (at the parameter d was measured at)
     return it.b >= 0 ? std::max(d / ctx.bound[k], mc.bound_.pairStep(it.a, it.b, dq, poses, d))
                      : mc.bound_.linkStep(it.a, dq, poses, d);
+  }
+
+  // How far either way from s item k is clear, measured for the interval s ± half; −1 within contact.
+  double first(int k, double s, double half) {
+    CollisionReport unused;
+    const double d = measure(k, s, ctx.bound[k] * half, unused);
+    return d <= mc.options_.contact_distance ? -1.0 : reach(k, d);
   }
 
   // Covers [a, b] ∩ [0, limit] for item k (all of [0, a) is covered already).
@@ -881,15 +890,31 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
   Sweep sweep{*this, ctx, r, q0, q1};
   // The item that met the last contact goes first: a planner's next segment often meets it again, and a
   // contact found early bounds every other item's work.
-  const int lead = ctx.lead >= 0 && ctx.lead < n_items ? ctx.lead : -1;
-  for (int n = -1; n < n_items && !sweep.capped; ++n) {
-    const int k = n < 0 ? lead : n;
-    if (k < 0 || (n >= 0 && k == lead) || items_[k].group >= 0) continue;
+  const int lead = ctx.lead >= 0 && ctx.lead < n_items && items_[ctx.lead].group < 0 ? ctx.lead : -1;
+  const auto cover = [&](int k, double a, double b, double witness) {
+    const int before = sweep.contacts;
+    sweep.cover(k, a, b, witness);
+    if (sweep.contacts > before) ctx.lead = k;
+  };
+  if (lead >= 0 && ctx.safe_until[lead] <= 1.0)
+    cover(lead, ctx.safe_until[lead], 1.0, ctx.safe_until[lead] > 0.0 ? ctx.safe_until[lead] : -1.0);
+  // Every other item is first measured in the middle of what is left, where one set of poses serves all.
+  const double mid = 0.5 * sweep.limit;
+  for (int k = 0; k < n_items && !sweep.capped; ++k)
+    if (k != lead && items_[k].group < 0 && ctx.safe_until[k] == 0.0) ctx.first_reach[k] = sweep.first(k, mid, mid);
+  for (int k = 0; k < n_items && !sweep.capped; ++k) {
+    if (k == lead || items_[k].group >= 0) continue;
     const double start = ctx.safe_until[k];  // 0, or where a shape cast says the item is clear until
     if (start > 1.0) continue;
-    const int before = sweep.contacts;
-    sweep.cover(k, start, 1.0, start > 0.0 ? start : -1.0);
-    if (sweep.contacts > before) ctx.lead = k;
+    if (start > 0.0) {
+      cover(k, start, 1.0, start);
+    } else if (ctx.first_reach[k] < 0.0) {
+      cover(k, 0.0, 1.0, -1.0);  // within contact in the middle: from the start, exactly
+    } else {  // what the ball in the middle leaves, left first
+      const double rad = ctx.first_reach[k];
+      if (mid - rad > 0.0) cover(k, 0.0, mid - rad, -1.0);
+      if (mid + rad < sweep.limit) cover(k, mid + rad, 1.0, mid);
+    }
   }
   if (sweep.capped) {
     r.capped = true;

@@ -438,9 +438,10 @@ struct DistanceMin {
   double shrink = 1.0;
   bool failed = false;
 
-  explicit DistanceMin(double relative_error) : shrink(1.0 / (1.0 + relative_error)) {
-    best.distance = std::numeric_limits<double>::infinity();
-    best.lower_bound = std::numeric_limits<double>::infinity();
+  explicit DistanceMin(double relative_error, double limit = std::numeric_limits<double>::infinity())
+      : cutoff(limit), shrink(1.0 / (1.0 + relative_error)) {
+    best.distance = limit;
+    best.lower_bound = limit;
     best.status = Status::Separated;
   }
   // The result in the world, given the frame the search ran in: a failure carries no certificate, and
@@ -507,14 +508,15 @@ void shapeTrianglesDistance(const S& s, const Pose& shape_in_link, const LinkGeo
 }  // namespace
 
 DistanceResult meshDistance(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
-                            const Tolerances& tol, double relative_error) noexcept {
-  if (!pose_a.isFinite() || !pose_b.isFinite() || !(relative_error >= 0.0) || !std::isfinite(relative_error)) {
+                            const Tolerances& tol, double relative_error, double cutoff) noexcept {
+  if (!pose_a.isFinite() || !pose_b.isFinite() || !(relative_error >= 0.0) || !std::isfinite(relative_error) ||
+      !(cutoff >= 0.0)) {
     DistanceResult r;
     r.status = Status::InvalidInput;
     return r;
   }
   const Pose b_in_a = relativePose(pose_a, pose_b);
-  DistanceMin m(relative_error);
+  DistanceMin m(relative_error, cutoff);
   const std::vector<Triangle>& ta = a.triangles();
   const std::vector<Triangle>& tb = b.triangles();
   bool stop = false;

@@ -138,6 +138,7 @@ struct MotionContext {
   std::vector<double> q, dq;
   std::vector<double> safe_until;  // per item: where its coverage starts (Cast: where its shape cast reached)
   std::vector<double> bound;       // per item: its motion bound for this segment
+  std::vector<double> first_reach; // per item: how far its first measurement (in the middle) clears, −1: none
   std::vector<SimplexCache> hull_cache;  // per self item: the hulls' last GJK axis (warm starts, kept across segments)
   std::vector<std::uint64_t> pose_stamp;  // per link: the step its pose in scene.poses was computed for
   std::vector<int> pose_path;             // scratch: links whose poses are due, deepest first

@@ -18,6 +18,7 @@
 #include <clearway/tolerances.h>
 #include <clearway/tree/aabb_tree.h>
 
+#include <limits>
 #include <vector>
 
 namespace clearway {
@@ -119,10 +120,12 @@ bool shapeIntersectsLink(const Shape& shape, const Pose& pose_shape, const LinkG
 /// (from A to B) in the world frame (the poses' frame). With relative_error = 0 the two agree within
 /// tol.gjk_relative; a relative_error e > 0 lets the search skip pairs that cannot be closer than
 /// distance / (1 + e), so lower_bound ≥ distance / (1 + e) only (much faster: conservative advancement
-/// needs a lower bound, not the exact distance). A narrow-phase failure, a non-finite pose or a negative
-/// relative_error gives distance 0 and a failure status.
+/// needs a lower bound, not the exact distance). Element pairs farther apart than `cutoff` are not
+/// examined: when none is nearer, distance = lower_bound = cutoff. A narrow-phase failure, a non-finite
+/// pose, a negative relative_error or cutoff gives distance 0 and a failure status.
 DistanceResult meshDistance(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
-                            const Tolerances& tol = {}, double relative_error = 0.0) noexcept;
+                            const Tolerances& tol = {}, double relative_error = 0.0,
+                            double cutoff = std::numeric_limits<double>::infinity()) noexcept;
 
 /// The distance between a convex shape (A, an obstacle or a voxel) and a link's exact geometry (B):
 /// the minimum over the link's triangles and primitives, with the same bounds, frames and relative_error
