@@ -673,6 +673,9 @@ void MotionChecker::castAhead(const double* q0, const double* q1, int n_items, M
 // matters to any item. So a free segment costs about one measurement per ball of twice the radius that
 // advancement alone would use, and the first contact is exact all the same.
 struct MotionChecker::Sweep {
+  // A clearance proven beyond the contact distance (the search said "not within it"), in contact distances.
+  static constexpr double kBeyond = 1.0 + 1e-9;
+
   const MotionChecker& mc;
   MotionContext& ctx;
   MotionResult& r;
@@ -736,9 +739,15 @@ struct MotionChecker::Sweep {
       d = lower - it.padding;
       if (d <= contact && exact && !head) d = std::max(partsLowerBound(a, pa, b, pb, tol, enough, relative) - it.padding, d);
       if (d <= contact && exact && !head) {
-        // The convex pieces are within contact: the triangles are near, and measuring them far costs dear.
-        const DistanceResult m = meshDistance(a, pa, b, pb, tol, relative, std::min(enough, it.padding + 8.0 * contact));
-        d = isFailure(m.status) ? 0.0 : m.lower_bound - it.padding;
+        // The convex pieces are within contact, so the triangles are near (and a fine mesh has many near):
+        // whether they are within contact is a search that stops at the first pair; only if not, how far
+        // they are, measured no farther than a few contact distances.
+        if (meshesIntersect(a, pa, b, pb, tol, GeometryMode::Mesh, it.padding + contact)) {
+          d = 0.0;
+        } else {
+          const DistanceResult m = meshDistance(a, pa, b, pb, tol, relative, std::min(enough, it.padding + 8.0 * contact));
+          d = isFailure(m.status) ? 0.0 : std::max(m.lower_bound - it.padding, kBeyond * contact);
+        }
       }
       if (d <= contact && !head) {
         report = CollisionReport{};
@@ -751,10 +760,18 @@ struct MotionChecker::Sweep {
       // As for pairs: the hull's bound first, the exact geometry only when the hull comes close.
       const double h = sc.environment().hullLowerBound(*it.ga, pa, tol, cutoff, relative, 0.0, &ctx.scene.counters.environment);
       d = h - it.padding;
-      if (d <= contact && exact && !head && h > 0.0) {
-        const DistanceResult e =
-            sc.environment().linkDistance(*it.ga, pa, tol, cutoff, 0.0, relative, &ctx.scene.counters.environment);
-        d = isFailure(e.status) ? 0.0 : e.lower_bound - it.padding;
+      EnvironmentHit hit;
+      bool found = false;  // `hit` names what is within contact
+      if (d <= contact && exact && !head) {  // as for pairs: within contact, then how far
+        EnvironmentCounters* counters = &ctx.scene.counters.environment;
+        if (sc.environment().linkIntersects(*it.ga, pa, tol, GeometryMode::Mesh, it.padding + contact, 0.0, &hit, counters)) {
+          d = 0.0;
+          found = true;
+        } else {
+          const DistanceResult e =
+              sc.environment().linkDistance(*it.ga, pa, tol, std::min(cutoff, it.padding + 8.0 * contact), 0.0, relative, counters);
+          d = isFailure(e.status) ? 0.0 : std::max(e.lower_bound - it.padding, kBeyond * contact);
+        }
       }
       if (d <= contact && !head) {
         report = CollisionReport{};
@@ -762,8 +779,10 @@ struct MotionChecker::Sweep {
         report.link = it.a;
         // Which obstacle or voxel (for the report only): one within the contact distance, widened by the
         // relative error the distance's lower bound was allowed.
-        sc.environment().linkIntersects(*it.ga, pa, tol, sc.options().mode,
-                                        it.padding + (contact + 1e-9) * (1.0 + relative), 0.0, &report.hit);
+        if (!found)
+          sc.environment().linkIntersects(*it.ga, pa, tol, sc.options().mode,
+                                          it.padding + (contact + 1e-9) * (1.0 + relative), 0.0, &hit);
+        report.hit = hit;
       }
     }
     if (r.distance_queries >= mc.options_.max_queries) capped = true;

@@ -254,6 +254,42 @@ TEST(MotionCertified, RigidBodiesAreOneItemUntilNear) {
   EXPECT_LE(hit.first_contact, fine.check(a0, b1, fc).first_contact + 1e-9);
 }
 
+TEST(MotionCertified, ConcaveLinkAroundAPostIsDecidedByItsElements) {
+  // One link, a fork of three boxes (the gripper's palm and fingers as one link): its hull covers the
+  // post between the prongs, but the prongs stay 38 mm clear of it, as dense sampling says.
+  TempDir dir;
+  const std::string urdf = dir.write("fork.urdf", R"(<?xml version="1.0"?>
+<robot name="fork">
+  <link name="base"/>
+  <link name="fork">
+    <collision><origin xyz="1.25 0 0"/><geometry><box size="0.06 0.3 0.08"/></geometry></collision>
+    <collision><origin xyz="1.38 0.12 0"/><geometry><box size="0.2 0.04 0.08"/></geometry></collision>
+    <collision><origin xyz="1.38 -0.12 0"/><geometry><box size="0.2 0.04 0.08"/></geometry></collision>
+  </link>
+  <joint name="pan" type="revolute">
+    <parent link="base"/><child link="fork"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" velocity="1" effort="1"/>
+  </joint>
+</robot>
+)");
+  const auto scene = Scene::load(dir.write("fork.yaml", "format: 1\nname: fork\nrobot:\n  urdf: " + urdf +
+                                                          "\n  group: [pan]\nenvironment:\n  obstacles:\n    - {name: post, "
+                                                          "cylinder: {radius: 0.02, length: 1}, pose: {position: [1.4, 0, 0]}}\n"
+                                                          "checks: [environment, continuous]\nstart: [0]\ngoal: [0.03]\n"));
+  const MotionChecker certified(scene);
+  const MotionChecker fine(scene, sampled(1e-3));
+  MotionContext ctx = certified.makeContext(), fc = fine.makeContext();
+  const double a0[1] = {-0.03}, a1[1] = {0.03};
+  EXPECT_TRUE(fine.check(a0, a1, fc).free);
+  const MotionResult r = certified.check(a0, a1, ctx);
+  EXPECT_TRUE(r.free) << "the hull touches the post; the boxes do not";
+  const double b1[1] = {0.1};
+  const MotionResult hit = certified.check(a0, b1, ctx);
+  ASSERT_FALSE(hit.free);
+  EXPECT_LE(hit.first_contact, fine.check(a0, b1, fc).first_contact + 1e-9);
+  EXPECT_EQ(hit.report.kind, CollisionReport::Kind::Environment);
+}
+
 TEST(MotionCertified, RigidPairThatOverlapsCollidesEverywhere) {
   // Both fingers at y = −0.12: they overlap, and no joint of the group can part them.
   TempDir dir;
