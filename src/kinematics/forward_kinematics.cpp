@@ -34,6 +34,29 @@ Pose jointMotion(const Joint& j, const double* v) noexcept {
   return m;
 }
 
+// parent · origin · Rot(u, angle) without forming the rotation (the inner loop of every motion check):
+// M · Rot = c·M + s·M[u]× + (1 − c)·(M u) uᵀ with M = parent.R · origin.R, column by column; about ±z
+// (most robots' axes) only the first two columns turn.
+Pose turned(const Pose& parent, const Pose& origin, const Vec3& u, double angle) noexcept {
+  Pose p;
+  const Mat3 M = parent.R * origin.R;
+  p.t = parent.R * origin.t + parent.t;
+  const double c = std::cos(angle), s = std::sin(angle);
+  const Vec3 m0 = M.col(0), m1 = M.col(1), m2 = M.col(2);
+  if (u.x() == 0.0 && u.y() == 0.0 && std::abs(u.z()) == 1.0) {
+    const double sz = s * u.z();
+    p.R.col(0) = c * m0 + sz * m1;
+    p.R.col(1) = c * m1 - sz * m0;
+    p.R.col(2) = m2;
+    return p;
+  }
+  const Vec3 w = (1.0 - c) * (M * u);
+  p.R.col(0) = c * m0 + s * (u.z() * m1 - u.y() * m2) + u.x() * w;
+  p.R.col(1) = c * m1 + s * (u.x() * m2 - u.z() * m0) + u.y() * w;
+  p.R.col(2) = c * m2 + s * (u.y() * m0 - u.x() * m1) + u.z() * w;
+  return p;
+}
+
 std::string show(double x) {
   std::ostringstream s;
   s.precision(17);
@@ -53,6 +76,12 @@ void planarBasis(const Vec3& axis, Vec3* u, Vec3* v) noexcept {
 void computeLinkPose(const RobotModel& model, const double* q, Pose* link_poses, int i) noexcept {
   const std::vector<Joint>& joints = model.joints();
   const Joint& j = joints[model.links()[i].parent_joint];
+  if (j.type == JointType::Revolute || j.type == JointType::Continuous) {
+    const double angle =
+        j.isMimic() ? j.mimic.multiplier * q[joints[j.mimic.joint].first_variable] + j.mimic.offset : q[j.first_variable];
+    link_poses[i] = turned(link_poses[j.parent_link], j.origin, j.axis, angle);
+    return;
+  }
   const Pose frame = link_poses[j.parent_link] * j.origin;
   if (j.type == JointType::Fixed) {
     link_poses[i] = frame;
