@@ -111,7 +111,9 @@ struct MotionOptions {
   /// Certified: a pair closer than this (metres) counts as in contact; larger is faster near obstacles.
   double contact_distance = 1e-3;
   /// Certified: GJK's relative error allowed in distances (only lower bounds are used, so any value is safe).
-  double distance_relative_error = 0.25;
+  /// (0.1 beats 0.25 by about 10% on the shared problems: looser bounds send more pairs down to the parts and
+  /// triangles; 0.02 is slower again.)
+  double distance_relative_error = 0.1;
   /// Certified: cap on distance queries per segment; reaching it reports a collision (never free by accident).
   int max_queries = 200000;
   /// Sampled: the largest step between checked states, in the state's Euclidean norm.
