@@ -636,8 +636,8 @@ void MotionChecker::castAhead(const double* q0, const double* q1, int n_items, M
   const double contact = options_.contact_distance;
   bool posed = false;
   for (int k = 0; k < n_items; ++k) {
-    if (ctx.safe_until[k] > 0.0) continue;  // does not move, or its group measures it
     const Item& it = items_[k];
+    if (it.group >= 0) continue;  // its group's coverage decides where it starts
     const bool self = it.b >= 0;
     if (self ? !bound_.translates(it.a, it.b, ctx.dq.data()) : !bound_.translates(it.a, ctx.dq.data())) continue;
     if (!posed) {  // both ends' poses, once: the end's kept aside, the start's left in the scene context
