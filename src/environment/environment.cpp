@@ -321,7 +321,6 @@ double Environment::hullLowerBound(const LinkGeometry& link, const Pose& pose, c
     return 0.0;
   double lower = enough;  // the least bound so far: items certainly beyond it cannot lower it
   const auto measure = [&](const auto& shape, const Pose& pose_o) {
-    if (counters) ++counters->distance_tests;
     SimplexCache cold;
     lower = std::min(lower, gjkLowerBound(link.hull(), pose, shape, pose_o, tol, cold, lower, relative));
     return !(lower > 0.0);
@@ -343,6 +342,7 @@ double Environment::hullLowerBound(const LinkGeometry& link, const Pose& pose, c
   if (!stop && !voxel_tree_.empty()) {
     const std::vector<Aabb>& voxels = map_->occupied;
     voxel_tree_.forEachWithin(link.bounds(), pose, lower, [&](std::int32_t v) {
+      if (counters) ++counters->voxel_tests;  // (as linkDistance counts: voxel hull tests, not obstacles')
       return measure(Box(voxels[v].halfExtents()), Pose::translation(voxels[v].center()));
     });
   }

@@ -57,6 +57,11 @@ Pose turned(const Pose& parent, const Pose& origin, const Vec3& u, double angle)
   return p;
 }
 
+// A mimic joint's value: its leader's times the multiplier, plus the offset.
+double mimicValue(const RobotModel& model, const Joint& j, const double* q) noexcept {
+  return j.mimic.multiplier * q[model.joint(j.mimic.joint).first_variable] + j.mimic.offset;
+}
+
 std::string show(double x) {
   std::ostringstream s;
   s.precision(17);
@@ -77,16 +82,14 @@ void computeLinkPose(const RobotModel& model, const double* q, Pose* link_poses,
   const std::vector<Joint>& joints = model.joints();
   const Joint& j = joints[model.links()[i].parent_joint];
   if (j.type == JointType::Revolute || j.type == JointType::Continuous) {
-    const double angle =
-        j.isMimic() ? j.mimic.multiplier * q[joints[j.mimic.joint].first_variable] + j.mimic.offset : q[j.first_variable];
-    link_poses[i] = turned(link_poses[j.parent_link], j.origin, j.axis, angle);
+    link_poses[i] = turned(link_poses[j.parent_link], j.origin, j.axis, j.isMimic() ? mimicValue(model, j, q) : q[j.first_variable]);
     return;
   }
   const Pose frame = link_poses[j.parent_link] * j.origin;
   if (j.type == JointType::Fixed) {
     link_poses[i] = frame;
   } else if (j.isMimic()) {
-    const double value = j.mimic.multiplier * q[joints[j.mimic.joint].first_variable] + j.mimic.offset;
+    const double value = mimicValue(model, j, q);
     link_poses[i] = frame * jointMotion(j, &value);
   } else {
     link_poses[i] = frame * jointMotion(j, q + j.first_variable);

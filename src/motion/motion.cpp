@@ -27,6 +27,26 @@ std::vector<double> referenceState(const Scene& scene) {
   return q;
 }
 
+// Per link: the link nearest the root that it moves rigidly with (joined by joints the group does not move).
+std::vector<int> rigidAnchors(const Scene& scene) {
+  const RobotModel& model = scene.robot();
+  std::vector<char> in_group(model.variableCount(), 0);
+  for (const int v : scene.groupVariables()) in_group[v] = 1;
+  const auto still = [&](const Joint& joint) {
+    const Joint& owner = joint.isMimic() ? model.joint(joint.mimic.joint) : joint;
+    for (int k = 0; owner.first_variable >= 0 && k < jointVariableCount(owner.type); ++k)
+      if (in_group[owner.first_variable + k]) return false;
+    return true;
+  };
+  std::vector<int> anchor(model.linkCount());
+  for (int l = 0; l < model.linkCount(); ++l) {
+    int a = l;
+    while (model.link(a).parent_joint >= 0 && still(model.joint(model.link(a).parent_joint))) a = model.parentLink(a);
+    anchor[l] = a;
+  }
+  return anchor;
+}
+
 }  // namespace
 
 // ---- MotionBound --------------------------------------------------------------------------------------
@@ -118,16 +138,11 @@ MotionBound::MotionBound(const Scene& scene, const std::vector<Body>& bodies)
         if (joint_var_[e] >= 0) return false;
       return true;
     };
-    std::vector<int> body(model_links);
-    for (int l = 0; l < model_links; ++l) body[l] = l;
-    const auto find = [&](int l) {
-      while (body[l] != l) l = body[l] = body[body[l]];
-      return l;
-    };
+    const std::vector<int> anchor = rigidAnchors(scene);  // (the same rigid bodies MotionChecker merges)
+    const auto find = [&](int l) { return anchor[l]; };
     for (int j = 0; j < joints; ++j) {
       const Joint& joint = model.joint(j);
       if (!still(j) || joint.parent_link < 0 || joint.child_link < 0) continue;
-      body[find(joint.parent_link)] = find(joint.child_link);
       // Held where the reference state has it (a held planar or floating joint has no limits to bound it).
       const double offset = relativePose(ctx.poses[joint.parent_link], ctx.poses[joint.child_link]).t.norm();
       for (const int e : elements_of[j]) step_[e] = e == elements_of[j].front() ? offset * (1.0 + 1e-12) : 0.0;
@@ -351,31 +366,6 @@ double MotionBound::pair(int a, int b, const double* dq) const noexcept {
 namespace clearway {
 
 // ---- MotionChecker ------------------------------------------------------------------------------------
-
-
-namespace {
-
-// Per link: the link nearest the root that it moves rigidly with (joined by joints the group does not move).
-std::vector<int> rigidAnchors(const Scene& scene) {
-  const RobotModel& model = scene.robot();
-  std::vector<char> in_group(model.variableCount(), 0);
-  for (const int v : scene.groupVariables()) in_group[v] = 1;
-  const auto still = [&](const Joint& joint) {
-    const Joint& owner = joint.isMimic() ? model.joint(joint.mimic.joint) : joint;
-    for (int k = 0; owner.first_variable >= 0 && k < jointVariableCount(owner.type); ++k)
-      if (in_group[owner.first_variable + k]) return false;
-    return true;
-  };
-  std::vector<int> anchor(model.linkCount());
-  for (int l = 0; l < model.linkCount(); ++l) {
-    int a = l;
-    while (model.link(a).parent_joint >= 0 && still(model.joint(model.link(a).parent_joint))) a = model.parentLink(a);
-    anchor[l] = a;
-  }
-  return anchor;
-}
-
-}  // namespace
 
 MotionChecker::Bodies MotionChecker::mergeBodies(const Scene& scene) {
   const RobotModel& model = scene.robot();
@@ -675,6 +665,9 @@ void MotionChecker::castAhead(const double* q0, const double* q1, int n_items, M
 struct MotionChecker::Sweep {
   // A clearance proven beyond the contact distance (the search said "not within it"), in contact distances.
   static constexpr double kBeyond = 1.0 + 1e-9;
+  // Once the convex bounds are within contact, how far (in contact distances) the exact geometry is
+  // measured: near fine meshes, a search farther out visits a great many triangles.
+  static constexpr double kNear = 8.0;
 
   const MotionChecker& mc;
   MotionContext& ctx;
@@ -745,7 +738,7 @@ struct MotionChecker::Sweep {
         if (meshesIntersect(a, pa, b, pb, tol, GeometryMode::Mesh, it.padding + contact)) {
           d = 0.0;
         } else {
-          const DistanceResult m = meshDistance(a, pa, b, pb, tol, relative, std::min(enough, it.padding + 8.0 * contact));
+          const DistanceResult m = meshDistance(a, pa, b, pb, tol, relative, std::min(enough, it.padding + kNear * contact));
           d = isFailure(m.status) ? 0.0 : std::max(m.lower_bound - it.padding, kBeyond * contact);
         }
       }
@@ -769,7 +762,7 @@ struct MotionChecker::Sweep {
           found = true;
         } else {
           const DistanceResult e =
-              sc.environment().linkDistance(*it.ga, pa, tol, std::min(cutoff, it.padding + 8.0 * contact), 0.0, relative, counters);
+              sc.environment().linkDistance(*it.ga, pa, tol, std::min(cutoff, it.padding + kNear * contact), 0.0, relative, counters);
           d = isFailure(e.status) ? 0.0 : std::max(e.lower_bound - it.padding, kBeyond * contact);
         }
       }
@@ -898,6 +891,9 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
 
   const bool check_env = sc.effects().environment && !sc.environment().empty();
   const int n_items = check_env ? static_cast<int>(items_.size()) : env_begin_;
+  // No warm start from other segments: a segment's verdict then depends on nothing but its ends (a planner's
+  // threads, and a later re-check of its path, must agree even on pairs within the contact distance).
+  for (SimplexCache& c : ctx.hull_cache) c = SimplexCache{};
   // Members wait until their group comes within contact.
   for (int k = 0; k < n_items; ++k) {
     if (items_[k].group >= 0) continue;
@@ -942,7 +938,17 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
     r.report.kind = CollisionReport::Kind::Invalid;
     return r;
   }
-  if (sweep.hit) {
+  // An end out of bounds: the segment is valid up to where it leaves them (q0 is within: boxes are convex).
+  double exit = 1.0;
+  if (end_invalid) {
+    for (int i = 0; i < sc.dimension(); ++i) {
+      const double lo = sc.lower(i) - kJointLimitTolerance, hi = sc.upper(i) + kJointLimitTolerance;
+      if (q1[i] > hi && ctx.dq[i] > 0.0) exit = std::min(exit, (hi - q0[i]) / ctx.dq[i]);
+      if (q1[i] < lo && ctx.dq[i] < 0.0) exit = std::min(exit, (lo - q0[i]) / ctx.dq[i]);
+    }
+    exit = std::clamp(exit, 0.0, 1.0);
+  }
+  if (sweep.hit && !(end_invalid && exit < sweep.limit)) {
     r.free = false;
     r.first_contact = sweep.limit;
     // The state at the contact is within contact_distance of touching: if it is still free, it is the last
@@ -951,16 +957,8 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
     r.last_valid = sc.isFree(ctx.q.data(), ctx.scene) ? sweep.limit : sweep.clear_before;
     return r;
   }
-  if (end_invalid) {
-    // Clear all the way, but the end is out of bounds: valid up to where the segment leaves them.
-    r.first_contact = 1.0;
-    r.last_valid = 1.0;
-    for (int i = 0; i < sc.dimension(); ++i) {
-      const double lo = sc.lower(i) - kJointLimitTolerance, hi = sc.upper(i) + kJointLimitTolerance;
-      if (q1[i] > hi && ctx.dq[i] > 0.0) r.last_valid = std::min(r.last_valid, (hi - q0[i]) / ctx.dq[i]);
-      if (q1[i] < lo && ctx.dq[i] < 0.0) r.last_valid = std::min(r.last_valid, (lo - q0[i]) / ctx.dq[i]);
-    }
-    r.last_valid = std::clamp(r.last_valid, 0.0, 1.0);
+  if (end_invalid) {  // clear until the segment leaves its bounds
+    r.first_contact = r.last_valid = exit;
     r.report = CollisionReport{};
     r.report.kind = CollisionReport::Kind::Invalid;
     return r;

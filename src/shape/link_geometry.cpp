@@ -433,7 +433,7 @@ namespace {
 // The running minimum of a distance query, in A's frame.
 struct DistanceMin {
   DistanceResult best;
-  // Pairs certainly farther than this are skipped: best.distance / (1 + relative_error).
+  // Pairs certainly farther than this are skipped: the caller's limit, then best.distance / (1 + relative_error).
   double cutoff = std::numeric_limits<double>::infinity();
   double shrink = 1.0;
   bool failed = false;

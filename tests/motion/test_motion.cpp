@@ -359,11 +359,23 @@ TEST(MotionCertified, BadInput) {
       if (bad == 5.0) {  // clear of the wall, but the turn leaves its limit (3.2) at s = 3.2 / 5
         const MotionResult out = m->check(ok, q, ctx);
         EXPECT_EQ(out.report.kind, CollisionReport::Kind::Invalid);
-        EXPECT_EQ(out.first_contact, 1.0);
+        EXPECT_NEAR(out.first_contact, 3.2 / 5.0, 1e-9);
         EXPECT_NEAR(out.last_valid, 3.2 / 5.0, 1e-9);
         double at[2];
         m->interpolate(ok, q, out.last_valid, at);
         EXPECT_TRUE(scene->validState(at));
+        // Into the wall at s ≈ 0.85, after leaving the limit at 0.64: the bounds come first.
+        const double far[2] = {0.1, 5.0};
+        const MotionResult both = m->check(ok, far, ctx);
+        EXPECT_EQ(both.report.kind, CollisionReport::Kind::Invalid);
+        EXPECT_NEAR(both.last_valid, 3.2 / 5.0, 1e-9);
+        // Into the wall before leaving the limit: the wall comes first, and the last valid state is valid.
+        const double soon[2] = {0.5, 4.0};
+        const MotionResult wall = m->check(ok, soon, ctx);
+        EXPECT_EQ(wall.report.kind, CollisionReport::Kind::Environment);
+        EXPECT_LT(wall.first_contact, 3.2 / 4.0);
+        m->interpolate(ok, soon, wall.last_valid, at);
+        EXPECT_TRUE(scene->isFree(std::vector<double>(at, at + 2)));
       }
     }
   }
@@ -821,6 +833,37 @@ TEST(MotionCertified, ThreadsShareOneChecker) {
     });
   for (auto& th : threads) th.join();
   for (int t = 0; t < 4; ++t) EXPECT_EQ(wrong[t], 0);
+}
+
+TEST(MotionCertified, VerdictDependsOnlyOnTheSegment) {
+  // Two contexts check the same segments in opposite orders (so different items lead, and different
+  // segments came before): a planner's threads and a later re-check of its path must agree, even on
+  // segments that pass within the contact distance. Free segments take the very same queries.
+  const auto scene = Scene::load(test::sourceRobot("scenes/arm6_wall.yaml"));
+  const MotionChecker certified(scene);
+  const int n = scene->dimension();
+  std::mt19937 rng(17);
+  // A random walk of 0.4 rad steps: some segments free, some meeting the wall or the arm itself.
+  std::vector<std::vector<double>> q(201, std::vector<double>(n));
+  for (std::size_t k = 0; k < q.size(); ++k)
+    for (int i = 0; i < n; ++i)
+      q[k][i] = k == 0 ? 0.5 * (scene->lower(i) + scene->upper(i))
+                       : std::clamp(q[k - 1][i] + std::uniform_real_distribution<double>(-0.4, 0.4)(rng), scene->lower(i),
+                                    scene->upper(i));
+  MotionContext forward = certified.makeContext(), backward = certified.makeContext();
+  std::vector<MotionResult> a(200), b(200);
+  for (int k = 0; k < 200; ++k) a[k] = certified.check(q[k].data(), q[k + 1].data(), forward);
+  for (int k = 200; k-- > 0;) b[k] = certified.check(q[k].data(), q[k + 1].data(), backward);
+  int free = 0;
+  for (int k = 0; k < 200; ++k) {
+    ASSERT_EQ(a[k].free, b[k].free) << "segment " << k;
+    if (a[k].free) {
+      ++free;
+      EXPECT_EQ(a[k].distance_queries, b[k].distance_queries) << "segment " << k;
+    }
+  }
+  EXPECT_GT(free, 20);
+  EXPECT_LT(free, 190);
 }
 
 }  // namespace

@@ -47,10 +47,11 @@ class MotionBound {
   double link(int link, const double* dq) const noexcept;
   /// Upper bound on how much the distance between links a and b can change for the step dq.
   double pair(int a, int b, const double* dq) const noexcept;
-  /// The largest h ≤ 1 such that, for the step h·dq from the state whose link poses are `poses` (the
-  /// link's and its ancestors' at least), no point of the link moves d or farther: the reaches measured
-  /// from where the joint axes are now, which is much tighter than d / link(dq) for a link near the axes
-  /// that turn it. Never below d / link(dq).
+  /// The largest h (possibly above 1, or ∞) such that, for the step ±h·dq from the state whose link poses
+  /// are `poses` (the link's and its ancestors' at least), no point of the link moves d or farther: the
+  /// reaches measured from where the joint axes are now (a point's distance from joint k's axis changes
+  /// only through the joints after k, either way), which is much tighter than d / link(dq) for a link near
+  /// the axes that turn it. Never below d / link(dq).
   double linkStep(int link, const double* dq, const Pose* poses, double d) const noexcept;
   /// The same for the distance between links a and b (poses of both and their ancestors needed), watched
   /// from their common ancestor; where pair() watches from a better link, d / pair(a, b, dq) may be larger.
@@ -110,9 +111,8 @@ struct MotionOptions {
   MotionMode mode = MotionMode::Certified;
   /// Certified: a pair closer than this (metres) counts as in contact; larger is faster near obstacles.
   double contact_distance = 1e-3;
-  /// Certified: GJK's relative error allowed in distances (only lower bounds are used, so any value is safe).
-  /// (0.1 beats 0.25 by about 10% on the shared problems: looser bounds send more pairs down to the parts and
-  /// triangles; 0.02 is slower again.)
+  /// Certified: GJK's relative error allowed in distances (only lower bounds are used, so any value is safe;
+  /// looser bounds end each GJK sooner but send more pairs down to the dearer parts and triangles).
   double distance_relative_error = 0.1;
   /// Certified: cap on distance queries per segment; reaching it reports a collision (never free by accident).
   int max_queries = 200000;
@@ -123,13 +123,14 @@ struct MotionOptions {
 /// The verdict on a segment.
 struct MotionResult {
   bool free = false;
-  /// When not free: the segment parameter of the first contact found (certified: contact within
-  /// contact_distance is certain not to happen before it), and the last parameter at which the state
-  /// is known to be free (≤ first_contact; 0 when q0 itself collides).
+  /// When not free: the segment parameter of the first contact found (certified: a state within
+  /// contact_distance of touching there, and none touching before it; an invalid state: where the segment
+  /// leaves the bounds), and the last parameter at which the state is known to be free (≤ first_contact;
+  /// 0 when q0 itself collides).
   double first_contact = 0.0;
   double last_valid = 0.0;
   CollisionReport report;   ///< what collided
-  int steps = 0;            ///< advancement steps (certified) or states checked (sampled)
+  int steps = 0;            ///< parameters whose poses were computed (certified) or states checked (sampled)
   int distance_queries = 0; ///< pair or link distances computed (certified)
   bool capped = false;      ///< the query cap was reached (reported as a collision)
 };
@@ -141,13 +142,13 @@ struct MotionContext {
   std::vector<double> safe_until;  // per item: where its coverage starts (Cast: where its shape cast reached)
   std::vector<double> bound;       // per item: its motion bound for this segment
   std::vector<double> first_reach; // per item: how far its first measurement (in the middle) clears, −1: none
-  std::vector<SimplexCache> hull_cache;  // per self item: the hulls' last GJK axis (warm starts, kept across segments)
+  std::vector<SimplexCache> hull_cache;  // per self item: the hulls' last GJK axis (warm starts within a segment)
   std::vector<std::uint64_t> pose_stamp;  // per link: the step its pose in scene.poses was computed for
   std::vector<int> pose_path;             // scratch: links whose poses are due, deepest first
   std::vector<Pose> end_poses;            // Cast: the link poses at the segment's end
   std::uint64_t step_stamp = 0;
   struct Interval {
-    double a, b;
+    double a, b;     // the parameters to cover
     double witness;  // a parameter ≤ a the item was measured clear at (−1: none)
   };
   std::vector<Interval> intervals;  // scratch: what items have yet to cover
@@ -183,7 +184,7 @@ class MotionChecker {
   struct Bodies {
     std::vector<int> anchor;  // per link: the link nearest the root that it moves rigidly with
     std::vector<int> index;   // per link: its body in `list` when merged, else -1
-    std::vector<std::unique_ptr<const LinkGeometry>> geometry;
+    std::vector<std::unique_ptr<const LinkGeometry>> geometry;  // per merged body, in its anchor's frame
     std::vector<MotionBound::Body> list;
   };
   static Bodies mergeBodies(const Scene& scene);
@@ -199,7 +200,9 @@ class MotionChecker {
     int first = 0, last = 0;  // a group: its members, items [first, last)
     int group = -1;           // a member: its group
   };
+  // Fills items_: groups where two bodies' every link pair (or a body's every link) is checked.
   void buildItems();
+  // The item's motion bound for the step dq.
   double itemBound(const Item& item, const double* dq) const noexcept;
   struct Sweep;  // motion.cpp
 
