@@ -48,6 +48,12 @@ Aabb obstacleBox(const Obstacle& o, const Pose& pose) noexcept {
   return o.mesh ? transformed(o.mesh->bounds(), pose) : shapeWorldBox(o.shape, pose);
 }
 
+// f applied to the obstacle as a convex shape: a mesh obstacle's hull, or its primitive.
+template <class F>
+decltype(auto) onConvex(const Obstacle& o, F&& f) {
+  return o.mesh ? f(o.mesh->hull()) : std::visit(f, o.shape);
+}
+
 Pose poseAt(const Obstacle& o, double t) noexcept {
   Pose p = o.pose;
   if (o.moving()) p.t += t * o.velocity;
@@ -261,12 +267,7 @@ DistanceResult Environment::linkDistance(const LinkGeometry& link, const Pose& p
 
   // One obstacle: the hull's lower bound first (one GJK), the exact geometry only when it may be nearer.
   const auto visit = [&](const Obstacle& o, const Pose& pose_o) {
-    DistanceResult hull;
-    if (o.mesh) {
-      hull = gjkDistance(link.hull(), pose, o.mesh->hull(), pose_o, tol);
-    } else {
-      hull = std::visit([&](const auto& s) { return gjkDistance(link.hull(), pose, s, pose_o, tol); }, o.shape);
-    }
+    const DistanceResult hull = onConvex(o, [&](const auto& s) { return gjkDistance(link.hull(), pose, s, pose_o, tol); });
     if (!isFailure(hull.status) && hull.lower_bound >= search.limit) return false;
     if (mode == GeometryMode::Hull) return search.add(hull);
     if (counters) ++counters->distance_tests;
@@ -274,7 +275,8 @@ DistanceResult Environment::linkDistance(const LinkGeometry& link, const Pose& p
                              : swapped(shapeLinkDistance(o.shape, pose_o, link, pose, tol, relative_error)));
   };
 
-  bool stop = static_tree_.forEachWithin(link_box, search.limit, [&](std::int32_t item) {
+  // The link's box as an oriented box sees obstacles and voxels much nearer than its world box admits.
+  bool stop = static_tree_.forEachWithin(link.bounds(), pose, search.limit, [&](std::int32_t item) {
     const Obstacle& o = obstacles_[static_[item]];
     return visit(o, o.pose);
   });
@@ -289,10 +291,7 @@ DistanceResult Environment::linkDistance(const LinkGeometry& link, const Pose& p
   }
   if (!stop && !search.failed && !voxel_tree_.empty()) {
     const std::vector<Aabb>& voxels = map_->occupied;
-    // The link's box as an oriented box sees voxels much nearer than its world box admits.
-    const detail::OrientedBoxTest obb(pose, 0.0, scale_ + maxAbs(link_box));
-    voxel_tree_.forEachWithin(link_box, search.limit, [&](std::int32_t v) {
-      if (obb.gap(voxels[v], link.bounds()) >= search.limit) return false;
+    voxel_tree_.forEachWithin(link.bounds(), pose, search.limit, [&](std::int32_t v) {
       const Box box(voxels[v].halfExtents());
       const Pose pose_v = Pose::translation(voxels[v].center());
       const DistanceResult hull = gjkDistance(link.hull(), pose, box, pose_v, tol);
@@ -326,7 +325,7 @@ double Environment::hullLowerBound(const LinkGeometry& link, const Pose& pose, c
     return !(lower > 0.0);
   };
   const auto obstacle = [&](const Obstacle& o, const Pose& at) {
-    return o.mesh ? measure(o.mesh->hull(), at) : std::visit([&](const auto& s) { return measure(s, at); }, o.shape);
+    return onConvex(o, [&](const auto& s) { return measure(s, at); });
   };
   bool stop = static_tree_.forEachWithin(link.bounds(), pose, lower, [&](std::int32_t item) {
     const Obstacle& o = obstacles_[static_[item]];
@@ -386,8 +385,7 @@ double Environment::linkCast(const LinkGeometry& link, const Pose& pose, const V
     if (c.hit) first = std::min(first, std::max(0.0, c.t));
   };
   const auto visitObstacle = [&](const Obstacle& o, const Pose& pose_o) {
-    if (o.mesh) visit(obstacleBox(o, pose_o), o.mesh->hull(), pose_o);
-    else std::visit([&](const auto& shape) { visit(obstacleBox(o, pose_o), shape, pose_o); }, o.shape);
+    onConvex(o, [&](const auto& shape) { visit(obstacleBox(o, pose_o), shape, pose_o); });
   };
   static_tree_.query(swept, [&](std::int32_t item) {
     const Obstacle& o = obstacles_[static_[item]];

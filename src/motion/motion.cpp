@@ -376,12 +376,13 @@ MotionChecker::Bodies MotionChecker::mergeBodies(const Scene& scene) {
   for (const int l : scene.geometry().geometricLinks()) members[out.anchor[l]].push_back(l);
   SceneContext ctx = scene.makeContext();
   scene.computePoses(referenceState(scene).data(), ctx);
+  out.reference = ctx.poses;
   for (int anchor = 0; anchor < model.linkCount(); ++anchor) {
     if (members[anchor].size() < 2) continue;
     // Every member's elements, placed in the anchor's frame (fixed: the joints in between do not move).
     std::vector<CollisionElement> elements;
     for (const int l : members[anchor]) {
-      const Pose in_anchor = relativePose(ctx.poses[anchor], ctx.poses[l]);
+      const Pose in_anchor = relativePose(out.reference[anchor], out.reference[l]);
       for (CollisionElement e : model.link(l).collisions) {
         e.origin = in_anchor * e.origin;
         elements.push_back(std::move(e));
@@ -464,13 +465,12 @@ void MotionChecker::buildItems() {
   if (sc.effects().self) {
     const SelfCollision& self = sc.selfCollision();
     std::vector<std::pair<std::pair<int, int>, int>> keyed;  // (anchors, index in single)
-    SceneContext ctx = sc.makeContext();
-    sc.computePoses(referenceState(sc).data(), ctx);
+    const std::vector<Pose>& at = bodies_.reference;
     for (int k = 0; k < static_cast<int>(self.pairs().size()); ++k) {
       const LinkPair& p = self.pairs()[k];
       if (anchor[p.a] == anchor[p.b]) {  // one rigid body: as at every state
         if (rigid_collision_.kind == CollisionReport::Kind::None &&
-            meshesIntersect(*sc.geometry().link(p.a), ctx.poses[p.a], *sc.geometry().link(p.b), ctx.poses[p.b],
+            meshesIntersect(*sc.geometry().link(p.a), at[p.a], *sc.geometry().link(p.b), at[p.b],
                             sc.options().tolerances, sc.options().mode, self.pairPadding(k))) {
           rigid_collision_.kind = CollisionReport::Kind::Self;
           rigid_collision_.link = p.a;

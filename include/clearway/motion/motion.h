@@ -184,6 +184,7 @@ class MotionChecker {
   struct Bodies {
     std::vector<int> anchor;  // per link: the link nearest the root that it moves rigidly with
     std::vector<int> index;   // per link: its body in `list` when merged, else -1
+    std::vector<Pose> reference;  // per link: its pose at a reference state (rigid offsets are read from it)
     std::vector<std::unique_ptr<const LinkGeometry>> geometry;  // per merged body, in its anchor's frame
     std::vector<MotionBound::Body> list;
   };
