@@ -544,6 +544,14 @@ MotionContext MotionChecker::makeContext() const {
   c.bound.resize(items_.size());
   c.first_reach.resize(items_.size());
   c.hull_cache.resize(env_begin_);
+  c.part_slot.assign(env_begin_, -1);
+  c.part_stamp.assign(env_begin_, 0);
+  for (int k = 0; k < env_begin_; ++k) {
+    const Item& it = items_[k];
+    if (it.last > it.first) continue;  // a head stops at its hulls
+    c.part_slot[k] = static_cast<int>(c.part_cache.size());
+    c.part_cache.resize(c.part_cache.size() + it.ga->parts().size() * it.gb->parts().size());
+  }
   c.pose_stamp.assign(scene_->robot().linkCount(), 0);
   c.pose_path.reserve(scene_->robot().linkCount());
   c.intervals.reserve(256);
@@ -730,7 +738,14 @@ struct MotionChecker::Sweep {
       if (!(lower >= enough))  // (the GJK bound first in max(): it is a number even if the balls' is not)
         lower = std::max(gjkLowerBound(a.hull(), pa, b.hull(), pb, tol, ctx.hull_cache[k], enough, relative), lower);
       d = lower - it.padding;
-      if (d <= contact && exact && !head) d = std::max(partsLowerBound(a, pa, b, pb, tol, enough, relative) - it.padding, d);
+      if (d <= contact && exact && !head) {
+        SimplexCache* caches = ctx.part_cache.data() + ctx.part_slot[k];
+        if (ctx.part_stamp[k] != ctx.segment) {
+          std::fill(caches, caches + a.parts().size() * b.parts().size(), SimplexCache{});
+          ctx.part_stamp[k] = ctx.segment;
+        }
+        d = std::max(partsLowerBound(a, pa, b, pb, tol, enough, relative, caches) - it.padding, d);
+      }
       if (d <= contact && exact && !head) {
         // The convex pieces are within contact, so the triangles are near (and a fine mesh has many near):
         // whether they are within contact is a search that stops at the first pair; only if not, how far
@@ -894,6 +909,7 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
   // No warm start from other segments: a segment's verdict then depends on nothing but its ends (a planner's
   // threads, and a later re-check of its path, must agree even on pairs within the contact distance).
   for (SimplexCache& c : ctx.hull_cache) c = SimplexCache{};
+  ++ctx.segment;  // (part pairs' warm starts are reset as their items first need them)
   // Members wait until their group comes within contact.
   for (int k = 0; k < n_items; ++k) {
     if (items_[k].group >= 0) continue;

@@ -10,6 +10,7 @@
 #include <clearway/shape/link_geometry.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -366,18 +367,47 @@ LinkGeometry::LinkGeometry(const std::vector<CollisionElement>& elements, const 
 // ---- Queries ------------------------------------------------------------------------------------------
 
 double partsLowerBound(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
-                       const Tolerances& tol, double enough, double relative) noexcept {
+                       const Tolerances& tol, double enough, double relative, SimplexCache* caches) noexcept {
   if (!pose_a.isFinite() || !pose_b.isFinite()) return 0.0;
   double best = enough;  // any bound at or above `enough` serves as well as the distance
-  for (const LinkGeometry::Part& pa : a.parts()) {
-    const Vec3 ca = pose_a * pa.center;
-    for (const LinkGeometry::Part& pb : b.parts()) {
-      const double balls = (ca - pose_b * pb.center).norm() - pa.radius - pb.radius;
-      if (balls >= best) continue;
-      SimplexCache cache;
-      best = std::min(best, std::max(balls, gjkLowerBound(pa.hull, pose_a, pb.hull, pose_b, tol, cache, best, relative)));
-      if (!(best > 0.0)) return 0.0;
+  const int na = static_cast<int>(a.parts().size()), nb = static_cast<int>(b.parts().size());
+  const auto gjk = [&](int i, int j, double balls) {
+    SimplexCache scratch;
+    SimplexCache& cache = caches ? caches[i * nb + j] : scratch;
+    best = std::min(best, std::max(balls, gjkLowerBound(a.parts()[i].hull, pose_a, b.parts()[j].hull, pose_b, tol,
+                                                        cache, best, relative)));
+  };
+  const auto balls = [&](int i, int j) {
+    return (pose_a * a.parts()[i].center - pose_b * b.parts()[j].center).norm() - a.parts()[i].radius -
+           b.parts()[j].radius;
+  };
+  constexpr int kPairs = LinkGeometry::kMaxParts * LinkGeometry::kMaxParts;
+  if (na * nb > kPairs) {  // (links with more primitives than kMaxParts: every pair in turn)
+    for (int i = 0; i < na; ++i) {
+      for (int j = 0; j < nb; ++j) {
+        const double x = balls(i, j);
+        if (x >= best) continue;
+        gjk(i, j, x);
+        if (!(best > 0.0)) return 0.0;
+      }
     }
+    return best;
+  }
+  // Nearest balls first: the first pair's distance is then usually the answer, and each later pair
+  // stops its GJK as soon as it is proved farther, or is never started once the balls are.
+  std::array<std::pair<double, int>, kPairs> near;
+  int count = 0;
+  for (int i = 0; i < na; ++i) {
+    for (int j = 0; j < nb; ++j) {
+      const double x = balls(i, j);
+      // (A NaN, which finite poses do not give, would break the sort: it goes first and GJK decides.)
+      if (!(x >= best)) near[count++] = {std::isnan(x) ? -std::numeric_limits<double>::infinity() : x, i * nb + j};
+    }
+  }
+  std::sort(near.begin(), near.begin() + count, [](const auto& x, const auto& y) { return x.first < y.first; });
+  for (int k = 0; k < count && near[k].first < best; ++k) {
+    gjk(near[k].second / nb, near[k].second % nb, near[k].first);
+    if (!(best > 0.0)) return 0.0;
   }
   return best;
 }

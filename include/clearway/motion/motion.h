@@ -143,6 +143,12 @@ struct MotionContext {
   std::vector<double> bound;       // per item: its motion bound for this segment
   std::vector<double> first_reach; // per item: how far its first measurement (in the middle) clears, −1: none
   std::vector<SimplexCache> hull_cache;  // per self item: the hulls' last GJK axis (warm starts within a segment)
+  // Per self item, its part pairs' GJK axes: they start at part_slot[k] in part_cache (−1: none) and are
+  // reset when first used in a segment (part_stamp[k] != segment).
+  std::vector<SimplexCache> part_cache;
+  std::vector<int> part_slot;
+  std::vector<std::uint64_t> part_stamp;
+  std::uint64_t segment = 0;
   std::vector<std::uint64_t> pose_stamp;  // per link: the step its pose in scene.poses was computed for
   std::vector<int> pose_path;             // scratch: links whose poses are due, deepest first
   std::vector<Pose> end_poses;            // Cast: the link poses at the segment's end

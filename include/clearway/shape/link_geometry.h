@@ -105,8 +105,9 @@ bool meshesIntersect(const LinkGeometry& a, const Pose& pose_a, const LinkGeomet
 /// A certified lower bound on the distance between two links from their convex parts (0 when parts
 /// touch): the least over part pairs, each pair's GJK stopping once it reaches `enough` metres or is
 /// within `relative` of its distance. Between the hulls' bound and meshDistance in cost and tightness.
+/// `caches`, if given, holds a.parts().size()·b.parts().size() warm starts (pair i, j at i·nb + j).
 double partsLowerBound(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
-                       const Tolerances& tol, double enough, double relative) noexcept;
+                       const Tolerances& tol, double enough, double relative, SimplexCache* caches = nullptr) noexcept;
 
 /// The same for a convex shape (an obstacle, a primitive) against a link: hull first, then (Mesh mode)
 /// the shape's box in the link frame against the triangle tree, and the link's primitives.
