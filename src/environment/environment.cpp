@@ -315,34 +315,35 @@ DistanceResult Environment::linkDistance(const LinkGeometry& link, const Pose& p
 }
 
 double Environment::hullLowerBound(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, double enough,
-                                   double relative, double t, EnvironmentCounters* counters) const noexcept {
+                                   double relative, double t, EnvironmentCounters* counters,
+                                   SimplexCache* warm) const noexcept {
   if (!pose.isFinite() || !std::isfinite(t) || !(enough >= 0.0) || !(relative >= 0.0) || !std::isfinite(relative))
     return 0.0;
   double lower = enough;  // the least bound so far: items certainly beyond it cannot lower it
-  const auto measure = [&](const auto& shape, const Pose& pose_o) {
+  const auto measure = [&](const auto& shape, const Pose& pose_o, SimplexCache* cache) {
     SimplexCache cold;
-    lower = std::min(lower, gjkLowerBound(link.hull(), pose, shape, pose_o, tol, cold, lower, relative));
+    lower = std::min(lower, gjkLowerBound(link.hull(), pose, shape, pose_o, tol, cache ? *cache : cold, lower, relative));
     return !(lower > 0.0);
   };
-  const auto obstacle = [&](const Obstacle& o, const Pose& at) {
-    return onConvex(o, [&](const auto& s) { return measure(s, at); });
+  const auto obstacle = [&](const Obstacle& o, const Pose& at, SimplexCache* cache) {
+    return onConvex(o, [&](const auto& s) { return measure(s, at, cache); });
   };
   bool stop = static_tree_.forEachWithin(link.bounds(), pose, lower, [&](std::int32_t item) {
     const Obstacle& o = obstacles_[static_[item]];
-    return obstacle(o, o.pose);
+    return obstacle(o, o.pose, warm ? warm + item : nullptr);
   });
   const Aabb link_box = transformed(link.bounds(), pose);
   for (std::size_t k = 0; k < moving_.size() && !stop; ++k) {
     const Obstacle& o = obstacles_[moving_[k]];
     const Pose at = poseAt(o, t);
     if (!at.isFinite()) return 0.0;
-    if (boxDistance(obstacleBox(o, at), link_box) <= lower) stop = obstacle(o, at);
+    if (boxDistance(obstacleBox(o, at), link_box) <= lower) stop = obstacle(o, at, nullptr);
   }
   if (!stop && !voxel_tree_.empty()) {
     const std::vector<Aabb>& voxels = map_->occupied;
     voxel_tree_.forEachWithin(link.bounds(), pose, lower, [&](std::int32_t v) {
       if (counters) ++counters->voxel_tests;  // (as linkDistance counts: voxel hull tests, not obstacles')
-      return measure(Box(voxels[v].halfExtents()), Pose::translation(voxels[v].center()));
+      return measure(Box(voxels[v].halfExtents()), Pose::translation(voxels[v].center()), nullptr);
     });
   }
   return lower >= 0.0 ? lower : 0.0;  // (NaN: 0)

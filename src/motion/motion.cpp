@@ -13,6 +13,9 @@ namespace clearway {
 
 namespace {
 
+// Environment items keep a GJK warm start per static obstacle up to this many obstacles (2.5 KiB a link).
+constexpr std::size_t kWarmObstacles = 64;
+
 // A state inside the scene's bounds (their midpoints) with unit quaternions, where the poses are defined.
 std::vector<double> referenceState(const Scene& scene) {
   const RobotModel& model = scene.robot();
@@ -552,6 +555,15 @@ MotionContext MotionChecker::makeContext() const {
     c.part_slot[k] = static_cast<int>(c.part_cache.size());
     c.part_cache.resize(c.part_cache.size() + it.ga->parts().size() * it.gb->parts().size());
   }
+  // (Warm starts per static obstacle while there are few: with many, the tree visits only a few per query.)
+  const std::size_t obstacles = scene_->environment().staticCount();
+  const int env_items = static_cast<int>(items_.size()) - env_begin_;
+  c.env_slot.assign(env_items, -1);
+  c.env_stamp.assign(env_items, 0);
+  if (obstacles > 0 && obstacles <= kWarmObstacles) {
+    for (int k = 0; k < env_items; ++k) c.env_slot[k] = static_cast<int>(k * obstacles);
+    c.env_cache.resize(env_items * obstacles);
+  }
   c.pose_stamp.assign(scene_->robot().linkCount(), 0);
   c.pose_path.reserve(scene_->robot().linkCount());
   c.intervals.reserve(256);
@@ -766,7 +778,16 @@ struct MotionChecker::Sweep {
     } else {
       const double cutoff = need + it.padding + contact;
       // As for pairs: the hull's bound first, the exact geometry only when the hull comes close.
-      const double h = sc.environment().hullLowerBound(*it.ga, pa, tol, cutoff, relative, 0.0, &ctx.scene.counters.environment);
+      SimplexCache* warm = nullptr;
+      if (const int slot = ctx.env_slot[k - mc.env_begin_]; slot >= 0) {
+        warm = ctx.env_cache.data() + slot;
+        if (ctx.env_stamp[k - mc.env_begin_] != ctx.segment) {
+          std::fill(warm, warm + sc.environment().staticCount(), SimplexCache{});
+          ctx.env_stamp[k - mc.env_begin_] = ctx.segment;
+        }
+      }
+      const double h =
+          sc.environment().hullLowerBound(*it.ga, pa, tol, cutoff, relative, 0.0, &ctx.scene.counters.environment, warm);
       d = h - it.padding;
       EnvironmentHit hit;
       bool found = false;  // `hit` names what is within contact

@@ -635,6 +635,64 @@ TEST(Environment, RandomLinksAgreeWithBruteForce) {
   EXPECT_GT(checked_distances, 50);
 }
 
+// The hull's lower bound against obstacles (boxes and box meshes) and voxels, from cold starts and from
+// warm starts carried along a path as a motion check carries them: certified (never above the nearest
+// hull distance), as tight as promised (within the relative error, or at least `enough`), both ways.
+TEST(Environment, HullLowerBoundIsCertifiedAndTightColdOrWarm) {
+  std::mt19937 rng(77);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * unit(rng); };
+  std::vector<Obstacle> obstacles;
+  for (int i = 0; i < 11; ++i) {
+    Obstacle o;
+    o.name = "o" + std::to_string(i);
+    // (Cores without a skin: the relative error applies to the cores' distance.)
+    const Vec3 half(uniform(0.02, 0.2), uniform(0.02, 0.2), uniform(0.02, 0.2));
+    if (i % 3 == 2) o.mesh = std::make_shared<const LinkGeometry>(boxSurface(half));
+    else o.shape = Box(half);
+    o.pose = randomPose(uniform, 0.8);
+    obstacles.push_back(o);
+  }
+  const Environment env(obstacles, mapOf({cube(Vec3(0.9, 0.9, 0.9), 0.1), cube(Vec3(-1.0, 0.9, -1.0), 0.1)}));
+  ASSERT_EQ(env.staticCount(), obstacles.size());
+  // The nearest hull distance, brute force.
+  const auto nearest = [&](const LinkGeometry& link, const Pose& pose) {
+    double d = INFINITY;
+    for (const Obstacle& o : obstacles) {
+      const DistanceResult r = o.mesh ? gjkDistance(o.mesh->hull(), o.pose, link.hull(), pose, kTol)
+                                      : gjkDistance(std::get<Box>(o.shape), o.pose, link.hull(), pose, kTol);
+      d = std::min(d, r.distance);
+    }
+    for (const Aabb& v : {cube(Vec3(0.9, 0.9, 0.9), 0.1), cube(Vec3(-1.0, 0.9, -1.0), 0.1)})
+      d = std::min(d, gjkDistance(Box(v.halfExtents()), Pose::translation(v.center()), link.hull(), pose, kTol).distance);
+    return d;
+  };
+  constexpr double kRelative = 0.25;
+  int near = 0, far = 0;
+  for (int path = 0; path < 12; ++path) {
+    const std::unique_ptr<LinkGeometry> link =
+        randomLink(path % 3, Vec3(uniform(0.02, 0.15), uniform(0.02, 0.15), uniform(0.02, 0.15)));
+    std::vector<SimplexCache> warm(env.staticCount());
+    Pose pose = randomPose(uniform, 0.8);
+    const Vec3 drift(uniform(-0.02, 0.02), uniform(-0.02, 0.02), uniform(-0.02, 0.02));
+    const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.03, Vec3(uniform(-1, 1), uniform(-1, 1), 1).normalized()).toRotationMatrix();
+    for (int step = 0; step < 40; ++step, pose.t += drift, pose.R = turn * pose.R) {
+      const double truth = nearest(*link, pose);
+      const double enough = step % 3 == 0 ? INFINITY : uniform(0.0, 0.3);
+      const double cold = env.hullLowerBound(*link, pose, kTol, enough, kRelative);
+      const double warmed = env.hullLowerBound(*link, pose, kTol, enough, kRelative, 0.0, nullptr, warm.data());
+      const std::string what = "path " + std::to_string(path) + " step " + std::to_string(step);
+      for (const double h : {cold, warmed}) {
+        EXPECT_LE(h, truth + 1e-9) << what;
+        EXPECT_GE(h, std::min(enough, (1.0 - kRelative) * truth) - 1e-9) << what;
+      }
+      (truth < 0.1 ? near : far)++;
+    }
+  }
+  EXPECT_GT(near, 40);  // both near and far cases, for the bounds to mean anything
+  EXPECT_GT(far, 40);
+}
+
 // ---- Casts: a translating link against obstacles and voxels -------------------------------------------
 
 TEST(Environment, LinkCastAgainstSampledDistances) {

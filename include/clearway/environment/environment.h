@@ -97,9 +97,13 @@ class Environment {
   /// obstacle's hull) or voxel, computed only as far as `enough`: the answer is at least `enough` when
   /// nothing is nearer. One GJK per item within reach of the link's oriented box, each stopping once it
   /// proves the item beyond the nearest so far, or within `relative` of its distance. Conservative
-  /// advancement needs no more. 0 for non-finite input or when the hull touches.
+  /// advancement needs no more. 0 for non-finite input or when the hull touches. `warm`, if given, holds
+  /// staticCount() GJK warm starts, one per static obstacle, kept by the caller for this link.
   double hullLowerBound(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, double enough,
-                        double relative, double t = 0.0, EnvironmentCounters* counters = nullptr) const noexcept;
+                        double relative, double t = 0.0, EnvironmentCounters* counters = nullptr,
+                        SimplexCache* warm = nullptr) const noexcept;
+  /// How many obstacles do not move (the warm starts hullLowerBound takes).
+  std::size_t staticCount() const noexcept { return static_.size(); }
 
   /// For a link translating by s·velocity (world frame), s ∈ [0, max_s], with its convex hull grown by
   /// `margin`: a certified lower bound on the first s at which it touches an obstacle (its hull, for a mesh

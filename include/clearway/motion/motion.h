@@ -148,6 +148,11 @@ struct MotionContext {
   std::vector<SimplexCache> part_cache;
   std::vector<int> part_slot;
   std::vector<std::uint64_t> part_stamp;
+  // Per environment item, its hull's GJK axes against each static obstacle, kept the same way (the
+  // item's block starts at env_slot[k − first environment item], −1: none).
+  std::vector<SimplexCache> env_cache;
+  std::vector<int> env_slot;
+  std::vector<std::uint64_t> env_stamp;
   std::uint64_t segment = 0;
   std::vector<std::uint64_t> pose_stamp;  // per link: the step its pose in scene.poses was computed for
   std::vector<int> pose_path;             // scratch: links whose poses are due, deepest first
