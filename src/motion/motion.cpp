@@ -726,6 +726,18 @@ struct MotionChecker::Sweep {
     return poses[link];
   }
 
+  // One item's warm starts, the block of n at `slot` in `all` (none for −1), emptied when this segment
+  // first uses them: a verdict depends on nothing but its segment.
+  SimplexCache* warmStarts(std::vector<SimplexCache>& all, int slot, std::uint64_t& stamp, std::size_t n) {
+    if (slot < 0) return nullptr;
+    SimplexCache* block = all.data() + slot;
+    if (stamp != ctx.segment) {
+      std::fill(block, block + n, SimplexCache{});
+      stamp = ctx.segment;
+    }
+    return block;
+  }
+
   // A certified lower bound on item k's clearance at s (padding removed), computed only as far as `need`
   // (beyond it, the answer only has to say so). A contact fills `report`.
   double measure(int k, double s, double need, CollisionReport& report) {
@@ -751,12 +763,9 @@ struct MotionChecker::Sweep {
         lower = std::max(gjkLowerBound(a.hull(), pa, b.hull(), pb, tol, ctx.hull_cache[k], enough, relative), lower);
       d = lower - it.padding;
       if (d <= contact && exact && !head) {
-        SimplexCache* caches = ctx.part_cache.data() + ctx.part_slot[k];
-        if (ctx.part_stamp[k] != ctx.segment) {
-          std::fill(caches, caches + a.parts().size() * b.parts().size(), SimplexCache{});
-          ctx.part_stamp[k] = ctx.segment;
-        }
-        d = std::max(partsLowerBound(a, pa, b, pb, tol, enough, relative, caches) - it.padding, d);
+        SimplexCache* caches =
+            warmStarts(ctx.part_cache, ctx.part_slot[k], ctx.part_stamp[k], a.parts().size() * b.parts().size());
+        d = std::max(d, partsLowerBound(a, pa, b, pb, tol, enough, relative, caches) - it.padding);  // (d first: NaN)
       }
       if (d <= contact && exact && !head) {
         // The convex pieces are within contact, so the triangles are near (and a fine mesh has many near):
@@ -778,14 +787,8 @@ struct MotionChecker::Sweep {
     } else {
       const double cutoff = need + it.padding + contact;
       // As for pairs: the hull's bound first, the exact geometry only when the hull comes close.
-      SimplexCache* warm = nullptr;
-      if (const int slot = ctx.env_slot[k - mc.env_begin_]; slot >= 0) {
-        warm = ctx.env_cache.data() + slot;
-        if (ctx.env_stamp[k - mc.env_begin_] != ctx.segment) {
-          std::fill(warm, warm + sc.environment().staticCount(), SimplexCache{});
-          ctx.env_stamp[k - mc.env_begin_] = ctx.segment;
-        }
-      }
+      const int e = k - mc.env_begin_;
+      SimplexCache* warm = warmStarts(ctx.env_cache, ctx.env_slot[e], ctx.env_stamp[e], sc.environment().staticCount());
       const double h =
           sc.environment().hullLowerBound(*it.ga, pa, tol, cutoff, relative, 0.0, &ctx.scene.counters.environment, warm);
       d = h - it.padding;
@@ -930,7 +933,7 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
   // No warm start from other segments: a segment's verdict then depends on nothing but its ends (a planner's
   // threads, and a later re-check of its path, must agree even on pairs within the contact distance).
   for (SimplexCache& c : ctx.hull_cache) c = SimplexCache{};
-  ++ctx.segment;  // (part pairs' warm starts are reset as their items first need them)
+  ++ctx.segment;  // (the part pairs' and obstacles' warm starts are emptied as their items first need them)
   // Members wait until their group comes within contact.
   for (int k = 0; k < n_items; ++k) {
     if (items_[k].group >= 0) continue;

@@ -368,7 +368,7 @@ LinkGeometry::LinkGeometry(const std::vector<CollisionElement>& elements, const 
 
 double partsLowerBound(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
                        const Tolerances& tol, double enough, double relative, SimplexCache* caches) noexcept {
-  if (!pose_a.isFinite() || !pose_b.isFinite()) return 0.0;
+  if (!pose_a.isFinite() || !pose_b.isFinite() || !(enough >= 0.0)) return 0.0;  // (a NaN `enough` too)
   double best = enough;  // any bound at or above `enough` serves as well as the distance
   const int na = static_cast<int>(a.parts().size()), nb = static_cast<int>(b.parts().size());
   const auto gjk = [&](int i, int j, double balls) {
@@ -382,7 +382,7 @@ double partsLowerBound(const LinkGeometry& a, const Pose& pose_a, const LinkGeom
            b.parts()[j].radius;
   };
   constexpr int kPairs = LinkGeometry::kMaxParts * LinkGeometry::kMaxParts;
-  if (na * nb > kPairs) {  // (links with more primitives than kMaxParts: every pair in turn)
+  if (na * nb > kPairs) {  // (links with many primitives, which add a part each: every pair in turn)
     for (int i = 0; i < na; ++i) {
       for (int j = 0; j < nb; ++j) {
         const double x = balls(i, j);

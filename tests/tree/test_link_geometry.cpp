@@ -384,6 +384,9 @@ TEST(LinkGeometry, DistanceMatchesBruteForce) {
         EXPECT_LE(warm, ref + kBand) << what;
         EXPECT_GE(warm, 0.75 * parts - kBand) << what;
         EXPECT_GE(parts, 0.75 * warm - kBand) << what;
+        // Stopped at `enough` with warm starts, and never above the distance for a `enough` that is no number.
+        EXPECT_LE(partsLowerBound(ga, pa, gb, pb, tol, 0.5 * parts, 0.25, warm_starts.data()), parts + kBand) << what;
+        EXPECT_EQ(partsLowerBound(ga, pa, gb, pb, tol, std::nan(""), 0.25, warm_starts.data()), 0.0) << what;
         if (ref == 0.0) {
           ++zero;
           EXPECT_EQ(d.distance, 0.0) << what;

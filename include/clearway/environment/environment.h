@@ -98,7 +98,7 @@ class Environment {
   /// nothing is nearer. One GJK per item within reach of the link's oriented box, each stopping once it
   /// proves the item beyond the nearest so far, or within `relative` of its distance. Conservative
   /// advancement needs no more. 0 for non-finite input or when the hull touches. `warm`, if given, holds
-  /// staticCount() GJK warm starts, one per static obstacle, kept by the caller for this link.
+  /// staticCount() GJK warm starts for this link, one per non-moving obstacle in the order given.
   double hullLowerBound(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, double enough,
                         double relative, double t = 0.0, EnvironmentCounters* counters = nullptr,
                         SimplexCache* warm = nullptr) const noexcept;

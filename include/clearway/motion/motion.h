@@ -135,7 +135,7 @@ struct MotionResult {
   bool capped = false;      ///< the query cap was reached (reported as a collision)
 };
 
-/// Scratch for checkSegment, one per thread (allocates once).
+/// Scratch for checkSegment, one per thread (allocates once), made by the checking MotionChecker's makeContext().
 struct MotionContext {
   SceneContext scene;
   std::vector<double> q, dq;
@@ -153,7 +153,7 @@ struct MotionContext {
   std::vector<SimplexCache> env_cache;
   std::vector<int> env_slot;
   std::vector<std::uint64_t> env_stamp;
-  std::uint64_t segment = 0;
+  std::uint64_t segment = 0;  // segments checked with this context (the stamps above refer to it)
   std::vector<std::uint64_t> pose_stamp;  // per link: the step its pose in scene.poses was computed for
   std::vector<int> pose_path;             // scratch: links whose poses are due, deepest first
   std::vector<Pose> end_poses;            // Cast: the link poses at the segment's end

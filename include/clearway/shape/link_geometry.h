@@ -69,9 +69,9 @@ class LinkGeometry {
     Vec3 center;
     double radius;
   };
-  // Four, not more: a pair of links costs parts² GJKs, and on the UR5's motions 8 parts took 8% longer
-  // than 4 (the tighter bound saved fewer mesh searches than it cost), 16 half as long again; 2 were
-  // too loose (5 times longer).
+  /// At most this many parts come from the triangles (each primitive adds one more). Four: a pair of
+  /// links may cost parts² GJKs, and on the shared UR5 motions 8 and 16 parts cost more than their
+  /// tighter bound saved, while 2 were too loose (mesh searches made motions 5 times slower).
   static constexpr int kMaxParts = 4;
   const std::vector<Part>& parts() const noexcept { return parts_; }
   /// A ball containing the hull (the first, cheapest test): centre in the link frame, and radius.
