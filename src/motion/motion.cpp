@@ -142,7 +142,6 @@ MotionBound::MotionBound(const Scene& scene, const std::vector<Body>& bodies)
       return true;
     };
     const std::vector<int> anchor = rigidAnchors(scene);  // (the same rigid bodies MotionChecker merges)
-    const auto find = [&](int l) { return anchor[l]; };
     for (int j = 0; j < joints; ++j) {
       const Joint& joint = model.joint(j);
       if (!still(j) || joint.parent_link < 0 || joint.child_link < 0) continue;
@@ -157,8 +156,8 @@ MotionBound::MotionBound(const Scene& scene, const std::vector<Body>& bodies)
       const Pose& child = ctx.poses[joint.child_link];  // the joint frame, turned by q about the axis
       const Vec3 point = child.t, dir = child.R * axis_[e];
       for (int l = 0; l < links_; ++l) {
-        const int root = find(frame_[l]);
-        if (root != find(joint.child_link) && root != find(joint.parent_link)) continue;
+        const int root = anchor[frame_[l]];
+        if (root != anchor[joint.child_link] && root != anchor[joint.parent_link]) continue;
         const Pose& pose = ctx.poses[frame_[l]];
         exact_[static_cast<std::size_t>(l) * elements + e] =
             axisReach(l, pose.R.transpose() * (point - pose.t), pose.R.transpose() * dir);
