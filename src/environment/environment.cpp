@@ -316,12 +316,20 @@ DistanceResult Environment::linkDistance(const LinkGeometry& link, const Pose& p
 
 double Environment::hullLowerBound(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, double enough,
                                    double relative, double t, EnvironmentCounters* counters,
-                                   SimplexCache* warm) const noexcept {
+                                   SimplexCache* warm, bool by_parts) const noexcept {
   if (!pose.isFinite() || !std::isfinite(t) || !(enough >= 0.0) || !(relative >= 0.0) || !std::isfinite(relative))
     return 0.0;
   double lower = enough;  // the least bound so far: items certainly beyond it cannot lower it
   const auto measure = [&](const auto& shape, const Pose& pose_o, SimplexCache* cache) {
     SimplexCache cold;
+    if (by_parts) {  // (cold starts: callers ask only when the hull has come within contact)
+      for (const LinkGeometry::Part& part : link.parts()) {
+        cold = SimplexCache{};
+        lower = std::min(lower, gjkLowerBound(part.hull, pose, shape, pose_o, tol, cold, lower, relative));
+        if (!(lower > 0.0)) return true;
+      }
+      return false;
+    }
     lower = std::min(lower, gjkLowerBound(link.hull(), pose, shape, pose_o, tol, cache ? *cache : cold, lower, relative));
     return !(lower > 0.0);
   };

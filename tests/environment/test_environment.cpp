@@ -78,6 +78,19 @@ TriangleMesh boxSurface(const Vec3& half) {
   return m;
 }
 
+// Two box surfaces of half extents `half`, centred at x = ±offset: a concave link of two convex parts.
+TriangleMesh twoBoxes(const Vec3& half, double offset) {
+  TriangleMesh two = boxSurface(half);
+  const TriangleMesh right = boxSurface(half);
+  for (Vec3& v : two.vertices) v.x() -= offset;
+  for (auto t : right.triangles) {
+    for (auto& i : t) i += static_cast<std::int32_t>(two.vertices.size());
+    two.triangles.push_back(t);
+  }
+  for (const Vec3& v : right.vertices) two.vertices.push_back(v + Vec3(offset, 0.0, 0.0));
+  return two;
+}
+
 std::shared_ptr<const OccupancyMap> mapOf(std::vector<Aabb> boxes, double resolution = 0.1) {
   auto map = std::make_shared<OccupancyMap>();
   map->resolution = resolution;
@@ -663,23 +676,31 @@ TEST(Environment, HullLowerBoundIsCertifiedAndTightColdOrWarm) {
   }
   const Environment env(obstacles, mapOf({cube(Vec3(0.9, 0.9, 0.9), 0.1), cube(Vec3(-1.0, 0.9, -1.0), 0.1)}));
   ASSERT_EQ(env.staticCount(), obstacles.size() - 1);
-  // The nearest hull distance, brute force.
-  const auto nearest = [&](const LinkGeometry& link, const Pose& pose) {
+  // The nearest hull (or convex part) distance, brute force.
+  const auto nearestTo = [&](const ConvexHull& hull, const Pose& pose) {
     double d = INFINITY;
     for (const Obstacle& o : obstacles) {
-      const DistanceResult r = o.mesh ? gjkDistance(o.mesh->hull(), o.pose, link.hull(), pose, kTol)
-                                      : gjkDistance(std::get<Box>(o.shape), o.pose, link.hull(), pose, kTol);
+      const DistanceResult r = o.mesh ? gjkDistance(o.mesh->hull(), o.pose, hull, pose, kTol)
+                                      : gjkDistance(std::get<Box>(o.shape), o.pose, hull, pose, kTol);
       d = std::min(d, r.distance);
     }
     for (const Aabb& v : {cube(Vec3(0.9, 0.9, 0.9), 0.1), cube(Vec3(-1.0, 0.9, -1.0), 0.1)})
-      d = std::min(d, gjkDistance(Box(v.halfExtents()), Pose::translation(v.center()), link.hull(), pose, kTol).distance);
+      d = std::min(d, gjkDistance(Box(v.halfExtents()), Pose::translation(v.center()), hull, pose, kTol).distance);
+    return d;
+  };
+  const auto nearest = [&](const LinkGeometry& link, const Pose& pose) { return nearestTo(link.hull(), pose); };
+  const auto nearestPart = [&](const LinkGeometry& link, const Pose& pose) {
+    double d = INFINITY;
+    for (const LinkGeometry::Part& part : link.parts()) d = std::min(d, nearestTo(part.hull, pose));
     return d;
   };
   constexpr double kRelative = 0.25;
   int near = 0, far = 0;
-  for (int path = 0; path < 12; ++path) {
-    const std::unique_ptr<LinkGeometry> link =
-        randomLink(path % 3, Vec3(uniform(0.02, 0.15), uniform(0.02, 0.15), uniform(0.02, 0.15)));
+  for (int path = 0; path < 16; ++path) {
+    const Vec3 half(uniform(0.02, 0.15), uniform(0.02, 0.15), uniform(0.02, 0.15));
+    // Every fourth link is two boxes apart (concave: its convex parts are far tighter than its hull).
+    std::unique_ptr<LinkGeometry> link =
+        path % 4 == 3 ? std::make_unique<LinkGeometry>(twoBoxes(half, 0.2)) : randomLink(path % 3, half);
     std::vector<SimplexCache> warm(env.staticCount());
     Pose pose = randomPose(uniform, 0.8);
     const Vec3 drift(uniform(-0.02, 0.02), uniform(-0.02, 0.02), uniform(-0.02, 0.02));
@@ -694,11 +715,31 @@ TEST(Environment, HullLowerBoundIsCertifiedAndTightColdOrWarm) {
         EXPECT_LE(h, truth + 1e-9) << what;
         EXPECT_GE(h, std::min(enough, (1.0 - kRelative) * truth) - 1e-9) << what;
       }
+      // By the convex parts: as certified and as tight against the parts' own nearest distance, which is
+      // never below the hull's.
+      const double parts_truth = nearestPart(*link, pose);
+      const double parts = env.hullLowerBound(*link, pose, kTol, enough, kRelative, 0.0, nullptr, warm.data(), true);
+      EXPECT_GE(parts_truth, truth - 1e-9) << what;
+      EXPECT_LE(parts, parts_truth + 1e-9) << what;
+      EXPECT_GE(parts, std::min(enough, (1.0 - kRelative) * parts_truth) - 1e-9) << what;
       (truth < 0.1 ? near : far)++;
     }
   }
   EXPECT_GT(near, 40);  // both near and far cases, for the bounds to mean anything
   EXPECT_GT(far, 40);
+  // An obstacle between the two boxes of a link: inside its hull, 0.1 m from its parts.
+  const Environment between({[] {
+    Obstacle o;
+    o.name = "between";
+    o.shape = Box(Vec3(0.05, 0.05, 0.05));
+    return o;
+  }()});
+  const LinkGeometry dumbbell(twoBoxes(Vec3(0.05, 0.05, 0.05), 0.2));
+  ASSERT_GE(dumbbell.parts().size(), 2u);
+  EXPECT_EQ(between.hullLowerBound(dumbbell, Pose::identity(), kTol, INFINITY, kRelative), 0.0);
+  const double parts = between.hullLowerBound(dumbbell, Pose::identity(), kTol, INFINITY, kRelative, 0.0, nullptr, nullptr, true);
+  EXPECT_LE(parts, 0.1 + 1e-9);
+  EXPECT_GE(parts, (1.0 - kRelative) * 0.1);
 }
 
 // ---- Casts: a translating link against obstacles and voxels -------------------------------------------

@@ -132,6 +132,17 @@ TEST(MotionCertified, ThinWallIsNeverTunnelled) {
   EXPECT_TRUE(scene->isFree(std::vector<double>(q, q + 2)));
   // Few steps: the block is far from the wall most of the way.
   EXPECT_LT(r.steps, 200);
+  // Without the state check at the contact: the same verdict and contact, and a last valid parameter
+  // that is still free, no later than the tight one, and near the contact although the one advancement
+  // step (exact for a slide) went from s = 0 straight to it.
+  const MotionResult loose = certified.check(q0, q1, ctx, /*tight_last_valid=*/false);
+  ASSERT_FALSE(loose.free);
+  EXPECT_EQ(loose.first_contact, r.first_contact);
+  EXPECT_EQ(loose.report.kind, r.report.kind);
+  EXPECT_LE(loose.last_valid, r.last_valid);
+  EXPECT_GT(loose.last_valid, r.first_contact - 0.01);
+  certified.interpolate(q0, q1, loose.last_valid, q);
+  EXPECT_TRUE(scene->isFree(std::vector<double>(q, q + 2)));
 
   // Turning while sliding (the block's corners sweep wider) is caught as well, and sooner.
   const double t1[2] = {1, 3.0};

@@ -99,9 +99,11 @@ class Environment {
   /// proves the item beyond the nearest so far, or within `relative` of its distance. Conservative
   /// advancement needs no more. 0 for non-finite input or when the hull touches. `warm`, if given, holds
   /// staticCount() GJK warm starts for this link, one per non-moving obstacle in the order given.
+  /// by_parts: the least over the link's convex parts instead of its hull (tighter where the link is
+  /// concave, up to kMaxParts GJKs per item; `warm` is then not used).
   double hullLowerBound(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, double enough,
                         double relative, double t = 0.0, EnvironmentCounters* counters = nullptr,
-                        SimplexCache* warm = nullptr) const noexcept;
+                        SimplexCache* warm = nullptr, bool by_parts = false) const noexcept;
   /// How many obstacles do not move (the warm starts hullLowerBound takes).
   std::size_t staticCount() const noexcept { return static_.size(); }
 

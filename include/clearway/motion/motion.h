@@ -179,14 +179,20 @@ class MotionChecker {
   const MotionBound& bound() const noexcept { return bound_; }
   MotionContext makeContext() const;
 
-  /// The verdict on q0 → q1 (each of scene().dimension() values).
-  MotionResult check(const double* q0, const double* q1, MotionContext& context) const noexcept;
+  /// The verdict on q0 → q1 (each of scene().dimension() values). A certified check of a segment that is
+  /// not free ends with a full state check at first_contact when tight_last_valid (then last_valid is
+  /// first_contact if that state is free); without it, last_valid is where the contacting item's last
+  /// clear measurement still certifies half the contact distance: also free, a fraction of the last
+  /// advancement step earlier, and no extra work for callers that want only the verdict (OMPL's
+  /// checkMotion(s1, s2)).
+  MotionResult check(const double* q0, const double* q1, MotionContext& context,
+                     bool tight_last_valid = true) const noexcept;
   /// The state at parameter s of q0 → q1, into out: linear, except that a floating joint's quaternion
   /// follows the short great arc at constant speed (slerp, as OMPL's SO(3) space), normalized.
   void interpolate(const double* q0, const double* q1, double s, double* out) const noexcept;
 
  private:
-  MotionResult certified(const double* q0, const double* q1, MotionContext& ctx) const noexcept;
+  MotionResult certified(const double* q0, const double* q1, MotionContext& ctx, bool tight_last_valid) const noexcept;
   MotionResult sampled(const double* q0, const double* q1, MotionContext& ctx) const noexcept;
   // Cast mode: items that only translate on the segment start from their shape cast's time of impact.
   void castAhead(const double* q0, const double* q1, int n_items, MotionContext& ctx, MotionResult& r) const noexcept;

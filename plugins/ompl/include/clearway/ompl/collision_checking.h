@@ -81,8 +81,8 @@ class ContinuousMotionValidator : public ompl::base::MotionValidator {
   bool checkMotion(const ompl::base::State* s1, const ompl::base::State* s2,
                    std::pair<ompl::base::State*, double>& lastValid) const override;
   const CheckerCounters& counters() const noexcept { return counters_; }
-  /// The last result this thread computed (for tools that want the contact).
-  MotionResult check(const ompl::base::State* s1, const ompl::base::State* s2) const;
+  /// The verdict on s1 → s2 with the contact (MotionChecker::check; tight_last_valid as there).
+  MotionResult check(const ompl::base::State* s1, const ompl::base::State* s2, bool tight_last_valid = true) const;
 
  private:
   MotionChecker checker_;
