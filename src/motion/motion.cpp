@@ -61,7 +61,20 @@ MotionBound::MotionBound(const Scene& scene, const std::vector<Body>& bodies)
   // A body is one more link: its merged geometry in the frame of its anchor link.
   frame_.resize(links_);
   for (int i = 0; i < links_; ++i) frame_[i] = i < model_links ? i : bodies[i - model_links].anchor;
-  const auto geometry = [&](int i) { return i < model_links ? scene.geometry().link(i) : bodies[i - model_links].geometry; };
+  // Each link's (or body's) points: their hull, and a ball containing them.
+  std::vector<Body> shape(links_);
+  for (int i = 0; i < links_; ++i) {
+    if (i >= model_links) {
+      shape[i] = bodies[i - model_links];
+    } else if (const LinkGeometry* g = scene.geometry().link(i)) {
+      shape[i] = Body{i, &g->hull(), g->sphereCenter(), g->sphereRadius()};
+    }
+  }
+  // The farthest hull vertex from the frame's origin.
+  radius_.assign(links_, 0.0);
+  for (int i = 0; i < links_; ++i)
+    if (shape[i].hull)
+      for (const Vec3& v : shape[i].hull->vertices()) radius_[i] = std::max(radius_[i], v.norm());
   // Which state entry drives each joint variable (through a mimic too).
   std::vector<int> var_to_state(model.variableCount(), -1);
   for (int i = 0; i < dim_; ++i) var_to_state[scene.groupVariables()[i]] = i;
@@ -123,14 +136,14 @@ MotionBound::MotionBound(const Scene& scene, const std::vector<Body>& bodies)
   exact_.assign(static_cast<std::size_t>(links_) * elements, std::numeric_limits<double>::infinity());
   // The farthest hull vertex of a link from a line (point o, unit direction u) in the link's frame.
   const auto axisReach = [&](int link, const Vec3& o, const Vec3& u) {
-    const LinkGeometry* g = geometry(link);
+    const ConvexHull* hull = shape[link].hull;
     double r = 0.0;
-    if (g)
-      for (const Vec3& v : g->hull().vertices()) {
+    if (hull)
+      for (const Vec3& v : hull->vertices()) {
         const Vec3 w = v - o;
         r = std::max(r, (w - w.dot(u) * u).norm());
       }
-    return r * (1.0 + 1e-12) + 1e-12 * (g ? g->boundingRadius() + o.norm() : 0.0);  // rounding
+    return r * (1.0 + 1e-12) + 1e-12 * (hull ? radius_[link] + o.norm() : 0.0);  // rounding
   };
   {
     SceneContext ctx = scene.makeContext();
@@ -167,7 +180,6 @@ MotionBound::MotionBound(const Scene& scene, const std::vector<Body>& bodies)
   chain_.resize(links_);
   prefix_.resize(links_);
   joint_reach_.resize(links_);
-  radius_.assign(links_, 0.0);
   sphere_center_.assign(links_, Vec3::Zero());
   sphere_radius_.assign(links_, 0.0);
   link_coef_.assign(static_cast<std::size_t>(links_) * dim_, 0.0);
@@ -177,9 +189,7 @@ MotionBound::MotionBound(const Scene& scene, const std::vector<Body>& bodies)
       chain_[i].insert(chain_[i].end(), e.rbegin(), e.rend());
     }
     std::reverse(chain_[i].begin(), chain_[i].end());
-    const LinkGeometry* g = geometry(i);
-    radius_[i] = g ? g->boundingRadius() : 0.0;
-    if (g) sphere_center_[i] = g->sphereCenter(), sphere_radius_[i] = g->sphereRadius();
+    sphere_center_[i] = shape[i].center, sphere_radius_[i] = shape[i].radius;
     const std::size_t n = chain_[i].size();
     prefix_[i].assign(n, 0.0);
     for (std::size_t k = 0; k < n; ++k) prefix_[i][k] = (k ? prefix_[i][k - 1] : 0.0) + step_[chain_[i][k]];
@@ -392,7 +402,18 @@ MotionChecker::Bodies MotionChecker::mergeBodies(const Scene& scene) {
     }
     for (const int l : members[anchor]) out.index[l] = static_cast<int>(out.list.size());
     out.geometry.push_back(std::make_unique<const LinkGeometry>(elements, model.meshes()));
-    out.list.push_back({anchor, out.geometry.back().get()});
+    const LinkGeometry& g = *out.geometry.back();
+    out.list.push_back({anchor, &g.hull(), g.sphereCenter(), g.sphereRadius()});
+  }
+  // Then each link's and merged body's convex pieces, as links of the bound of their own.
+  const int merged = static_cast<int>(out.list.size());
+  out.parts_begin.assign(model.linkCount() + merged, -1);
+  for (int l = 0; l < model.linkCount() + merged; ++l) {
+    const LinkGeometry* g = l < model.linkCount() ? scene.geometry().link(l) : out.geometry[l - model.linkCount()].get();
+    if (!g) continue;
+    out.parts_begin[l] = model.linkCount() + static_cast<int>(out.list.size());
+    const int frame = l < model.linkCount() ? l : out.list[l - model.linkCount()].anchor;
+    for (const LinkGeometry::Part& part : g->parts()) out.list.push_back({frame, &part.hull, part.center, part.radius});
   }
   return out;
 }
@@ -432,7 +453,7 @@ void MotionChecker::buildItems() {
     const int body = bodies_.index[link];
     const int index = body >= 0 ? n_links + body : link;
     const int frame = body >= 0 ? bodies_.list[body].anchor : link;
-    const LinkGeometry* g = body >= 0 ? bodies_.list[body].geometry : sc.geometry().link(link);
+    const LinkGeometry* g = body >= 0 ? bodies_.geometry[body].get() : sc.geometry().link(link);
     (second ? item.b : item.a) = index;
     (second ? item.frame_b : item.frame_a) = frame;
     (second ? item.gb : item.ga) = g;
@@ -548,8 +569,12 @@ MotionContext MotionChecker::makeContext() const {
   c.hull_cache.resize(env_begin_);
   c.part_slot.assign(env_begin_, -1);
   c.part_stamp.assign(env_begin_, 0);
+  c.split_slot.assign(env_begin_, 0);
+  c.split_stamp.assign(env_begin_, 0);
   for (int k = 0; k < env_begin_; ++k) {
     const Item& it = items_[k];
+    c.split_slot[k] = static_cast<int>(c.split_bound.size());
+    c.split_bound.resize(c.split_bound.size() + it.ga->parts().size() + it.gb->parts().size());
     if (it.last > it.first) continue;  // a head stops at its hulls
     c.part_slot[k] = static_cast<int>(c.part_cache.size());
     c.part_cache.resize(c.part_cache.size() + it.ga->parts().size() * it.gb->parts().size());
@@ -700,6 +725,10 @@ struct MotionChecker::Sweep {
   bool capped = false;
   int contacts = 0;           // how often the limit was lowered
   double at_s = -1.0;         // the parameter ctx.scene.q holds
+  // The last measurement's self item whose hulls' GJK axis separates them (splitClearances), −1: none.
+  static constexpr std::size_t kSplit = 8;
+  int split_item = -1;
+  double clear_a[kSplit], clear_b[kSplit];
 
   Sweep(const MotionChecker& checker, MotionContext& c, MotionResult& result, const double* from, const double* to)
       : mc(checker), ctx(c), r(result), q0(from), q1(to) {
@@ -748,6 +777,7 @@ struct MotionChecker::Sweep {
     const Item& it = mc.items_[k];
     const bool head = it.last > it.first;  // a group stops at the merged hulls: its members decide the rest
     ++r.distance_queries;
+    split_item = -1;
     need = std::max(need, 2.0 * contact);  // a clearance must exceed the contact distance to count
     const Pose pa = pose(s, it.frame_a);
     double d;
@@ -762,6 +792,7 @@ struct MotionChecker::Sweep {
       if (!(lower >= enough))  // (the GJK bound first in max(): it is a number even if the balls' is not)
         lower = std::max(gjkLowerBound(a.hull(), pa, b.hull(), pb, tol, ctx.hull_cache[k], enough, relative), lower);
       d = lower - it.padding;
+      if (d > contact) split_item = k;  // (the hulls' last GJK axis is this measurement's)
       if (d <= contact && exact && !head) {
         SimplexCache* caches =
             warmStarts(ctx.part_cache, ctx.part_slot[k], ctx.part_stamp[k], a.parts().size() * b.parts().size());
@@ -824,20 +855,72 @@ struct MotionChecker::Sweep {
     return d;
   }
 
-  // How far from s a clearance d of item k reaches, either way.
-  double reach(int k, double d) {
+  // Self item k's parts' clearances from the other link, from the hulls' separating plane: any unit u gives,
+  // for a part of A whose points reach at most P_i along u and a B whose points start at Q, a clearance of
+  // at least Q − P_i (the last GJK axis makes it tight for the nearest part); never below d, the hulls'.
+  // False when there is no axis or too many parts.
+  bool splitClearances(int k, double d) {
+    const Item& it = mc.items_[k];
+    const SimplexCache& cache = ctx.hull_cache[k];
+    const std::vector<LinkGeometry::Part>& parts_a = it.ga->parts();
+    const std::vector<LinkGeometry::Part>& parts_b = it.gb->parts();
+    if (!cache.valid || parts_a.size() > kSplit || parts_b.size() > kSplit) return false;
+    const Pose& pa = ctx.scene.poses[it.frame_a];  // (as measured)
+    const Pose& pb = ctx.scene.poses[it.frame_b];
+    const Vec3 u_a = -cache.axis.normalized();  // A towards B, in A's frame
+    const Vec3 u = pa.R * u_a, u_b = pb.R.transpose() * u;
+    if (!u.allFinite()) return false;
+    std::int32_t hint_a = cache.hint_a, hint_b = cache.hint_b;
+    const double p = u.dot(pa.t) + u_a.dot(it.ga->hull().support(u_a, hint_a));
+    const double q = u.dot(pb.t) + u_b.dot(it.gb->hull().support(-u_b, hint_b));
+    // Rounding: each term is a dot product of coordinates of a few metres at most.
+    const double slack = it.padding + 1e-12 * (1.0 + std::abs(p) + std::abs(q));
+    for (std::size_t i = 0; i < parts_a.size(); ++i)  // (d first in max(): a NaN plane leaves d)
+      clear_a[i] = std::max(d, q - std::min(p, u.dot(pa * parts_a[i].center) + parts_a[i].radius) - slack);
+    for (std::size_t j = 0; j < parts_b.size(); ++j)
+      clear_b[j] = std::max(d, std::max(q, u.dot(pb * parts_b[j].center) - parts_b[j].radius) - p - slack);
+    return true;
+  }
+
+  // Self item k's parts' motion bounds against the other link, for this segment: a's parts, then b's.
+  const double* splitBounds(int k) {
+    const Item& it = mc.items_[k];
+    double* bound = ctx.split_bound.data() + ctx.split_slot[k];
+    if (ctx.split_stamp[k] != ctx.segment) {
+      const std::vector<int>& begin = mc.bodies_.parts_begin;
+      const int na = static_cast<int>(it.ga->parts().size()), nb = static_cast<int>(it.gb->parts().size());
+      for (int i = 0; i < na; ++i) bound[i] = mc.bound_.pair(begin[it.a] + i, it.b, ctx.dq.data());
+      for (int j = 0; j < nb; ++j) bound[na + j] = mc.bound_.pair(it.a, begin[it.b] + j, ctx.dq.data());
+      ctx.split_stamp[k] = ctx.segment;
+    }
+    return bound;
+  }
+
+  // How far from s a clearance d of item k reaches, either way. Beyond `want` nothing is asked; only short
+  // of it does a self item look at its links' parts: where the near part lies close to the axes that turn
+  // it, the far parts' larger clearances make up for their larger motion.
+  double reach(int k, double d, double want) {
     const Item& it = mc.items_[k];
     const double* dq = ctx.dq.data();
     const Pose* poses = ctx.scene.poses.data();  // (at the parameter d was measured at)
-    return it.b >= 0 ? std::max(d / ctx.bound[k], mc.bound_.pairStep(it.a, it.b, dq, poses, d))
-                     : mc.bound_.linkStep(it.a, dq, poses, d);
+    if (it.b < 0) return mc.bound_.linkStep(it.a, dq, poses, d);
+    double h = std::max(d / ctx.bound[k], mc.bound_.pairStep(it.a, it.b, dq, poses, d));
+    if (h < want && split_item == k && splitClearances(k, d)) {
+      const double* bound = splitBounds(k);
+      const std::size_t na = it.ga->parts().size(), nb = it.gb->parts().size();
+      double ha = INFINITY, hb = INFINITY;  // (a part that does not move relative to the other: ∞)
+      for (std::size_t i = 0; i < na; ++i) ha = std::min(ha, clear_a[i] / bound[i]);
+      for (std::size_t j = 0; j < nb; ++j) hb = std::min(hb, clear_b[j] / bound[na + j]);
+      h = std::max(h, std::max(ha, hb));
+    }
+    return h;
   }
 
   // How far either way from s item k is clear, measured for the interval s ± half; −1 within contact.
   double first(int k, double s, double half) {
     CollisionReport unused;
     const double d = measure(k, s, ctx.bound[k] * half, unused);
-    return d <= mc.options_.contact_distance ? -1.0 : reach(k, d);
+    return d <= mc.options_.contact_distance ? -1.0 : reach(k, d, half);
   }
 
   // Covers [a, b] ∩ [0, limit] for item k (all of [0, a) is covered already).
@@ -867,7 +950,7 @@ struct MotionChecker::Sweep {
         }
         continue;
       }
-      const double rad = reach(k, d);
+      const double rad = reach(k, d, std::max(m - iv.a, hi - m));
       if (m + rad < hi) ctx.intervals.push_back({m + rad, hi, m});
       if (m - rad > iv.a) ctx.intervals.push_back({iv.a, m - rad, iv.witness});
     }
@@ -897,7 +980,7 @@ struct MotionChecker::Sweep {
       }
       prev = s;
       prev_d = d;
-      s += reach(k, d);  // at least contact_distance / B: the loop ends
+      s += reach(k, d, until - s);  // at least contact_distance / B: the loop ends
       if (!(s < until)) return false;
     }
     return false;

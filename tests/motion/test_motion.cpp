@@ -770,6 +770,64 @@ TEST(MotionBound, HoldsOnTheSharedRobots) {
   }
 }
 
+// A link's convex parts as links of the bound of their own (as the certified check splits a pair whose
+// hulls are near): no distance between a part's hull vertices and the other link's changes by more than
+// pair(part, other) says; and a part next to the axes that turn it gets a bound well below its link's
+// (the UR5's upper arm turns about the shoulder, where its near end sits beside the base).
+TEST(MotionBound, HoldsForConvexParts) {
+  const std::string root = std::string(CLEARWAY_SHARED_DIR) + "/scenes";
+  if (!std::filesystem::is_directory(root) || test::sharedRobot("panda/panda.urdf").empty())
+    GTEST_SKIP() << "shared scenes not found at " << root << " (see DATA.md)";
+  std::mt19937 rng(5);
+  for (const char* name : {"box_panda/box_panda_0001.yaml", "box_ur5/box_ur5_0001.yaml"}) {
+    const auto scene = std::make_shared<const Scene>(parseSceneFile(root + "/" + name));
+    const int links = scene->robot().linkCount();
+    std::vector<MotionBound::Body> parts;
+    std::vector<int> first(links, -1);  // per link: the bound's link of its first part
+    for (const int l : scene->geometry().geometricLinks()) {
+      first[l] = links + static_cast<int>(parts.size());
+      for (const LinkGeometry::Part& part : scene->geometry().link(l)->parts())
+        parts.push_back({l, &part.hull, part.center, part.radius});
+    }
+    const MotionBound bound(*scene, parts);
+    const int n = scene->dimension();
+    SceneContext c0 = scene->makeContext(), c1 = scene->makeContext();
+    std::vector<double> q0(n), q1(n), dq(n);
+    int checked = 0, much_lower = 0;
+    for (int trial = 0; trial < 20; ++trial) {
+      for (int i = 0; i < n; ++i) {
+        std::uniform_real_distribution<double> u(std::max(scene->lower(i), -3.0), std::min(scene->upper(i), 3.0));
+        q0[i] = u(rng);
+        q1[i] = std::clamp(q0[i] + std::uniform_real_distribution<double>(-0.4, 0.4)(rng), scene->lower(i), scene->upper(i));
+        dq[i] = q1[i] - q0[i];
+      }
+      scene->computePoses(q0.data(), c0);
+      scene->computePoses(q1.data(), c1);
+      for (const LinkPair& p : scene->selfCollision().pairs()) {
+        const double whole = bound.pair(p.a, p.b, dq.data());
+        const std::vector<LinkGeometry::Part>& pa = scene->geometry().link(p.a)->parts();
+        const std::vector<Vec3>& vb = scene->geometry().link(p.b)->hull().vertices();
+        for (std::size_t k = 0; k < pa.size(); ++k) {
+          const double b = bound.pair(first[p.a] + static_cast<int>(k), p.b, dq.data());
+          EXPECT_LE(b, whole * (1 + 1e-12) + 1e-12) << name;  // a part's points are among its link's
+          much_lower += b < 0.5 * whole;
+          const std::vector<Vec3>& va = pa[k].hull.vertices();
+          for (std::size_t i = 0; i < va.size(); i += 1 + va.size() / 8)
+            for (std::size_t j = 0; j < vb.size(); j += 1 + vb.size() / 8) {
+              const double before = (c0.poses[p.b] * vb[j] - c0.poses[p.a] * va[i]).norm();
+              const double after = (c1.poses[p.b] * vb[j] - c1.poses[p.a] * va[i]).norm();
+              EXPECT_LE(std::abs(after - before), b + 1e-9)
+                  << name << ": part " << k << " of " << scene->robot().link(p.a).name << " / " << scene->robot().link(p.b).name;
+              ++checked;
+            }
+        }
+      }
+    }
+    EXPECT_GT(checked, 1000) << name;
+    EXPECT_GT(much_lower, 20) << name << ": no part is bounded well below its link";
+  }
+}
+
 // The shared Panda and UR5 problems: segments from the start towards random states. Dense sampling
 // (1e-3 rad) finding a collision means the certified check must find one no later; the certified check
 // reporting a contact that sampling does not see is allowed only where the robot is truly within

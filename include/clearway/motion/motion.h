@@ -33,11 +33,13 @@ namespace clearway {
 /// Per-link and per-pair coefficients of the motion bound of one scene's group.
 class MotionBound {
  public:
-  /// Links that move as one (joined by joints the group does not move), seen as one more link: their
-  /// merged geometry in the frame of the anchor link (the one nearest the root).
+  /// Points that move with link `anchor`, seen as one more link: the links that move as one (joined by
+  /// joints the group does not move) merged, or a convex piece of a link; in the anchor's frame.
   struct Body {
     int anchor = 0;
-    const LinkGeometry* geometry = nullptr;
+    const ConvexHull* hull = nullptr;  ///< the points' hull
+    Vec3 center = Vec3::Zero();        ///< a ball that contains them
+    double radius = 0.0;
   };
   /// A planar or floating joint's slides are bounded by the scene's limits of its x, y (and z) entries.
   /// Body k takes the link index scene.robot().linkCount() + k in every call below.
@@ -153,6 +155,11 @@ struct MotionContext {
   std::vector<SimplexCache> env_cache;
   std::vector<int> env_slot;
   std::vector<std::uint64_t> env_stamp;
+  // Per self item, the motion bounds of its links' convex parts against the other link for this segment
+  // (a's parts, then b's, from split_slot[k]), computed when the item first needs them (split_stamp[k]).
+  std::vector<double> split_bound;
+  std::vector<int> split_slot;
+  std::vector<std::uint64_t> split_stamp;
   std::uint64_t segment = 0;  // segments checked with this context (the stamps above refer to it)
   std::vector<std::uint64_t> pose_stamp;  // per link: the step its pose in scene.poses was computed for
   std::vector<int> pose_path;             // scratch: links whose poses are due, deepest first
@@ -203,7 +210,8 @@ class MotionChecker {
     std::vector<int> index;   // per link: its body in `list` when merged, else -1
     std::vector<Pose> reference;  // per link: its pose at a reference state (rigid offsets are read from it)
     std::vector<std::unique_ptr<const LinkGeometry>> geometry;  // per merged body, in its anchor's frame
-    std::vector<MotionBound::Body> list;
+    std::vector<MotionBound::Body> list;  // the merged bodies, then every link's and body's convex parts
+    std::vector<int> parts_begin;  // per link, then per merged body: the bound's link of its first part, −1: none
   };
   static Bodies mergeBodies(const Scene& scene);
   // What certified mode measures: a self pair (b ≥ 0) or a link against the environment (b < 0); or a
