@@ -21,6 +21,8 @@ const char* const kMotionUsage =
     "2n numbers separated by spaces or commas; '#' starts a comment); each output line is 'free',\n"
     "'collision F WHAT' (F: the last valid fraction of the segment; WHAT: the links, obstacle or\n"
     "'invalid state'), or 'error REASON'. Without --motions it checks the scene's start -> goal.\n"
+    "In a scene with moving obstacles (checks: moving) a line may also hold each state's time, 2n + 2\n"
+    "numbers 't0 q0... t1 q1...' (seconds): the obstacles are where they are at each moment of the segment.\n"
     "Modes: certified (default: conservative advancement, never steps over an obstacle, contact within\n"
     "1 mm), cast (certified, with one GJK shape cast for what only translates: prismatic joints),\n"
     "sampled:RES (states every RES in the Euclidean joint norm, as OMPL's DiscreteMotionValidator;\n"
@@ -28,8 +30,9 @@ const char* const kMotionUsage =
     "Exit status: 0 when every line was a segment, 1 when some line was an error, 2 on a usage error or\n"
     "a scene that does not load.\n";
 
-std::string verdict(const MotionChecker& checker, const double* q0, const double* q1, MotionContext& ctx) {
-  const MotionResult r = checker.check(q0, q1, ctx);
+std::string verdict(const MotionChecker& checker, const double* q0, const double* q1, MotionContext& ctx,
+                    double t0 = 0.0, double t1 = 0.0) {
+  const MotionResult r = checker.check(q0, t0, q1, t1, ctx);
   if (r.free) return "free";
   char fraction[32];
   std::snprintf(fraction, sizeof fraction, "%.9g", r.last_valid);
@@ -125,19 +128,28 @@ int motionCommand(const std::vector<std::string>& args) {
       continue;
     }
     if (q.empty()) continue;
-    if (static_cast<int>(q.size()) != 2 * n) {
+    const bool timed = static_cast<int>(q.size()) == 2 * n + 2;
+    if (static_cast<int>(q.size()) != 2 * n && !timed) {
       std::cout << "error line " << line_no << ": " << q.size() << " values for two states of " << n
-                << " group joints\n";
+                << " group joints (2n, or 2n + 2 with their times)\n";
       status = kExitBadLine;
       continue;
     }
+    const double* q0 = q.data() + (timed ? 1 : 0);
+    const double* q1 = q.data() + (timed ? n + 2 : n);
+    const double t0 = timed ? q[0] : 0.0, t1 = timed ? q[n + 1] : 0.0;
     std::string bad;
-    if (!scene->validState(q.data(), &bad) || !scene->validState(q.data() + n, &bad)) {
+    if (!scene->validState(q0, &bad) || !scene->validState(q1, &bad)) {
       std::cout << "error line " << line_no << ": " << bad << "\n";
       status = kExitBadLine;
       continue;
     }
-    std::cout << verdict(*checker, q.data(), q.data() + n, ctx) << "\n";
+    if (!std::isfinite(t0) || !std::isfinite(t1)) {
+      std::cout << "error line " << line_no << ": a time is not finite\n";
+      status = kExitBadLine;
+      continue;
+    }
+    std::cout << verdict(*checker, q0, q1, ctx, t0, t1) << "\n";
   }
   std::cout.flush();
   return std::cout ? status : kExitUsage;

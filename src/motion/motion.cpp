@@ -299,9 +299,10 @@ void MotionBound::addDynamic(int link, std::size_t from, const double* dq, const
   f.fixed += after;
 }
 
-double MotionBound::linkStep(int link, const double* dq, const Pose* poses, double d) const noexcept {
+double MotionBound::linkStep(int link, const double* dq, const Pose* poses, double d, double extra) const noexcept {
   DynamicBound f;
   addDynamic(link, 0, dq, poses, f);
+  f.a += extra, f.fixed += extra;  // (linear in h)
   return f.solve(d);
 }
 
@@ -427,10 +428,7 @@ MotionChecker::MotionChecker(std::shared_ptr<const Scene> scene, MotionOptions o
   if (!(options_.distance_relative_error >= 0.0) || !std::isfinite(options_.distance_relative_error))
     throw std::invalid_argument("MotionChecker: distance_relative_error must be finite and >= 0");
   if (options_.max_queries < 1) throw std::invalid_argument("MotionChecker: max_queries must be >= 1");
-  // A segment has no time axis yet: moving obstacles would be checked where they are at t = 0 only.
-  if (scene_->effects().moving && scene_->environment().hasMovingObstacles())
-    throw std::invalid_argument("MotionChecker: scene '" + scene_->name() +
-                                "' has moving obstacles; segment checks against moving obstacles are not supported");
+  for (const Obstacle& o : scene_->environment().obstacles()) obstacle_speed_ = std::max(obstacle_speed_, o.velocity.norm());
   // A floating joint's quaternion turns along the great arc (slerp), as OMPL's SO(3) interpolates.
   const RobotModel& model = scene_->robot();
   for (int i = 0; i < scene_->dimension(); ++i) {
@@ -624,30 +622,38 @@ void MotionChecker::interpolate(const double* q0, const double* q1, double s, do
 
 MotionResult MotionChecker::check(const double* q0, const double* q1, MotionContext& ctx,
                                   bool tight_last_valid) const noexcept {
-  return options_.mode == MotionMode::Sampled ? sampled(q0, q1, ctx) : certified(q0, q1, ctx, tight_last_valid);
+  return check(q0, 0.0, q1, 0.0, ctx, tight_last_valid);
 }
 
-MotionResult MotionChecker::sampled(const double* q0, const double* q1, MotionContext& ctx) const noexcept {
+MotionResult MotionChecker::check(const double* q0, double t0, const double* q1, double t1, MotionContext& ctx,
+                                  bool tight_last_valid) const noexcept {
+  return options_.mode == MotionMode::Sampled ? sampled(q0, t0, q1, t1, ctx)
+                                              : certified(q0, t0, q1, t1, ctx, tight_last_valid);
+}
+
+MotionResult MotionChecker::sampled(const double* q0, double t0, const double* q1, double t1,
+                                    MotionContext& ctx) const noexcept {
   MotionResult r;
   const Scene& sc = *scene_;
+  const auto time = [&](double s) { return t0 + s * (t1 - t0); };
   double len2 = 0.0;
   for (int i = 0; i < sc.dimension(); ++i) len2 += (q1[i] - q0[i]) * (q1[i] - q0[i]);
   // As OMPL's DiscreteMotionValidator: the ends, then the states in between at the resolution.
   const double len = std::sqrt(len2);
   const int n = std::isfinite(len) ? std::max(1, static_cast<int>(std::ceil(len / options_.resolution))) : 1;
   r.steps = 1;
-  if (!sc.isFree(q0, ctx.scene, &r.report)) return r;
+  if (!sc.isFree(q0, ctx.scene, &r.report, t0)) return r;
   // The end first (each state is checked once); if it collides, the states in between say whether the
   // segment collides earlier.
   ++r.steps;
   CollisionReport end;
-  const bool end_free = sc.isFree(q1, ctx.scene, &end);
+  const bool end_free = sc.isFree(q1, ctx.scene, &end, t1);
   double last = 0.0;
   for (int k = 1; k < n; ++k) {
     const double s = static_cast<double>(k) / n;
     interpolate(q0, q1, s, ctx.q.data());
     ++r.steps;
-    if (!sc.isFree(ctx.q.data(), ctx.scene, &r.report)) {
+    if (!sc.isFree(ctx.q.data(), ctx.scene, &r.report, time(s))) {
       r.first_contact = s;
       r.last_valid = last;
       return r;
@@ -674,6 +680,7 @@ void MotionChecker::castAhead(const double* q0, const double* q1, int n_items, M
     const Item& it = items_[k];
     if (it.group >= 0) continue;  // its group's coverage decides where it starts
     const bool self = it.b >= 0;
+    if (!self && ctx.obstacle_motion > 0.0) continue;  // (the cast holds obstacles still)
     if (self ? !bound_.translates(it.a, it.b, ctx.dq.data()) : !bound_.translates(it.a, ctx.dq.data())) continue;
     if (!posed) {  // both ends' poses, once: the end's kept aside, the start's left in the scene context
       sc.computePoses(q1, ctx.scene);
@@ -719,6 +726,7 @@ struct MotionChecker::Sweep {
   MotionResult& r;
   const double* q0;
   const double* q1;
+  double t0 = 0.0, t1 = 0.0;  // the times at q0 and q1 (moving obstacles)
   double limit = 1.0;         // the first contact found so far, or the segment's end
   bool hit = false;           // a contact at `limit`
   double clear_before = 0.0;  // a parameter before `limit` the contacting item is certified clear at
@@ -734,6 +742,9 @@ struct MotionChecker::Sweep {
       : mc(checker), ctx(c), r(result), q0(from), q1(to) {
     ctx.scene.poses[0] = Pose::identity();
   }
+
+  // The time at parameter s.
+  double time(double s) const noexcept { return t0 + s * (t1 - t0); }
 
   // The link's pose (and its ancestors') at parameter s.
   const Pose& pose(double s, int link) {
@@ -817,25 +828,26 @@ struct MotionChecker::Sweep {
       }
     } else {
       const double cutoff = need + it.padding + contact;
+      const double t = time(s);  // where moving obstacles are
       // As for pairs: the hull's bound first, the exact geometry only when the hull comes close.
       const int e = k - mc.env_begin_;
       SimplexCache* warm = warmStarts(ctx.env_cache, ctx.env_slot[e], ctx.env_stamp[e], sc.environment().staticCount());
       const double h =
-          sc.environment().hullLowerBound(*it.ga, pa, tol, cutoff, relative, 0.0, &ctx.scene.counters.environment, warm);
+          sc.environment().hullLowerBound(*it.ga, pa, tol, cutoff, relative, t, &ctx.scene.counters.environment, warm);
       d = h - it.padding;
       EnvironmentHit hit;
       bool found = false;  // `hit` names what is within contact
       EnvironmentCounters* counters = &ctx.scene.counters.environment;
       if (d <= contact && exact && !head)  // the convex parts, then (as for pairs) within contact, then how far
-        d = std::max(d, sc.environment().hullLowerBound(*it.ga, pa, tol, cutoff, relative, 0.0, counters, nullptr, true) -
+        d = std::max(d, sc.environment().hullLowerBound(*it.ga, pa, tol, cutoff, relative, t, counters, nullptr, true) -
                             it.padding);  // (d first: NaN)
       if (d <= contact && exact && !head) {
-        if (sc.environment().linkIntersects(*it.ga, pa, tol, GeometryMode::Mesh, it.padding + contact, 0.0, &hit, counters)) {
+        if (sc.environment().linkIntersects(*it.ga, pa, tol, GeometryMode::Mesh, it.padding + contact, t, &hit, counters)) {
           d = 0.0;
           found = true;
         } else {
           const DistanceResult e =
-              sc.environment().linkDistance(*it.ga, pa, tol, std::min(cutoff, it.padding + kNear * contact), 0.0, relative, counters);
+              sc.environment().linkDistance(*it.ga, pa, tol, std::min(cutoff, it.padding + kNear * contact), t, relative, counters);
           d = isFailure(e.status) ? 0.0 : std::max(e.lower_bound - it.padding, kBeyond * contact);
         }
       }
@@ -847,7 +859,7 @@ struct MotionChecker::Sweep {
         // relative error the distance's lower bound was allowed.
         if (!found)
           sc.environment().linkIntersects(*it.ga, pa, tol, sc.options().mode,
-                                          it.padding + (contact + 1e-9) * (1.0 + relative), 0.0, &hit);
+                                          it.padding + (contact + 1e-9) * (1.0 + relative), t, &hit);
         report.hit = hit;
       }
     }
@@ -903,7 +915,7 @@ struct MotionChecker::Sweep {
     const Item& it = mc.items_[k];
     const double* dq = ctx.dq.data();
     const Pose* poses = ctx.scene.poses.data();  // (at the parameter d was measured at)
-    if (it.b < 0) return mc.bound_.linkStep(it.a, dq, poses, d);
+    if (it.b < 0) return mc.bound_.linkStep(it.a, dq, poses, d, ctx.obstacle_motion);
     double h = std::max(d / ctx.bound[k], mc.bound_.pairStep(it.a, it.b, dq, poses, d));
     if (h < want && split_item == k && splitClearances(k, d)) {
       const double* bound = splitBounds(k);
@@ -939,7 +951,7 @@ struct MotionChecker::Sweep {
       if (d <= mc.options_.contact_distance) {
         if (it.last > it.first) {  // a group within contact: its members take over here, exactly
           for (int member = it.first; member < it.last && !capped; ++member) {
-            ctx.bound[member] = mc.itemBound(mc.items_[member], ctx.dq.data());
+            ctx.bound[member] = mc.itemBound(mc.items_[member], ctx.dq.data(), ctx.obstacle_motion);
             cover(member, iv.a, hi, iv.witness);
           }
           continue;
@@ -987,11 +999,11 @@ struct MotionChecker::Sweep {
   }
 };
 
-double MotionChecker::itemBound(const Item& it, const double* dq) const noexcept {
-  return it.b >= 0 ? bound_.pair(it.a, it.b, dq) : bound_.link(it.a, dq);
+double MotionChecker::itemBound(const Item& it, const double* dq, double obstacle_motion) const noexcept {
+  return it.b >= 0 ? bound_.pair(it.a, it.b, dq) : bound_.link(it.a, dq) + obstacle_motion;
 }
 
-MotionResult MotionChecker::certified(const double* q0, const double* q1, MotionContext& ctx,
+MotionResult MotionChecker::certified(const double* q0, double t0, const double* q1, double t1, MotionContext& ctx,
                                       bool tight_last_valid) const noexcept {
   MotionResult r;
   const Scene& sc = *scene_;
@@ -1027,14 +1039,24 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
   for (SimplexCache& c : ctx.hull_cache) c = SimplexCache{};
   ++ctx.segment;  // (the part pairs' and obstacles' warm starts are emptied as their items first need them)
   // Members wait until their group comes within contact.
+  // How far moving obstacles travel over the segment (per unit of s): it adds to every environment item's
+  // motion; none unless the scene declares them.
+  const bool timed = sc.effects().moving && sc.environment().hasMovingObstacles();
+  if (!timed) t0 = t1 = 0.0;
+  ctx.obstacle_motion = timed ? obstacle_speed_ * std::abs(t1 - t0) : 0.0;
+  if (!std::isfinite(ctx.obstacle_motion) || !std::isfinite(t0)) {
+    r.report.kind = CollisionReport::Kind::Invalid;
+    return r;
+  }
   for (int k = 0; k < n_items; ++k) {
     if (items_[k].group >= 0) continue;
-    ctx.bound[k] = itemBound(items_[k], ctx.dq.data());  // (0 when still on this segment: measured once)
+    ctx.bound[k] = itemBound(items_[k], ctx.dq.data(), ctx.obstacle_motion);  // (0 when nothing moves: measured once)
     ctx.safe_until[k] = 0.0;
   }
 
   if (options_.mode == MotionMode::Cast) castAhead(q0, q1, n_items, ctx, r);
   Sweep sweep{*this, ctx, r, q0, q1};
+  sweep.t0 = t0, sweep.t1 = t1;
   // The item that met the last contact goes first: a planner's next segment often meets it again, and a
   // contact found early bounds every other item's work.
   const int lead = ctx.lead >= 0 && ctx.lead < n_items && items_[ctx.lead].group < 0 ? ctx.lead : -1;
@@ -1090,7 +1112,7 @@ MotionResult MotionChecker::certified(const double* q0, const double* q1, Motion
     r.last_valid = sweep.clear_before;
     if (tight_last_valid) {
       interpolate(q0, q1, sweep.limit, ctx.q.data());
-      if (sc.isFree(ctx.q.data(), ctx.scene)) r.last_valid = sweep.limit;
+      if (sc.isFree(ctx.q.data(), ctx.scene, nullptr, sweep.time(sweep.limit))) r.last_valid = sweep.limit;
     }
     return r;
   }

@@ -622,6 +622,41 @@ TEST(MotionTool, ChecksSegments) {
   EXPECT_EQ(runTool("motion").exit_code, 2);
 }
 
+TEST(MotionTool, TimedLinesAgainstMovingObstacles) {
+  // A block on a slider holds still at x = 0 while a wall moving at 1 m/s along +x sweeps past it
+  // between t = 0.9 and t = 1.1: a line with times sees it; without times, or later, the segment is free.
+  const std::string base = testing::TempDir() + "clearway_moving_" + std::to_string(::getpid());
+  std::ofstream(base + ".urdf") << R"(<?xml version="1.0"?>
+<robot name="slider">
+  <link name="base"/>
+  <link name="block"><collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>
+  <joint name="slide" type="prismatic">
+    <parent link="base"/><child link="block"/><axis xyz="1 0 0"/>
+    <limit lower="-1" upper="1" velocity="1" effort="1"/>
+  </joint>
+</robot>
+)";
+  std::ofstream(base + ".yaml") << "format: 1\nname: moving\nrobot:\n  urdf: " << base << ".urdf\n  group: [slide]\n"
+                                   "environment:\n  obstacles:\n    - {name: wall, box: {size: [0.001, 2, 2]}, "
+                                   "pose: {position: [-1, 0, 0]}, velocity: [1, 0, 0]}\n"
+                                   "checks: [environment, continuous, moving]\nstart: [0]\ngoal: [0]\n";
+  std::ofstream(base + ".txt") << "0 0  2 0\n"   // the wall sweeps past
+                                  "0  0\n"        // no times: the wall at t = 0, far away
+                                  "3 0  5 0\n"   // after it has passed
+                                  "0 0 0\n";     // three values: neither 2n nor 2n + 2
+  const ToolRun r = runTool("motion " + base + ".yaml --motions " + base + ".txt");
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  std::istringstream out(r.out);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(out, line);) lines.push_back(line);
+  ASSERT_EQ(lines.size(), 4u) << r.out;
+  EXPECT_EQ(lines[0].rfind("collision 0.47", 0), 0u) << lines[0];  // the faces meet at t = 0.9495
+  EXPECT_NE(lines[0].find("wall"), std::string::npos) << lines[0];
+  EXPECT_EQ(lines[1], "free");
+  EXPECT_EQ(lines[2], "free");
+  EXPECT_EQ(lines[3].rfind("error line 4", 0), 0u) << lines[3];
+}
+
 TEST(AuditTool, WritesSrdfAndReport) {
   const std::string dir = testing::TempDir() + "clearway_audit_" + std::to_string(::getpid());
   std::filesystem::create_directories(dir);

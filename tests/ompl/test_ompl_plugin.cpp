@@ -115,6 +115,18 @@ TEST(OmplPlugin, ValidityCheckerAgreesWithTheScene) {
   EXPECT_EQ(c.validity->getSpecs().clearanceComputationType, ob::StateValidityCheckerSpecs::NONE);
 }
 
+TEST(OmplPlugin, MovingObstaclesAreRefused) {
+  // OMPL's states carry no time: a scene with moving obstacles is refused, not checked at t = 0.
+  TempDir dir;
+  const std::string urdf = dir.write("spinner.urdf", kSpinnerUrdf);
+  const auto scene = Scene::load(dir.write("moving.yaml", "format: 1\nname: moving\nrobot:\n  urdf: " + urdf +
+                                                              "\n  group: [spin, lift]\nenvironment:\n  obstacles:\n"
+                                                              "    - {name: ball, sphere: {radius: 0.1}, pose: {position: [0, 1, 0]}, "
+                                                              "velocity: [0, -1, 0]}\nchecks: [environment, moving]\n"));
+  auto si = std::make_shared<ob::SpaceInformation>(makeStateSpace(*scene));
+  EXPECT_THROW(setupCollisionChecking(si, scene), std::invalid_argument);
+}
+
 TEST(OmplPlugin, MotionValidatorTakesTheShortWayAndReportsLastValid) {
   TempDir dir;
   const auto scene = spinnerScene(dir);

@@ -53,8 +53,9 @@ class MotionBound {
   /// are `poses` (the link's and its ancestors' at least), no point of the link moves d or farther: the
   /// reaches measured from where the joint axes are now (a point's distance from joint k's axis changes
   /// only through the joints after k, either way), which is much tighter than d / link(dq) for a link near
-  /// the axes that turn it. Never below d / link(dq).
-  double linkStep(int link, const double* dq, const Pose* poses, double d) const noexcept;
+  /// the axes that turn it. Never below d / link(dq). `extra`: more motion, extra·h for the step h·dq (the
+  /// obstacles it is measured from moving too).
+  double linkStep(int link, const double* dq, const Pose* poses, double d, double extra = 0.0) const noexcept;
   /// The same for the distance between links a and b (poses of both and their ancestors needed), watched
   /// from their common ancestor; where pair() watches from a better link, d / pair(a, b, dq) may be larger.
   double pairStep(int a, int b, const double* dq, const Pose* poses, double d) const noexcept;
@@ -160,6 +161,7 @@ struct MotionContext {
   std::vector<double> split_bound;
   std::vector<int> split_slot;
   std::vector<std::uint64_t> split_stamp;
+  double obstacle_motion = 0.0;  // how far moving obstacles travel over the segment (per unit of s)
   std::uint64_t segment = 0;  // segments checked with this context (the stamps above refer to it)
   std::vector<std::uint64_t> pose_stamp;  // per link: the step its pose in scene.poses was computed for
   std::vector<int> pose_path;             // scratch: links whose poses are due, deepest first
@@ -177,8 +179,7 @@ struct MotionContext {
 /// of bounds) anywhere makes the segment not free. Thread-safe given one context per thread.
 class MotionChecker {
  public:
-  /// Throws std::invalid_argument for options out of range or a scene with moving obstacles (segments have
-  /// no time axis yet).
+  /// Throws std::invalid_argument for options out of range.
   MotionChecker(std::shared_ptr<const Scene> scene, MotionOptions options = {});
 
   const Scene& scene() const noexcept { return *scene_; }
@@ -194,13 +195,19 @@ class MotionChecker {
   /// checkMotion(s1, s2)).
   MotionResult check(const double* q0, const double* q1, MotionContext& context,
                      bool tight_last_valid = true) const noexcept;
+  /// The same for q0 at time t0 → q1 at time t1 (the time linear in s), with the scene's moving obstacles
+  /// where they are at each moment: their speed adds to every environment item's motion bound. Scenes that
+  /// do not declare `moving` ignore the times; the check above is this one at t0 = t1 = 0.
+  MotionResult check(const double* q0, double t0, const double* q1, double t1, MotionContext& context,
+                     bool tight_last_valid = true) const noexcept;
   /// The state at parameter s of q0 → q1, into out: linear, except that a floating joint's quaternion
   /// follows the short great arc at constant speed (slerp, as OMPL's SO(3) space), normalized.
   void interpolate(const double* q0, const double* q1, double s, double* out) const noexcept;
 
  private:
-  MotionResult certified(const double* q0, const double* q1, MotionContext& ctx, bool tight_last_valid) const noexcept;
-  MotionResult sampled(const double* q0, const double* q1, MotionContext& ctx) const noexcept;
+  MotionResult certified(const double* q0, double t0, const double* q1, double t1, MotionContext& ctx,
+                         bool tight_last_valid) const noexcept;
+  MotionResult sampled(const double* q0, double t0, const double* q1, double t1, MotionContext& ctx) const noexcept;
   // Cast mode: items that only translate on the segment start from their shape cast's time of impact.
   void castAhead(const double* q0, const double* q1, int n_items, MotionContext& ctx, MotionResult& r) const noexcept;
 
@@ -229,7 +236,7 @@ class MotionChecker {
   // Fills items_: groups where two bodies' every link pair (or a body's every link) is checked.
   void buildItems();
   // The item's motion bound for the step dq.
-  double itemBound(const Item& item, const double* dq) const noexcept;
+  double itemBound(const Item& item, const double* dq, double obstacle_motion) const noexcept;
   struct Sweep;  // motion.cpp
 
   std::shared_ptr<const Scene> scene_;
@@ -239,6 +246,7 @@ class MotionChecker {
   std::vector<Item> items_;  // self groups and their members, other self pairs; then the same for the environment
   int env_begin_ = 0;        // the first environment item
   CollisionReport rigid_collision_;  // a self pair within one rigid body that collides (then every state does)
+  double obstacle_speed_ = 0.0;   // the fastest obstacle's speed (m/s)
   std::vector<int> quaternions_;  // state entries where a floating joint's quaternion starts (qx)
 };
 

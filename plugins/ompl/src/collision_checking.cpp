@@ -234,9 +234,22 @@ double ValidityChecker::clearance(const ob::State* state) const {
 
 // ---- ContinuousMotionValidator ------------------------------------------------------------------------
 
+namespace {
+
+// OMPL's states carry no time, and against moving obstacles a segment's verdict depends on when it is
+// travelled: refused rather than checked with the obstacles held where they are at t = 0.
+std::shared_ptr<const Scene> timeless(std::shared_ptr<const Scene> scene) {
+  if (scene && scene->effects().moving && scene->environment().hasMovingObstacles())
+    throw std::invalid_argument("ContinuousMotionValidator: scene '" + scene->name() +
+                                "' has moving obstacles, and OMPL states carry no time (use MotionChecker::check with times)");
+  return scene;
+}
+
+}  // namespace
+
 ContinuousMotionValidator::ContinuousMotionValidator(const ob::SpaceInformationPtr& si,
                                                      std::shared_ptr<const Scene> scene, MotionOptions options)
-    : ob::MotionValidator(si), checker_(scene, options), map_(*scene), serial_(g_next_serial++) {}
+    : ob::MotionValidator(si), checker_(timeless(scene), options), map_(*scene), serial_(g_next_serial++) {}
 
 MotionResult ContinuousMotionValidator::check(const ob::State* s1, const ob::State* s2, bool tight_last_valid) const {
   const Timer timer(counters_.nanoseconds);
