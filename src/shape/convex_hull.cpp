@@ -812,6 +812,42 @@ ConvexHull::ConvexHull(const std::vector<Vec3>& points) {
     center_ += v;
   }
   center_ /= static_cast<double>(vertices_.size());
+
+  // The cube map, by brute force (once): a direction's cell holds a vertex near its answer, so a climb
+  // from it takes a step or two where one from a stale hint (another pose, or GJK's first, far-apart
+  // directions) crosses much of a fine hull.
+  if (!adjacency_.empty() && vertices_.size() >= kBruteForceBelow) {
+    cube_.resize(6 * kCube * kCube);
+    for (int face = 0; face < 6; ++face)
+      for (int i = 0; i < kCube; ++i)
+        for (int j = 0; j < kCube; ++j) {
+          Vec3 d = Vec3::Zero();
+          const int axis = face / 2;
+          d[axis] = face % 2 ? -1.0 : 1.0;
+          d[(axis + 1) % 3] = (i + 0.5) * 2.0 / kCube - 1.0;
+          d[(axis + 2) % 3] = (j + 0.5) * 2.0 / kCube - 1.0;
+          std::int32_t best = 0;
+          for (std::size_t v = 1; v < vertices_.size(); ++v)
+            if (d.dot(vertices_[v]) > d.dot(vertices_[best])) best = static_cast<std::int32_t>(v);
+          cube_[(face * kCube + i) * kCube + j] = best;
+        }
+  }
+}
+
+int ConvexHull::cubeCell(const Vec3& d) const noexcept {
+  const Vec3 a = d.cwiseAbs();
+  const int axis = a.x() >= a.y() ? (a.x() >= a.z() ? 0 : 2) : (a.y() >= a.z() ? 1 : 2);
+  const double m = a[axis];
+  if (!(m > 0.0) || !std::isfinite(m)) return -1;
+  const int face = 2 * axis + (d[axis] < 0.0 ? 1 : 0);
+  // (A NaN coordinate compares false and lands in cell 0: any start is correct, only slower.)
+  const auto cell = [&](double u) {
+    double x = (u / m + 1.0) * (0.5 * kCube);
+    if (!(x >= 0.0)) x = 0.0;
+    if (x > kCube - 1) x = kCube - 1;
+    return static_cast<int>(x);
+  };
+  return (face * kCube + cell(d[(axis + 1) % 3])) * kCube + cell(d[(axis + 2) % 3]);
 }
 
 Vec3 ConvexHull::support(const Vec3& d) const noexcept {
@@ -833,8 +869,15 @@ Vec3 ConvexHull::support(const Vec3& d, std::int32_t& hint) const noexcept {
   double cur_dot;
   if (hint >= 0 && static_cast<std::size_t>(hint) < vertices_.size()) {
     // Consecutive support directions of one query (and of a pair moving smoothly) are close, so the
-    // last answer is usually a step or two from the next one.
+    // last answer is usually a step or two from the next one; the cube map's vertex when it is better.
     cur = hint;
+    cur_dot = d.dot(vertices_[cur]);
+    if (const int c = cubeCell(d); c >= 0) {
+      const double x = d.dot(vertices_[cube_[c]]);
+      if (x > cur_dot) cur = cube_[c], cur_dot = x;
+    }
+  } else if (const int c = cubeCell(d); c >= 0) {
+    cur = cube_[c];
     cur_dot = d.dot(vertices_[cur]);
   } else {
     cur = starts_[0];

@@ -83,12 +83,16 @@ void expectExactSupport(const ConvexHull& hull, const std::vector<Vec3>& input, 
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal;
   const double scale = largestCoordinate(input);
+  std::int32_t hint = -1;  // carried from one direction to the next, as GJK's warm starts are
   for (int i = 0; i < count; ++i) {
     Vec3 d(normal(rng), normal(rng), normal(rng));
     if (i % 7 == 0) d = Vec3(i % 2 ? 1.0 : -1.0, 0.0, 0.0);  // axis directions: ties on flat faces
+    if (i % 11 == 0) d = Vec3(1.0, i % 2 ? -1.0 : 1.0, 1.0);  // the cube map's face and cell borders
     const Vec3 s = hull.support(d);
     ASSERT_NEAR(d.dot(s), bruteForceMax(input, d), 1e-12 * scale * d.norm()) << "direction " << d.transpose();
     ASSERT_TRUE(isInputPoint(hull.vertices(), s));
+    const Vec3 warm = hull.support(d, hint);
+    ASSERT_NEAR(d.dot(warm), bruteForceMax(input, d), 1e-12 * scale * d.norm()) << "direction " << d.transpose();
   }
 }
 

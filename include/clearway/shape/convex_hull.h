@@ -38,6 +38,11 @@ class ConvexHull {
   std::vector<std::int32_t> offsets_, adjacency_;
   // Start vertices for hill climbing: the extreme vertex along ±x, ±y, ±z.
   std::array<std::int32_t, 6> starts_{};
+  // A cube map of start vertices (hulls that hill-climb): per face of the cube (±x, ±y, ±z) a kCube × kCube
+  // grid, each cell's extreme vertex along the direction through its centre.
+  static constexpr int kCube = 8;
+  std::vector<std::int32_t> cube_;
+  int cubeCell(const Vec3& d) const noexcept;
   Vec3 center_ = Vec3::Zero();
 };
 
