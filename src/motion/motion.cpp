@@ -915,8 +915,11 @@ struct MotionChecker::Sweep {
     const Item& it = mc.items_[k];
     const double* dq = ctx.dq.data();
     const Pose* poses = ctx.scene.poses.data();  // (at the parameter d was measured at)
-    if (it.b < 0) return mc.bound_.linkStep(it.a, dq, poses, d, ctx.obstacle_motion);
-    double h = std::max(d / ctx.bound[k], mc.bound_.pairStep(it.a, it.b, dq, poses, d));
+    // The static bound first: where it reaches as far as asked, the reaches from the axes now are not needed.
+    double h = d / ctx.bound[k];  // (∞ when the item does not move)
+    if (!(h < want)) return h;
+    if (it.b < 0) return std::max(h, mc.bound_.linkStep(it.a, dq, poses, d, ctx.obstacle_motion));
+    h = std::max(h, mc.bound_.pairStep(it.a, it.b, dq, poses, d));
     if (h < want && split_item == k && splitClearances(k, d)) {
       const double* bound = splitBounds(k);
       const std::size_t na = it.ga->parts().size(), nb = it.gb->parts().size();

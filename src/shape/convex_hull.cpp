@@ -834,21 +834,27 @@ ConvexHull::ConvexHull(const std::vector<Vec3>& points) {
   }
 }
 
-int ConvexHull::cubeCell(const Vec3& d) const noexcept {
-  const Vec3 a = d.cwiseAbs();
-  const int axis = a.x() >= a.y() ? (a.x() >= a.z() ? 0 : 2) : (a.y() >= a.z() ? 1 : 2);
-  const double m = a[axis];
-  if (!(m > 0.0) || !std::isfinite(m)) return -1;
+namespace {
+
+// The cube map's cell of direction d (n × n cells per face), −1 for a zero or non-finite d.
+inline int cubeCell(const Vec3& d, int n) noexcept {
+  const double ax = std::abs(d.x()), ay = std::abs(d.y()), az = std::abs(d.z());
+  const int axis = ax >= ay ? (ax >= az ? 0 : 2) : (ay >= az ? 1 : 2);
+  const double m = axis == 0 ? ax : axis == 1 ? ay : az;
+  if (!(m > 0.0) || !(m < std::numeric_limits<double>::infinity())) return -1;
   const int face = 2 * axis + (d[axis] < 0.0 ? 1 : 0);
   // (A NaN coordinate compares false and lands in cell 0: any start is correct, only slower.)
+  const double scale = 0.5 * n / m;
   const auto cell = [&](double u) {
-    double x = (u / m + 1.0) * (0.5 * kCube);
+    double x = u * scale + 0.5 * n;
     if (!(x >= 0.0)) x = 0.0;
-    if (x > kCube - 1) x = kCube - 1;
+    if (x > n - 1) x = n - 1;
     return static_cast<int>(x);
   };
-  return (face * kCube + cell(d[(axis + 1) % 3])) * kCube + cell(d[(axis + 2) % 3]);
+  return (face * n + cell(d[(axis + 1) % 3])) * n + cell(d[(axis + 2) % 3]);
 }
+
+}  // namespace
 
 Vec3 ConvexHull::support(const Vec3& d) const noexcept {
   std::int32_t hint = -1;
@@ -872,11 +878,11 @@ Vec3 ConvexHull::support(const Vec3& d, std::int32_t& hint) const noexcept {
     // last answer is usually a step or two from the next one; the cube map's vertex when it is better.
     cur = hint;
     cur_dot = d.dot(vertices_[cur]);
-    if (const int c = cubeCell(d); c >= 0) {
+    if (const int c = cubeCell(d, kCube); c >= 0) {
       const double x = d.dot(vertices_[cube_[c]]);
       if (x > cur_dot) cur = cube_[c], cur_dot = x;
     }
-  } else if (const int c = cubeCell(d); c >= 0) {
+  } else if (const int c = cubeCell(d, kCube); c >= 0) {
     cur = cube_[c];
     cur_dot = d.dot(vertices_[cur]);
   } else {

@@ -42,7 +42,6 @@ class ConvexHull {
   // grid, each cell's extreme vertex along the direction through its centre.
   static constexpr int kCube = 8;
   std::vector<std::int32_t> cube_;
-  int cubeCell(const Vec3& d) const noexcept;
   Vec3 center_ = Vec3::Zero();
 };
 
