@@ -688,6 +688,17 @@ TEST(MotionCertified, PlanarAndFloatingNeverMissWhatDenseSamplingFinds) {
   EXPECT_GE(r.first_contact, (0.69 - 0.15 + 1 - certified.options().contact_distance) / 3 - 1e-9);
 }
 
+// A random state within the scene's bounds (and ±3), and a step of up to 0.4 in each entry that stays in them.
+void randomStep(const Scene& scene, std::mt19937& rng, std::vector<double>& q0, std::vector<double>& q1,
+                std::vector<double>& dq) {
+  for (int i = 0; i < scene.dimension(); ++i) {
+    std::uniform_real_distribution<double> u(std::max(scene.lower(i), -3.0), std::min(scene.upper(i), 3.0));
+    q0[i] = u(rng);
+    q1[i] = std::clamp(q0[i] + std::uniform_real_distribution<double>(-0.4, 0.4)(rng), scene.lower(i), scene.upper(i));
+    dq[i] = q1[i] - q0[i];
+  }
+}
+
 // The bounds on the shared robots, where the reaches come from real meshes, rigid grippers and chains
 // that fork: over random steps, no hull vertex of a link moves farther than link() says, and no distance
 // between hull vertices of a checked pair changes by more than pair() says.
@@ -704,12 +715,7 @@ TEST(MotionBound, HoldsOnTheSharedRobots) {
     std::vector<double> q0(n), q1(n), dq(n);
     int checked = 0;
     for (int trial = 0; trial < 30; ++trial) {
-      for (int i = 0; i < n; ++i) {
-        std::uniform_real_distribution<double> u(std::max(scene->lower(i), -3.0), std::min(scene->upper(i), 3.0));
-        q0[i] = u(rng);
-        q1[i] = std::clamp(q0[i] + std::uniform_real_distribution<double>(-0.4, 0.4)(rng), scene->lower(i), scene->upper(i));
-        dq[i] = q1[i] - q0[i];
-      }
+      randomStep(*scene, rng, q0, q1, dq);
       scene->computePoses(q0.data(), c0);
       scene->computePoses(q1.data(), c1);
       const auto vertices = [&](int link) -> const std::vector<Vec3>& { return scene->geometry().link(link)->hull().vertices(); };
@@ -871,12 +877,7 @@ TEST(MotionBound, HoldsForConvexParts) {
     std::vector<double> q0(n), q1(n), dq(n);
     int checked = 0, much_lower = 0;
     for (int trial = 0; trial < 20; ++trial) {
-      for (int i = 0; i < n; ++i) {
-        std::uniform_real_distribution<double> u(std::max(scene->lower(i), -3.0), std::min(scene->upper(i), 3.0));
-        q0[i] = u(rng);
-        q1[i] = std::clamp(q0[i] + std::uniform_real_distribution<double>(-0.4, 0.4)(rng), scene->lower(i), scene->upper(i));
-        dq[i] = q1[i] - q0[i];
-      }
+      randomStep(*scene, rng, q0, q1, dq);
       scene->computePoses(q0.data(), c0);
       scene->computePoses(q1.data(), c1);
       for (const LinkPair& p : scene->selfCollision().pairs()) {
