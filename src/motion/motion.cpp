@@ -621,14 +621,14 @@ void MotionChecker::interpolate(const double* q0, const double* q1, double s, do
 }
 
 MotionResult MotionChecker::check(const double* q0, const double* q1, MotionContext& ctx,
-                                  bool tight_last_valid) const noexcept {
-  return check(q0, 0.0, q1, 0.0, ctx, tight_last_valid);
+                                  bool locate_contact) const noexcept {
+  return check(q0, 0.0, q1, 0.0, ctx, locate_contact);
 }
 
 MotionResult MotionChecker::check(const double* q0, double t0, const double* q1, double t1, MotionContext& ctx,
-                                  bool tight_last_valid) const noexcept {
+                                  bool locate_contact) const noexcept {
   return options_.mode == MotionMode::Sampled ? sampled(q0, t0, q1, t1, ctx)
-                                              : certified(q0, t0, q1, t1, ctx, tight_last_valid);
+                                              : certified(q0, t0, q1, t1, ctx, locate_contact);
 }
 
 MotionResult MotionChecker::sampled(const double* q0, double t0, const double* q1, double t1,
@@ -732,6 +732,10 @@ struct MotionChecker::Sweep {
   double clear_before = 0.0;  // a parameter before `limit` the contacting item is certified clear at
   bool capped = false;
   int contacts = 0;           // how often the limit was lowered
+  // Only the verdict is asked: the first measurement within contact settles it (it is a contact, if not
+  // the first one), and nothing else is measured.
+  bool verdict_only = false;
+  bool stop() const noexcept { return capped || (verdict_only && hit); }
   double at_s = -1.0;         // the parameter ctx.scene.q holds
   // The last measurement's self item whose hulls' GJK axis separates them (splitClearances), −1: none.
   static constexpr std::size_t kSplit = 8;
@@ -933,9 +937,20 @@ struct MotionChecker::Sweep {
 
   // How far either way from s item k is clear, measured for the interval s ± half; −1 within contact.
   double first(int k, double s, double half) {
-    CollisionReport unused;
-    const double d = measure(k, s, ctx.bound[k] * half, unused);
-    return d <= mc.options_.contact_distance ? -1.0 : reach(k, d, half);
+    CollisionReport report;
+    const double d = measure(k, s, ctx.bound[k] * half, report);
+    if (d > mc.options_.contact_distance) return reach(k, d, half);
+    if (verdict_only && mc.items_[k].last <= mc.items_[k].first) found(s, report);
+    return -1.0;
+  }
+
+  // A contact at s settles a verdict-only check (no parameter before it is known to be free).
+  void found(double s, const CollisionReport& report) {
+    hit = true;
+    limit = s;
+    ++contacts;
+    clear_before = 0.0;
+    r.report = report;
   }
 
   // Covers [a, b] ∩ [0, limit] for item k (all of [0, a) is covered already).
@@ -944,7 +959,7 @@ struct MotionChecker::Sweep {
     const std::size_t base = ctx.intervals.size();
     ctx.intervals.push_back({a, b, witness});
     CollisionReport report;
-    while (ctx.intervals.size() > base && !capped) {
+    while (ctx.intervals.size() > base && !stop()) {
       const MotionContext::Interval iv = ctx.intervals.back();
       ctx.intervals.pop_back();
       const double hi = std::min(iv.b, limit);
@@ -953,11 +968,16 @@ struct MotionChecker::Sweep {
       const double d = measure(k, m, ctx.bound[k] * 0.5 * (hi - iv.a), report);
       if (d <= mc.options_.contact_distance) {
         if (it.last > it.first) {  // a group within contact: its members take over here, exactly
-          for (int member = it.first; member < it.last && !capped; ++member) {
+          for (int member = it.first; member < it.last && !stop(); ++member) {
             ctx.bound[member] = mc.itemBound(mc.items_[member], ctx.dq.data(), ctx.obstacle_motion);
             cover(member, iv.a, hi, iv.witness);
           }
           continue;
+        }
+        if (verdict_only) {
+          found(m, report);
+          ctx.intervals.resize(base);
+          return;
         }
         if (advance(k, iv.a, iv.witness, hi)) {
           ctx.intervals.resize(base);  // all to the right of the contact
@@ -1007,7 +1027,7 @@ double MotionChecker::itemBound(const Item& it, const double* dq, double obstacl
 }
 
 MotionResult MotionChecker::certified(const double* q0, double t0, const double* q1, double t1, MotionContext& ctx,
-                                      bool tight_last_valid) const noexcept {
+                                      bool locate_contact) const noexcept {
   MotionResult r;
   const Scene& sc = *scene_;
   // q0's collisions are found by the items' coverage of the segment, except those no state changes.
@@ -1060,6 +1080,7 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
   if (options_.mode == MotionMode::Cast) castAhead(q0, q1, n_items, ctx, r);
   Sweep sweep{*this, ctx, r, q0, q1};
   sweep.t0 = t0, sweep.t1 = t1;
+  sweep.verdict_only = !locate_contact;
   // The item that met the last contact goes first: a planner's next segment often meets it again, and a
   // contact found early bounds every other item's work.
   const int lead = ctx.lead >= 0 && ctx.lead < n_items && items_[ctx.lead].group < 0 ? ctx.lead : -1;
@@ -1072,9 +1093,13 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
     cover(lead, ctx.safe_until[lead], 1.0, ctx.safe_until[lead] > 0.0 ? ctx.safe_until[lead] : -1.0);
   // Every other item is first measured in the middle of what is left, where one set of poses serves all.
   const double mid = 0.5 * sweep.limit;
-  for (int k = 0; k < n_items && !sweep.capped; ++k)
-    if (k != lead && items_[k].group < 0 && ctx.safe_until[k] == 0.0) ctx.first_reach[k] = sweep.first(k, mid, mid);
-  for (int k = 0; k < n_items && !sweep.capped; ++k) {
+  for (int k = 0; k < n_items && !sweep.stop(); ++k)
+    if (k != lead && items_[k].group < 0 && ctx.safe_until[k] == 0.0) {
+      const int before = sweep.contacts;
+      ctx.first_reach[k] = sweep.first(k, mid, mid);
+      if (sweep.contacts > before) ctx.lead = k;
+    }
+  for (int k = 0; k < n_items && !sweep.stop(); ++k) {
     if (k == lead || items_[k].group >= 0) continue;
     const double start = ctx.safe_until[k];  // 0, or where a shape cast says the item is clear until
     if (start > 1.0) continue;
@@ -1113,7 +1138,7 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
     // full check of a state next to a contact, where the exact meshes decide: about a tenth of a UR5's
     // motion checks, so only for callers that want it.)
     r.last_valid = sweep.clear_before;
-    if (tight_last_valid) {
+    if (locate_contact) {
       interpolate(q0, q1, sweep.limit, ctx.q.data());
       if (sc.isFree(ctx.q.data(), ctx.scene, nullptr, sweep.time(sweep.limit))) r.last_valid = sweep.limit;
     }

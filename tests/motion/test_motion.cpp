@@ -133,17 +133,15 @@ TEST(MotionCertified, ThinWallIsNeverTunnelled) {
   EXPECT_TRUE(scene->isFree(std::vector<double>(q, q + 2)));
   // Few steps: the block is far from the wall most of the way.
   EXPECT_LT(r.steps, 200);
-  // Without the state check at the contact: the same verdict and contact, and a last valid parameter
-  // that is still free, no later than the tight one, and near the contact although the one advancement
-  // step (exact for a slide) went from s = 0 straight to it.
-  const MotionResult loose = certified.check(q0, q1, ctx, /*tight_last_valid=*/false);
+  // The verdict only: the same verdict and what collides, found at a parameter where the block is within
+  // contact_distance of the wall or through it (the segment's middle, here), with fewer steps.
+  const MotionResult loose = certified.check(q0, q1, ctx, /*locate_contact=*/false);
   ASSERT_FALSE(loose.free);
-  EXPECT_EQ(loose.first_contact, r.first_contact);
   EXPECT_EQ(loose.report.kind, r.report.kind);
-  EXPECT_LE(loose.last_valid, r.last_valid);
-  EXPECT_GT(loose.last_valid, r.first_contact - 0.01);
-  certified.interpolate(q0, q1, loose.last_valid, q);
-  EXPECT_TRUE(scene->isFree(std::vector<double>(q, q + 2)));
+  EXPECT_GE(loose.first_contact, near - 1e-9);
+  EXPECT_LE(loose.first_contact, (1.0 + 0.0505 + certified.options().contact_distance) / 2.0 + 1e-9);
+  EXPECT_EQ(loose.last_valid, 0.0);
+  EXPECT_LT(loose.steps, r.steps);
 
   // Turning while sliding (the block's corners sweep wider) is caught as well, and sooner.
   const double t1[2] = {1, 3.0};
@@ -1010,6 +1008,20 @@ TEST(MotionCertified, VerdictDependsOnlyOnTheSegment) {
   }
   EXPECT_GT(free, 20);
   EXPECT_LT(free, 190);
+  // The verdict alone (OMPL's checkMotion(s1, s2)) ends at the first measurement within contact: it too
+  // depends only on the segment, and says free exactly where the located check does (both measure the
+  // same parameters until a contact; here no segment grazes the wall within contact_distance only).
+  std::vector<MotionResult> va(200), vb(200);
+  for (int k = 0; k < 200; ++k) va[k] = certified.check(q[k].data(), q[k + 1].data(), forward, false);
+  for (int k = 200; k-- > 0;) vb[k] = certified.check(q[k].data(), q[k + 1].data(), backward, false);
+  long located_queries = 0, verdict_queries = 0;
+  for (int k = 0; k < 200; ++k) {
+    ASSERT_EQ(va[k].free, vb[k].free) << "segment " << k;
+    EXPECT_EQ(va[k].free, a[k].free) << "segment " << k;
+    if (a[k].free) EXPECT_EQ(va[k].distance_queries, a[k].distance_queries) << "segment " << k;
+    else located_queries += a[k].distance_queries, verdict_queries += va[k].distance_queries;
+  }
+  EXPECT_LT(verdict_queries, located_queries) << "the verdict alone should stop sooner on colliding segments";
 }
 
 }  // namespace

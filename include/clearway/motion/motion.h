@@ -187,26 +187,28 @@ class MotionChecker {
   const MotionBound& bound() const noexcept { return bound_; }
   MotionContext makeContext() const;
 
-  /// The verdict on q0 → q1 (each of scene().dimension() values). A certified check of a segment that is
-  /// not free ends with a full state check at first_contact when tight_last_valid (then last_valid is
-  /// first_contact if that state is free); without it, last_valid is where the contacting item's last
-  /// clear measurement still certifies half the contact distance: also free, a fraction of the last
-  /// advancement step earlier, and no extra work for callers that want only the verdict (OMPL's
-  /// checkMotion(s1, s2)).
+  /// The verdict on q0 → q1 (each of scene().dimension() values). With locate_contact, a certified check
+  /// of a segment that is not free finds its first contact and ends with a full state check there (then
+  /// last_valid is first_contact if that state is free, else where the contacting item's last clear
+  /// measurement still certifies half the contact distance). Without it, only the verdict: the first
+  /// measurement within contact_distance ends the check (first_contact is then a contact, not
+  /// necessarily the first, and last_valid 0) — OMPL's checkMotion(s1, s2), where planners try many
+  /// colliding motions. Whenever it says free, the located check says free as well (both measure the same
+  /// parameters until a contact).
   MotionResult check(const double* q0, const double* q1, MotionContext& context,
-                     bool tight_last_valid = true) const noexcept;
+                     bool locate_contact = true) const noexcept;
   /// The same for q0 at time t0 → q1 at time t1 (the time linear in s), with the scene's moving obstacles
   /// where they are at each moment: their speed adds to every environment item's motion bound. Scenes that
   /// do not declare `moving` ignore the times; the check above is this one at t0 = t1 = 0.
   MotionResult check(const double* q0, double t0, const double* q1, double t1, MotionContext& context,
-                     bool tight_last_valid = true) const noexcept;
+                     bool locate_contact = true) const noexcept;
   /// The state at parameter s of q0 → q1, into out: linear, except that a floating joint's quaternion
   /// follows the short great arc at constant speed (slerp, as OMPL's SO(3) space), normalized.
   void interpolate(const double* q0, const double* q1, double s, double* out) const noexcept;
 
  private:
   MotionResult certified(const double* q0, double t0, const double* q1, double t1, MotionContext& ctx,
-                         bool tight_last_valid) const noexcept;
+                         bool locate_contact) const noexcept;
   MotionResult sampled(const double* q0, double t0, const double* q1, double t1, MotionContext& ctx) const noexcept;
   // Cast mode: items that only translate on the segment start from their shape cast's time of impact.
   void castAhead(const double* q0, const double* q1, int n_items, MotionContext& ctx, MotionResult& r) const noexcept;

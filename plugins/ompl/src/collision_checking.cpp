@@ -251,7 +251,7 @@ ContinuousMotionValidator::ContinuousMotionValidator(const ob::SpaceInformationP
                                                      std::shared_ptr<const Scene> scene, MotionOptions options)
     : ob::MotionValidator(si), checker_(timeless(scene), options), map_(*scene), serial_(g_next_serial++) {}
 
-MotionResult ContinuousMotionValidator::check(const ob::State* s1, const ob::State* s2, bool tight_last_valid) const {
+MotionResult ContinuousMotionValidator::check(const ob::State* s1, const ob::State* s2, bool locate_contact) const {
   const Timer timer(counters_.nanoseconds);
   ++counters_.motions;
   MotionScratch& s = perThread<MotionScratch>(serial_, [&] {
@@ -261,11 +261,11 @@ MotionResult ContinuousMotionValidator::check(const ob::State* s1, const ob::Sta
   map_.toVector(s1, s.q0.data());
   map_.toVector(s2, s.q1.data());
   map_.unwrap(s.q0.data(), s.q1.data());
-  return checker_.check(s.q0.data(), s.q1.data(), s.ctx, tight_last_valid);
+  return checker_.check(s.q0.data(), s.q1.data(), s.ctx, locate_contact);
 }
 
 bool ContinuousMotionValidator::checkMotion(const ob::State* s1, const ob::State* s2) const {
-  const bool free = check(s1, s2, /*tight_last_valid=*/false).free;
+  const bool free = check(s1, s2, /*locate_contact=*/false).free;
   // OMPL's own counters are plain integers; they are kept for its tools, but ours are the reliable ones.
   return free;
 }

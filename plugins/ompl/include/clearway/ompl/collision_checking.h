@@ -71,8 +71,9 @@ class ValidityChecker : public ompl::base::StateValidityChecker {
 };
 
 /// ompl::base::MotionValidator that checks the whole segment (MotionMode::Certified: no tunnelling).
-/// checkMotion(s1, s2, lastValid) reports the fraction of the last valid state before first contact and
-/// writes that state when lastValid.first is given.
+/// checkMotion(s1, s2) asks for the verdict alone (the first contact found ends it); checkMotion(s1, s2,
+/// lastValid) locates the first contact, reports the fraction of the last valid state before it and
+/// writes that state when lastValid.first is given. Where the first says free, so does the second.
 class ContinuousMotionValidator : public ompl::base::MotionValidator {
  public:
   ContinuousMotionValidator(const ompl::base::SpaceInformationPtr& si, std::shared_ptr<const Scene> scene,
@@ -81,8 +82,8 @@ class ContinuousMotionValidator : public ompl::base::MotionValidator {
   bool checkMotion(const ompl::base::State* s1, const ompl::base::State* s2,
                    std::pair<ompl::base::State*, double>& lastValid) const override;
   const CheckerCounters& counters() const noexcept { return counters_; }
-  /// The verdict on s1 → s2 with the contact (MotionChecker::check; tight_last_valid as there).
-  MotionResult check(const ompl::base::State* s1, const ompl::base::State* s2, bool tight_last_valid = true) const;
+  /// The verdict on s1 → s2 with the contact (MotionChecker::check; locate_contact as there).
+  MotionResult check(const ompl::base::State* s1, const ompl::base::State* s2, bool locate_contact = true) const;
 
  private:
   MotionChecker checker_;
