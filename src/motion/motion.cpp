@@ -670,7 +670,7 @@ MotionResult MotionChecker::sampled(const double* q0, double t0, const double* q
   return r;
 }
 
-void MotionChecker::castAhead(const double* q0, const double* q1, int n_items, MotionContext& ctx,
+void MotionChecker::castAhead(const double* q0, const double* q1, double t0, int n_items, MotionContext& ctx,
                               MotionResult& r) const noexcept {
   const Scene& sc = *scene_;
   const Tolerances& tol = sc.options().tolerances;
@@ -680,7 +680,7 @@ void MotionChecker::castAhead(const double* q0, const double* q1, int n_items, M
     const Item& it = items_[k];
     if (it.group >= 0) continue;  // its group's coverage decides where it starts
     const bool self = it.b >= 0;
-    if (!self && ctx.obstacle_motion > 0.0) continue;  // (the cast holds obstacles still)
+    if (!self && ctx.obstacle_motion > 0.0) continue;  // (the cast holds obstacles still, where they are at t0)
     if (self ? !bound_.translates(it.a, it.b, ctx.dq.data()) : !bound_.translates(it.a, ctx.dq.data())) continue;
     if (!posed) {  // both ends' poses, once: the end's kept aside, the start's left in the scene context
       sc.computePoses(q1, ctx.scene);
@@ -701,7 +701,7 @@ void MotionChecker::castAhead(const double* q0, const double* q1, int n_items, M
       first = c.hit ? std::max(0.0, c.t) : 2.0;
     } else {
       first = sc.environment().linkCast(*it.ga, start[it.frame_a], end[it.frame_a].t - start[it.frame_a].t,
-                                        it.padding + contact, tol, 1.0, 0.0, &ctx.scene.counters.environment);
+                                        it.padding + contact, tol, 1.0, t0, &ctx.scene.counters.environment);
     }
     ctx.safe_until[k] = std::min(first, 2.0);
   }
@@ -807,7 +807,7 @@ struct MotionChecker::Sweep {
       if (!(lower >= enough))  // (the GJK bound first in max(): it is a number even if the balls' is not)
         lower = std::max(gjkLowerBound(a.hull(), pa, b.hull(), pb, tol, ctx.hull_cache[k], enough, relative), lower);
       d = lower - it.padding;
-      if (d > contact) split_item = k;  // (the hulls' last GJK axis is this measurement's)
+      if (d > contact) split_item = k;  // (the hulls' last GJK axis: this measurement's, or an earlier one's)
       if (d <= contact && exact && !head) {
         SimplexCache* caches =
             warmStarts(ctx.part_cache, ctx.part_slot[k], ctx.part_stamp[k], a.parts().size() * b.parts().size());
@@ -1077,7 +1077,7 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
     ctx.safe_until[k] = 0.0;
   }
 
-  if (options_.mode == MotionMode::Cast) castAhead(q0, q1, n_items, ctx, r);
+  if (options_.mode == MotionMode::Cast) castAhead(q0, q1, t0, n_items, ctx, r);
   Sweep sweep{*this, ctx, r, q0, q1};
   sweep.t0 = t0, sweep.t1 = t1;
   sweep.verdict_only = !locate_contact;

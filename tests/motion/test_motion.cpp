@@ -804,6 +804,16 @@ TEST(MotionCertified, MovingWallIsNeverTunnelled) {
   // the wall at 1.2 m/s is never caught, at 0.1 m/s it is.
   EXPECT_TRUE(certified.check(q, q, ctx).free);
   EXPECT_TRUE(certified.check(q, 3.0, q, 5.0, ctx).free);
+  // At t = 1 the wall is inside the block: a segment that takes no time there collides, in every mode
+  // (cast mode casts nothing that moves, and holds the obstacles where they are at t0).
+  for (const MotionMode mode : {MotionMode::Certified, MotionMode::Cast, MotionMode::Sampled}) {
+    MotionOptions o;
+    o.mode = mode;
+    const MotionChecker m(scene, o);
+    MotionContext mctx = m.makeContext();
+    EXPECT_FALSE(m.check(q, 1.0, q, 1.0, mctx).free) << static_cast<int>(mode);
+    EXPECT_TRUE(m.check(q, 3.0, q, 3.0, mctx).free) << static_cast<int>(mode);
+  }
   const auto ahead = movingWallScene(dir, -0.6);  // the wall's face at −0.5995, the block's back at −0.55
   const MotionChecker runner(ahead);
   MotionContext rc = runner.makeContext();

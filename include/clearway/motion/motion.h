@@ -194,7 +194,8 @@ class MotionChecker {
   /// measurement within contact_distance ends the check (first_contact is then a contact, not
   /// necessarily the first, and last_valid 0) — OMPL's checkMotion(s1, s2), where planners try many
   /// colliding motions. Whenever it says free, the located check says free as well (both measure the same
-  /// parameters until a contact).
+  /// parameters until a contact); its verdict depends on the segment alone, its first_contact and report
+  /// also on which item met the context's last contact.
   MotionResult check(const double* q0, const double* q1, MotionContext& context,
                      bool locate_contact = true) const noexcept;
   /// The same for q0 at time t0 → q1 at time t1 (the time linear in s), with the scene's moving obstacles
@@ -211,7 +212,7 @@ class MotionChecker {
                          bool locate_contact) const noexcept;
   MotionResult sampled(const double* q0, double t0, const double* q1, double t1, MotionContext& ctx) const noexcept;
   // Cast mode: items that only translate on the segment start from their shape cast's time of impact.
-  void castAhead(const double* q0, const double* q1, int n_items, MotionContext& ctx, MotionResult& r) const noexcept;
+  void castAhead(const double* q0, const double* q1, double t0, int n_items, MotionContext& ctx, MotionResult& r) const noexcept;
 
   // Links that move rigidly together: those with geometry merged, per body of two or more.
   struct Bodies {
