@@ -1061,7 +1061,6 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
   // threads, and a later re-check of its path, must agree even on pairs within the contact distance).
   for (SimplexCache& c : ctx.hull_cache) c = SimplexCache{};
   ++ctx.segment;  // (the part pairs' and obstacles' warm starts are emptied as their items first need them)
-  // Members wait until their group comes within contact.
   // How far moving obstacles travel over the segment (per unit of s): it adds to every environment item's
   // motion; none unless the scene declares them.
   const bool timed = sc.effects().moving && sc.environment().hasMovingObstacles();
@@ -1071,6 +1070,7 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
     r.report.kind = CollisionReport::Kind::Invalid;
     return r;
   }
+  // Members wait until their group comes within contact.
   for (int k = 0; k < n_items; ++k) {
     if (items_[k].group >= 0) continue;
     ctx.bound[k] = itemBound(items_[k], ctx.dq.data(), ctx.obstacle_motion);  // (0 when nothing moves: measured once)
