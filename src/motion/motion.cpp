@@ -564,6 +564,8 @@ MotionContext MotionChecker::makeContext() const {
   c.safe_until.resize(items_.size());
   c.bound.resize(items_.size());
   c.first_reach.resize(items_.size());
+  c.contact.assign(items_.size(), options_.contact_distance);
+  c.contact_stamp.assign(items_.size(), 0);
   c.hull_cache.resize(env_begin_);
   c.part_slot.assign(env_begin_, -1);
   c.part_stamp.assign(env_begin_, 0);
@@ -782,12 +784,72 @@ struct MotionChecker::Sweep {
     return block;
   }
 
+  // Item k's contact distance on this segment.
+  double contactOf(int k) const noexcept {
+    return ctx.contact_stamp[k] == ctx.segment ? ctx.contact[k] : mc.options_.contact_distance;
+  }
+
+  // measure(), and when item k first comes within contact on this segment, its ends' clearances: where the
+  // nearer end is closer than twice the contact distance, the item's contact distance becomes half that
+  // end's clearance (never 0: an end that touches keeps it), and s is measured again. A state the
+  // validity checker accepts can then be left; the loops still end, each ball being at least that wide.
+  double measureItem(int k, double s, double need, CollisionReport& report) {
+    const double d = measure(k, s, need, report);
+    if (!(d <= contactOf(k)) || ctx.contact_stamp[k] == ctx.segment) return d;
+    ctx.contact_stamp[k] = ctx.segment;
+    ctx.contact[k] = mc.options_.contact_distance;
+    const Item& it = mc.items_[k];
+    if (it.last > it.first) return d;  // a group's members decide, each with its own ends
+    const double e0 = endClearance(k, 0.0);
+    const double e = e0 > 0.0 ? std::min(e0, endClearance(k, 1.0)) : 0.0;
+    if (!(e > 0.0) || !(0.5 * e < ctx.contact[k])) return d;
+    ctx.contact[k] = 0.5 * e;
+    return measure(k, s, need, report);
+  }
+
+  // A certified lower bound on item k's clearance at s (padding removed) where it is below the contact
+  // distance; at least the contact distance otherwise. As the scene's geometry mode sees it.
+  double endClearance(int k, double s) {
+    const Scene& sc = *mc.scene_;
+    const Tolerances& tol = sc.options().tolerances;
+    const double relative = mc.options_.distance_relative_error;
+    const Item& it = mc.items_[k];
+    const double cutoff = it.padding + mc.options_.contact_distance;
+    const bool exact = sc.options().mode != GeometryMode::Hull;
+    ++r.distance_queries;
+    if (r.distance_queries >= mc.options_.max_queries) capped = true;
+    const Pose pa = pose(s, it.frame_a);
+    double d;
+    if (it.b >= 0) {
+      const Pose& pb = pose(s, it.frame_b);
+      if (exact) {
+        const DistanceResult m = meshDistance(*it.ga, pa, *it.gb, pb, tol, relative, cutoff);
+        d = isFailure(m.status) ? 0.0 : m.lower_bound;
+      } else {
+        SimplexCache cold;
+        d = gjkLowerBound(it.ga->hull(), pa, it.gb->hull(), pb, tol, cold, cutoff, relative);
+      }
+    } else {
+      EnvironmentCounters* counters = &ctx.scene.counters.environment;
+      if (exact) {
+        const DistanceResult m = sc.environment().linkDistance(*it.ga, pa, tol, cutoff, time(s), relative, counters);
+        d = isFailure(m.status) ? 0.0 : m.lower_bound;
+      } else {
+        d = sc.environment().hullLowerBound(*it.ga, pa, tol, cutoff, relative, time(s), counters);
+      }
+    }
+    return d - it.padding;
+  }
+
   // A certified lower bound on item k's clearance at s (padding removed), computed only as far as `need`
   // (beyond it, the answer only has to say so). A contact fills `report`.
   double measure(int k, double s, double need, CollisionReport& report) {
     const Scene& sc = *mc.scene_;
     const Tolerances& tol = sc.options().tolerances;
-    const double contact = mc.options_.contact_distance, relative = mc.options_.distance_relative_error;
+    const double contact = contactOf(k), relative = mc.options_.distance_relative_error;
+    // Below the scene's contact distance (an end of the segment is that near), only distances decide: an
+    // intersection test within it would count the narrow phase's band as contact.
+    const bool lowered = contact < mc.options_.contact_distance;
     const bool exact = sc.options().mode != GeometryMode::Hull;
     const Item& it = mc.items_[k];
     const bool head = it.last > it.first;  // a group stops at the merged hulls: its members decide the rest
@@ -817,11 +879,11 @@ struct MotionChecker::Sweep {
         // The convex pieces are within contact, so the triangles are near (and a fine mesh has many near):
         // whether they are within contact is a search that stops at the first pair; only if not, how far
         // they are, measured no farther than a few contact distances.
-        if (meshesIntersect(a, pa, b, pb, tol, GeometryMode::Mesh, it.padding + contact)) {
+        if (!lowered && meshesIntersect(a, pa, b, pb, tol, GeometryMode::Mesh, it.padding + contact)) {
           d = 0.0;
         } else {
           const DistanceResult m = meshDistance(a, pa, b, pb, tol, relative, std::min(enough, it.padding + kNear * contact));
-          d = isFailure(m.status) ? 0.0 : std::max(m.lower_bound - it.padding, kBeyond * contact);
+          d = isFailure(m.status) ? 0.0 : std::max(m.lower_bound - it.padding, lowered ? 0.0 : kBeyond * contact);
         }
       }
       if (d <= contact && !head) {
@@ -846,13 +908,14 @@ struct MotionChecker::Sweep {
         d = std::max(d, sc.environment().hullLowerBound(*it.ga, pa, tol, cutoff, relative, t, counters, nullptr, true) -
                             it.padding);  // (d first: NaN)
       if (d <= contact && exact && !head) {
-        if (sc.environment().linkIntersects(*it.ga, pa, tol, GeometryMode::Mesh, it.padding + contact, t, &hit, counters)) {
+        if (!lowered &&
+            sc.environment().linkIntersects(*it.ga, pa, tol, GeometryMode::Mesh, it.padding + contact, t, &hit, counters)) {
           d = 0.0;
           found = true;
         } else {
           const DistanceResult e =
               sc.environment().linkDistance(*it.ga, pa, tol, std::min(cutoff, it.padding + kNear * contact), t, relative, counters);
-          d = isFailure(e.status) ? 0.0 : std::max(e.lower_bound - it.padding, kBeyond * contact);
+          d = isFailure(e.status) ? 0.0 : std::max(e.lower_bound - it.padding, lowered ? 0.0 : kBeyond * contact);
         }
       }
       if (d <= contact && !head) {
@@ -938,8 +1001,8 @@ struct MotionChecker::Sweep {
   // How far either way from s item k is clear, measured for the interval s ± half; −1 within contact.
   double first(int k, double s, double half) {
     CollisionReport report;
-    const double d = measure(k, s, ctx.bound[k] * half, report);
-    if (d > mc.options_.contact_distance) return reach(k, d, half);
+    const double d = measureItem(k, s, ctx.bound[k] * half, report);
+    if (d > contactOf(k)) return reach(k, d, half);
     if (verdict_only && mc.items_[k].last <= mc.items_[k].first) found(s, report);
     return -1.0;
   }
@@ -965,8 +1028,8 @@ struct MotionChecker::Sweep {
       const double hi = std::min(iv.b, limit);
       if (iv.a > hi || (hit && iv.a >= hi)) continue;
       const double m = 0.5 * (iv.a + hi);
-      const double d = measure(k, m, ctx.bound[k] * 0.5 * (hi - iv.a), report);
-      if (d <= mc.options_.contact_distance) {
+      const double d = measureItem(k, m, ctx.bound[k] * 0.5 * (hi - iv.a), report);
+      if (d <= contactOf(k)) {
         if (it.last > it.first) {  // a group within contact: its members take over here, exactly
           for (int member = it.first; member < it.last && !stop(); ++member) {
             ctx.bound[member] = mc.itemBound(mc.items_[member], ctx.dq.data(), ctx.obstacle_motion);
@@ -996,10 +1059,10 @@ struct MotionChecker::Sweep {
   // contact there (which becomes the limit); false when [a, until] is clear.
   bool advance(int k, double a, double witness, double until) {
     CollisionReport report;
-    const double contact = mc.options_.contact_distance;
     double s = a, prev = std::max(witness, 0.0), prev_d = 0.0;  // the clearance measured at prev (0: none)
     while (!capped) {
-      const double d = measure(k, s, ctx.bound[k] * (until - s), report);
+      const double d = measureItem(k, s, ctx.bound[k] * (until - s), report);
+      const double contact = contactOf(k);
       if (d <= contact) {
         if (!hit || s < limit) {
           limit = s;
@@ -1015,7 +1078,7 @@ struct MotionChecker::Sweep {
       }
       prev = s;
       prev_d = d;
-      s += reach(k, d, until - s);  // at least contact_distance / B: the loop ends
+      s += reach(k, d, until - s);  // at least contactOf(k) / B > 0: the loop ends
       if (!(s < until)) return false;
     }
     return false;

@@ -19,6 +19,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <functional>
 #include <random>
 #include <thread>
@@ -264,6 +265,55 @@ TEST(OmplPlugin, PlansOnTheBundledScene) {
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
   ompl::RNG::setSeed(42);
   planAndCertify([](const ob::SpaceInformationPtr& si) { return std::make_shared<og::RRTConnect>(si); });
+}
+
+// A Panda start 0.5 mm below a ceiling: within the certified check's contact distance (1 mm), but free,
+// so it must be leavable and the problem planned (it once used up the whole time limit).
+TEST(OmplPlugin, PlansFromAStartJustBelowACeiling) {
+  const std::string file = std::string(CLEARWAY_SHARED_DIR) + "/scenes/box_panda/box_panda_0001.yaml";
+  if (test::sharedRobot("panda/panda.urdf").empty() || !std::ifstream(file))
+    GTEST_SKIP() << "shared scene not found: " << file;
+  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+  ompl::RNG::setSeed(5);
+  SceneDescription d = parseSceneFile(file);
+  d.octomap.clear();
+  d.effects.clearance = true;
+  SceneDescription::ObstacleSpec ceiling;
+  ceiling.name = "ceiling";
+  ceiling.shape = Box(Vec3(2.0, 2.0, 0.05));
+  ceiling.pose = Pose::translation(Vec3(0, 0, 3.0));
+  d.obstacles = {ceiling};
+  d.effects.self = false;  // (clearance from the ceiling alone)
+  const auto ceilingClearance = [&] {
+    const Scene probe(d);
+    SceneContext pc = probe.makeContext();
+    return probe.clearance(d.start.data(), pc);
+  };
+  const double high = ceilingClearance();
+  ASSERT_GT(high, 0.5);
+  d.obstacles[0].pose = Pose::translation(Vec3(0, 0, 3.0 - high + 5e-4));
+  const double gap = ceilingClearance();
+  ASSERT_GT(gap, 4e-4);
+  ASSERT_LT(gap, 6e-4);
+  d.effects.self = true;
+  d.effects.clearance = false;
+  const auto scene = std::make_shared<const Scene>(d);
+  ASSERT_TRUE(scene->isFree(d.start));
+  ASSERT_TRUE(scene->isFree(d.goal));
+
+  og::SimpleSetup setup(makeStateSpace(*scene));
+  const CollisionChecking c = setupCollisionChecking(setup.getSpaceInformation(), scene);
+  const StateMap map(*scene);
+  ob::ScopedState<> start(setup.getStateSpace()), goal(setup.getStateSpace());
+  map.fromVector(d.start.data(), start.get());
+  map.fromVector(d.goal.data(), goal.get());
+  EXPECT_TRUE(c.motion->check(start.get(), start.get()).free);
+  setup.setStartAndGoalStates(start, goal);
+  setup.setPlanner(std::make_shared<og::RRTConnect>(setup.getSpaceInformation()));
+  ASSERT_EQ(setup.solve(30.0), ob::PlannerStatus::EXACT_SOLUTION);
+  og::PathGeometric& path = setup.getSolutionPath();
+  for (std::size_t i = 0; i + 1 < path.getStateCount(); ++i)
+    EXPECT_TRUE(c.motion->check(path.getState(i), path.getState(i + 1)).free) << "segment " << i;
 }
 
 // OMPL's parallel planners call the checkers from several threads at once (pRRT: two trees grown in

@@ -113,6 +113,9 @@ enum class MotionMode {
 struct MotionOptions {
   MotionMode mode = MotionMode::Certified;
   /// Certified: a pair closer than this (metres) counts as in contact; larger is faster near obstacles.
+  /// Where an end of the segment is itself nearer, the pair's contact distance on that segment is half the
+  /// nearer end's clearance instead, so a free state can always be left (a free motion from it, such as
+  /// one of length zero, is certified free).
   double contact_distance = 1e-3;
   /// Certified: GJK's relative error allowed in distances (only lower bounds are used, so any value is safe;
   /// looser bounds end each GJK sooner but send more pairs down to the dearer parts and triangles).
@@ -145,6 +148,10 @@ struct MotionContext {
   std::vector<double> safe_until;  // per item: where its coverage starts (Cast: where its shape cast reached)
   std::vector<double> bound;       // per item: its motion bound for this segment
   std::vector<double> first_reach; // per item: how far its first measurement (in the middle) clears, −1: none
+  // Per item: its contact distance on this segment, set when it first comes within contact_distance
+  // (contact_stamp[k] == segment); below contact_distance where an end of the segment is itself that near.
+  std::vector<double> contact;
+  std::vector<std::uint64_t> contact_stamp;
   std::vector<SimplexCache> hull_cache;  // per self item: the hulls' last GJK axis (warm starts within a segment)
   // Per self item, its part pairs' GJK axes: they start at part_slot[k] in part_cache (−1: none) and are
   // reset when first used in a segment (part_stamp[k] != segment).
