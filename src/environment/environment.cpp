@@ -250,6 +250,16 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
     });
     if (found >= 0) return report(EnvironmentHit::Kind::Voxel, found);
   }
+  // No surface touches a voxel: one may still lie inside a closed mesh of the link.
+  if (link.solidCount() > 0) {
+    const Pose to_link = pose.inverse();
+    voxel_tree_.query(query, [&](std::int32_t v) {
+      if (!link.containsPoint(to_link * voxels[v].center())) return false;
+      found = v;
+      return true;
+    });
+    if (found >= 0) return report(EnvironmentHit::Kind::Voxel, found);
+  }
   return false;
 }
 
@@ -327,6 +337,12 @@ double Environment::hullLowerBound(const LinkGeometry& link, const Pose& pose, c
         cold = SimplexCache{};
         lower = std::min(lower, gjkLowerBound(part.hull, pose, shape, pose_o, tol, cold, lower, relative));
         if (!(lower > 0.0)) return true;
+      }
+      // The parts cover the link's surfaces, not a closed mesh's inside, where the item may lie.
+      // (The core's support point is a point of the item.)
+      if (link.solidCount() > 0 && link.containsPoint(relativePose(pose, pose_o) * shape.support(Vec3::UnitX()))) {
+        lower = 0.0;
+        return true;
       }
       return false;
     }

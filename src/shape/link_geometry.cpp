@@ -282,6 +282,7 @@ LinkGeometry::LinkGeometry(std::vector<Triangle> triangles, std::vector<Primitiv
   // Rounding of the norms (relative) and of the centre (relative to the coordinates).
   sphere_radius_ = sphere_radius_ * (1.0 + 1e-12) + 1e-12 * bounding_radius_;
   buildParts();
+  findSolids();
 }
 
 void LinkGeometry::buildParts() {
@@ -366,9 +367,24 @@ LinkGeometry::LinkGeometry(const std::vector<CollisionElement>& elements, const 
 
 // ---- Queries ------------------------------------------------------------------------------------------
 
+namespace {
+double partsBound(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                  const Tolerances& tol, double enough, double relative, SimplexCache* caches) noexcept;
+}  // namespace
+
 double partsLowerBound(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
                        const Tolerances& tol, double enough, double relative, SimplexCache* caches) noexcept {
   if (!pose_a.isFinite() || !pose_b.isFinite() || !(enough >= 0.0)) return 0.0;  // (a NaN `enough` too)
+  const double d = partsBound(a, pose_a, b, pose_b, tol, enough, relative, caches);
+  // The parts cover the surfaces, not a closed mesh's inside: a piece in there is 0 away.
+  if (d > 0.0 && (a.solidCount() > 0 || b.solidCount() > 0) && linkContained(a, b, relativePose(pose_a, pose_b)))
+    return 0.0;
+  return d;
+}
+
+namespace {
+double partsBound(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                  const Tolerances& tol, double enough, double relative, SimplexCache* caches) noexcept {
   double best = enough;  // any bound at or above `enough` serves as well as the distance
   const int na = static_cast<int>(a.parts().size()), nb = static_cast<int>(b.parts().size());
   const auto gjk = [&](int i, int j, double balls) {
@@ -411,6 +427,7 @@ double partsLowerBound(const LinkGeometry& a, const Pose& pose_a, const LinkGeom
   }
   return best;
 }
+}  // namespace
 
 bool meshesIntersect(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
                      const Tolerances& tol, GeometryMode mode, double padding, SimplexCache* hull_cache) noexcept {
@@ -429,7 +446,7 @@ bool meshesIntersect(const LinkGeometry& a, const Pose& pose_a, const LinkGeomet
   const IntersectResult hulls = gjkIntersect(Padded<ConvexHull>{a.hull(), padding}, pose_a, b.hull(), pose_b, tol, cache);
   if (!hulls.intersecting) return false;
   if (mode == GeometryMode::Hull) return true;
-  return exactIntersect(a, b, b_in_a, tol, padding, slack);
+  return exactIntersect(a, b, b_in_a, tol, padding, slack) || linkContained(a, b, b_in_a);
 }
 
 bool shapeIntersectsLink(const Shape& shape, const Pose& pose_shape, const LinkGeometry& link, const Pose& pose_link,
@@ -455,7 +472,7 @@ bool shapeIntersectsLink(const Shape& shape, const Pose& pose_shape, const LinkG
   if (shapeIntersectsTriangles(shape, shape_in_link, link, tol, padding, slack)) return true;
   for (const auto& p : link.primitives())
     if (shapesIntersect(shape, shape_in_link, p.shape, p.pose, tol, padding)) return true;
-  return false;
+  return shapeInsideLink(shape, shape_in_link, link);
 }
 
 namespace {
@@ -489,6 +506,13 @@ struct DistanceMin {
     r.point_b = frame * r.point_b;
     r.normal = frame.R * r.normal;
     return r;
+  }
+  // One body lies inside the other's closed mesh: they overlap (no witness points on the surfaces).
+  void inside() {
+    best.distance = best.lower_bound = 0.0;
+    best.status = Status::Overlapping;
+    best.normal = Vec3::Zero();
+    cutoff = 0.0;
   }
   // Returns true when the search can stop (an overlap, or a failure).
   bool add(const DistanceResult& r) {
@@ -579,6 +603,8 @@ DistanceResult meshDistance(const LinkGeometry& a, const Pose& pose_a, const Lin
       for (const auto& q : b.primitives())
         if (!m.failed) m.add(gjkDistance(p.shape, p.pose, q.shape, b_in_a * q.pose, tol));
   }
+  if (!m.failed && m.best.distance > 0.0 && (a.solidCount() > 0 || b.solidCount() > 0) && linkContained(a, b, b_in_a))
+    m.inside();
   return m.finish(pose_a);
 }
 
@@ -596,6 +622,7 @@ DistanceResult shapeLinkDistance(const Shape& shape, const Pose& pose_shape, con
              shape);
   for (const auto& p : link.primitives())
     if (!m.failed && !(m.best.distance <= 0.0)) m.add(gjkDistance(shape, shape_in_link, p.shape, p.pose, tol));
+  if (!m.failed && m.best.distance > 0.0 && shapeInsideLink(shape, shape_in_link, link)) m.inside();
   return m.finish(pose_link);
 }
 

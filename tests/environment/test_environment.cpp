@@ -78,6 +78,13 @@ TriangleMesh boxSurface(const Vec3& half) {
   return m;
 }
 
+// The same surface with its last triangle removed: open, so a surface and not a solid.
+TriangleMesh openBoxSurface(const Vec3& half) {
+  TriangleMesh m = boxSurface(half);
+  m.triangles.pop_back();
+  return m;
+}
+
 // Two box surfaces of half extents `half`, centred at x = ±offset: a concave link of two convex parts.
 TriangleMesh twoBoxes(const Vec3& half, double offset) {
   TriangleMesh two = boxSurface(half);
@@ -399,22 +406,33 @@ TEST(Environment, TouchingVoxelFaceCollidesApartIsFree) {
 }
 
 TEST(Environment, ObstacleInsideALink) {
-  // A small sphere strictly inside a link: a solid primitive link collides with it in both modes; a
-  // closed mesh is a surface (link_geometry.h), so only its hull collides and Mesh mode reports free.
+  // A small sphere strictly inside a link: a solid primitive link collides with it in both modes, and so
+  // does a closed mesh (a solid: distance 0, lower bounds 0); an open mesh is a surface, so only its hull
+  // collides and Mesh mode reports free.
   Obstacle pebble;
   pebble.name = "pebble";
   pebble.shape = Sphere(0.01);
   pebble.pose = Pose::translation(Vec3(0.1, 0.0, 0.0));
   const Environment env({pebble});
   const LinkGeometry solid = primitiveLink(Box(Vec3(0.5, 0.5, 0.5)));
-  const LinkGeometry surface(boxSurface(Vec3(0.5, 0.5, 0.5)));
+  const LinkGeometry closed(boxSurface(Vec3(0.5, 0.5, 0.5)));
+  const LinkGeometry open(openBoxSurface(Vec3(0.5, 0.5, 0.5)));
+  EXPECT_EQ(closed.solidCount(), 1);
+  EXPECT_EQ(open.solidCount(), 0);
   EnvironmentHit hit;
   EXPECT_TRUE(env.linkIntersects(solid, Pose(), kTol, GeometryMode::Hull));
-  EXPECT_TRUE(env.linkIntersects(solid, Pose(), kTol, GeometryMode::Mesh, 0.0, 0.0, &hit));
-  EXPECT_EQ(hit.kind, EnvironmentHit::Kind::Obstacle);
-  EXPECT_EQ(hit.index, 0);
-  EXPECT_TRUE(env.linkIntersects(surface, Pose(), kTol, GeometryMode::Hull));
-  EXPECT_FALSE(env.linkIntersects(surface, Pose(), kTol, GeometryMode::Mesh));
+  for (const LinkGeometry* link : {&solid, &closed}) {
+    EXPECT_TRUE(env.linkIntersects(*link, Pose(), kTol, GeometryMode::Mesh, 0.0, 0.0, &hit));
+    EXPECT_EQ(hit.kind, EnvironmentHit::Kind::Obstacle);
+    EXPECT_EQ(hit.index, 0);
+    EXPECT_EQ(env.linkDistance(*link, Pose(), kTol).distance, 0.0);
+    EXPECT_EQ(env.linkDistance(*link, Pose(), kTol).lower_bound, 0.0);
+    EXPECT_EQ(env.hullLowerBound(*link, Pose(), kTol, 1.0, 0.1, 0.0, nullptr, nullptr, true), 0.0);
+  }
+  EXPECT_TRUE(env.linkIntersects(open, Pose(), kTol, GeometryMode::Hull));
+  EXPECT_FALSE(env.linkIntersects(open, Pose(), kTol, GeometryMode::Mesh));
+  EXPECT_GT(env.linkDistance(open, Pose(), kTol).lower_bound, 0.38);
+  const LinkGeometry& surface = closed;
   // Moved onto the surface, the mesh touches it.
   // Moved so that a face crosses it, then touches it from either side, then clears it by 1e-6.
   const auto at = [](double x) { return Pose::translation(Vec3(x, 0, 0)); };
@@ -426,15 +444,22 @@ TEST(Environment, ObstacleInsideALink) {
 }
 
 TEST(Environment, ManyVoxelsInsideAMeshLink) {
-  // 27 voxels inside a closed mesh, none touching it: the hull overlaps them all (the tree-vs-tree
-  // path), yet in Mesh mode only a voxel crossing the surface counts.
+  // 27 voxels inside a mesh, none touching it: the hull overlaps them all (the tree-vs-tree path). A
+  // closed mesh is a solid and collides with them; an open one is a surface, and in Mesh mode only a
+  // voxel crossing the surface counts.
   std::vector<Aabb> voxels;
   for (int i = -1; i <= 1; ++i)
     for (int j = -1; j <= 1; ++j)
       for (int k = -1; k <= 1; ++k) voxels.push_back(cube(Vec3(0.1 * i - 0.025, 0.1 * j - 0.025, 0.1 * k - 0.025), 0.05));
-  const LinkGeometry surface(boxSurface(Vec3(0.3, 0.3, 0.3)));
+  const LinkGeometry closed(boxSurface(Vec3(0.3, 0.3, 0.3)));
+  const LinkGeometry surface(openBoxSurface(Vec3(0.3, 0.3, 0.3)));
   {
     const Environment env({}, mapOf(voxels));
+    EnvironmentHit inside;
+    EXPECT_TRUE(env.linkIntersects(closed, Pose(), kTol, GeometryMode::Mesh, 0.0, 0.0, &inside));
+    EXPECT_EQ(inside.kind, EnvironmentHit::Kind::Voxel);
+    EXPECT_EQ(env.linkDistance(closed, Pose(), kTol).lower_bound, 0.0);
+    EXPECT_EQ(env.hullLowerBound(closed, Pose(), kTol, 1.0, 0.1, 0.0, nullptr, nullptr, true), 0.0);
     EnvironmentCounters counters;
     EXPECT_TRUE(env.linkIntersects(surface, Pose(), kTol, GeometryMode::Hull));
     EXPECT_FALSE(env.linkIntersects(surface, Pose(), kTol, GeometryMode::Mesh, 0.0, 0.0, nullptr, &counters));
@@ -568,10 +593,18 @@ TEST(Environment, MeshObstacle) {
   const LinkGeometry ball = primitiveLink(Sphere(0.1));
   EXPECT_TRUE(env.linkIntersects(ball, Pose::translation(Vec3(0, 0, 0.4)), kTol, GeometryMode::Mesh));
   EXPECT_FALSE(env.linkIntersects(ball, Pose::translation(Vec3(0, 0, 0.4 - 1e-6)), kTol, GeometryMode::Mesh));
-  // Inside the crate's surface: only its hull is hit.
+  // Inside the closed crate: a solid, so hit in both modes, at distance 0.
   EXPECT_TRUE(env.linkIntersects(ball, Pose::translation(Vec3(0, 0, 1)), kTol, GeometryMode::Hull));
-  EXPECT_FALSE(env.linkIntersects(ball, Pose::translation(Vec3(0, 0, 1)), kTol, GeometryMode::Mesh));
+  EXPECT_TRUE(env.linkIntersects(ball, Pose::translation(Vec3(0, 0, 1)), kTol, GeometryMode::Mesh));
+  EXPECT_EQ(env.linkDistance(ball, Pose::translation(Vec3(0, 0, 1)), kTol).lower_bound, 0.0);
   EXPECT_NEAR(env.linkDistance(ball, Pose::translation(Vec3(0, 0, 0.2)), kTol).distance, 0.2, 1e-9);
+  // Inside an open crate (a surface): only its hull is hit.
+  Obstacle open = crate;
+  open.mesh = std::make_shared<const LinkGeometry>(openBoxSurface(Vec3(0.5, 0.5, 0.5)));
+  const Environment open_env({open});
+  EXPECT_TRUE(open_env.linkIntersects(ball, Pose::translation(Vec3(0, 0, 1)), kTol, GeometryMode::Hull));
+  EXPECT_FALSE(open_env.linkIntersects(ball, Pose::translation(Vec3(0, 0, 1)), kTol, GeometryMode::Mesh));
+  EXPECT_NEAR(open_env.linkDistance(ball, Pose::translation(Vec3(0, 0, 1)), kTol).distance, 0.4, 1e-9);
 }
 
 // One of three kinds of link with half extents `half`: a box, an offset ball, a closed box mesh.

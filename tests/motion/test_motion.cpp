@@ -967,6 +967,130 @@ TEST(MotionCertified, SharedProblemsAgreeWithDenseSampling) {
   EXPECT_GT(both_hit, 10);
 }
 
+// A number written back exactly (std::to_string keeps six decimals).
+std::string exactNumber(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", x);
+  return buf;
+}
+
+TEST(MotionCertified, FreeStatesNearContactCanBeLeft) {
+  // The block (0.1 m, at x = 0) has a wall 0.5 mm, then 1 µm, beyond its face (contact_distance is
+  // 1 mm): a motion of length zero and one away from the wall are free, in both directions and every
+  // mode; one into the wall is not.
+  for (const double gap : {5e-4, 1e-6}) {
+    TempDir dir;
+    const double x = 0.05 + gap + 0.005;  // the wall's centre: the block's face + gap + half its width
+    const auto scene = sliderScene(dir, "    - {name: wall, box: {size: [0.01, 2, 2]}, pose: {position: [" +
+                                            exactNumber(x) + ", 0, 0]}}\n");
+    const double q0[2] = {0.0, 0.0}, away[2] = {-0.5, 0.0}, into[2] = {0.1, 0.0};
+    ASSERT_TRUE(scene->isFree(std::vector<double>(q0, q0 + 2))) << "gap " << gap;
+    for (const MotionMode mode : {MotionMode::Certified, MotionMode::Cast}) {
+      MotionOptions o;
+      o.mode = mode;
+      const MotionChecker checker(scene, o);
+      MotionContext c = checker.makeContext();
+      for (const bool locate : {true, false}) {
+        const MotionResult zero = checker.check(q0, q0, c, locate);
+        EXPECT_TRUE(zero.free) << "gap " << gap << ": a free state must be leavable";
+        EXPECT_FALSE(zero.capped);
+        EXPECT_TRUE(checker.check(q0, away, c, locate).free) << "gap " << gap;
+        EXPECT_TRUE(checker.check(away, q0, c, locate).free) << "gap " << gap;
+        EXPECT_FALSE(checker.check(q0, into, c, locate).free) << "gap " << gap;
+        EXPECT_FALSE(checker.check(into, q0, c, locate).free) << "gap " << gap;
+      }
+    }
+  }
+}
+
+TEST(MotionCertified, FreeStatesNearContactLeaveInEveryDirection) {
+  // The planar arm's link2 tip 0.3 mm from a post: short motions from there are free exactly when dense
+  // sampling keeps them at least 0.6 of the start's clearance away (the item's contact distance is half
+  // the nearer end's clearance, measured with GJK's relative error 0.1), and never free when it touches.
+  TempDir dir;
+  // link2's tip at q = (0, 0) reaches x = 1.5 (a cylinder from the elbow at x = 1, see the URDF); the post's
+  // near face is 0.3 mm beyond it.
+  const double x = 1.5 + 0.05 + 3e-4;
+  const auto scene = planarScene(dir, "    - {name: post, box: {size: [0.1, 0.1, 0.1]}, pose: {position: [" +
+                                          exactNumber(x) + ", 0, 0.1]}}\n",
+                                 "[self, environment, continuous, clearance]");
+  const double q_start[2] = {0.0, 0.0};
+  SceneContext sc = scene->makeContext();
+  const double c0 = scene->clearance(q_start, sc);
+  ASSERT_GT(c0, 1e-4);
+  ASSERT_LT(c0, 5e-4);
+  const MotionChecker certified(scene);
+  MotionContext c = certified.makeContext();
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-0.02, 0.02);
+  int free = 0, hit = 0, near = 0;
+  std::vector<double> q(2);
+  for (int trial = 0; trial < 120; ++trial) {
+    const double q1[2] = {u(rng), u(rng)};
+    if (!scene->isFree(std::vector<double>(q1, q1 + 2))) {
+      EXPECT_FALSE(certified.check(q_start, q1, c).free);
+      ++hit;
+      continue;
+    }
+    const double c1 = scene->clearance(q1, sc);
+    const MotionResult a = certified.check(q_start, q1, c, trial % 2 == 0);
+    EXPECT_FALSE(a.capped) << "trial " << trial;
+    // The least clearance along the segment, densely.
+    double least = std::min(c0, c1);
+    bool touches = false;
+    for (int k = 1; k < 1000; ++k) {
+      certified.interpolate(q_start, q1, k / 1000.0, q.data());
+      const double cl = scene->clearance(q.data(), sc);
+      touches = touches || !(cl > 0.0);
+      least = std::min(least, cl);
+    }
+    if (touches) {
+      EXPECT_FALSE(a.free) << "trial " << trial;
+      ++hit;
+    } else if (least > 0.6 * std::min(c0, c1) + 1e-9) {
+      EXPECT_TRUE(a.free) << "trial " << trial << ": least clearance " << least << ", ends " << c0 << ", " << c1;
+      ++free;
+    } else {
+      ++near;
+    }
+  }
+  std::printf("from %.3g m: %d free, %d collide, %d pass nearer than 0.6 of an end's clearance\n", c0, free, hit, near);
+  EXPECT_GT(free, 30);
+  EXPECT_GT(hit, 20);
+}
+
+TEST(MotionCertified, InsideAClosedMeshIsACollision) {
+  // A closed tetrahedron mesh (scaled 3, corner at −0.5): x, y, z > −0.5 and x + y + z < 1.5. The slider's
+  // block lies wholly inside it for x in (−0.45, 1.35), touching no triangle: a solid, so those states
+  // collide, and so does every segment through them, even one that stays inside, in every mode.
+  TempDir dir;
+  const std::string stl = dir.write("tet.stl", test::tetrahedronStl());
+  const auto scene = sliderScene(dir, "    - {name: tent, mesh: {file: " + stl +
+                                          ", scale: 3}, pose: {position: [-0.5, -0.5, -0.5]}}\n");
+  EXPECT_FALSE(scene->isFree(std::vector<double>{0.0, 0.0}));
+  EXPECT_FALSE(scene->isFree(std::vector<double>{0.9, 1.0}));
+  EXPECT_TRUE(scene->isFree(std::vector<double>{-1.0, 0.0}));
+  for (const MotionOptions& o : {MotionOptions{}, sampled(0.01)}) {
+    for (const MotionMode mode : {MotionMode::Certified, MotionMode::Cast, MotionMode::Sampled}) {
+      if ((mode == MotionMode::Sampled) != (o.mode == MotionMode::Sampled)) continue;
+      MotionOptions with = o;
+      with.mode = mode;
+      const MotionChecker checker(scene, with);
+      MotionContext c = checker.makeContext();
+      const double in0[2] = {-0.2, 0.0}, in1[2] = {0.2, 0.5}, out0[2] = {-1.0, 0.0}, out1[2] = {-0.8, 0.0};
+      EXPECT_FALSE(checker.check(in0, in1, c).free) << static_cast<int>(mode);
+      EXPECT_FALSE(checker.check(in0, in1, c, false).free) << static_cast<int>(mode);
+      EXPECT_TRUE(checker.check(out0, out1, c).free) << static_cast<int>(mode);
+      const double into[2] = {0.0, 0.0};
+      const MotionResult r = checker.check(out0, into, c);
+      EXPECT_FALSE(r.free);
+      // The block's face reaches the mesh's face x = −0.5 at x = −0.55: s = 0.45.
+      EXPECT_LE(r.first_contact, 0.45 + 1e-9) << static_cast<int>(mode);
+      EXPECT_GE(r.first_contact, mode == MotionMode::Sampled ? 0.4 : 0.445) << static_cast<int>(mode);
+    }
+  }
+}
+
 TEST(MotionCertified, ThreadsShareOneChecker) {
   TempDir dir;
   const auto scene = planarScene(

@@ -181,6 +181,63 @@ inline double meshDistance(const WorldMesh& a, const WorldMesh& b) {
   return best;
 }
 
+/// The generalized winding number of the triangles at p (their solid angles over 4π; A. Van Oosterom and
+/// J. Strackee, 1983): ±1 inside a closed, consistently oriented mesh, 0 outside, between near its surface.
+inline double windingNumber(const Vec3& p, const WorldMesh& m) {
+  double sum = 0.0;
+  for (const Tri& t : m.tris) {
+    const Vec3 a = t.v[0] - p, b = t.v[1] - p, c = t.v[2] - p;
+    const double la = a.norm(), lb = b.norm(), lc = c.norm();
+    const double num = a.dot(b.cross(c));
+    const double den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+    sum += 2.0 * std::atan2(num, den);
+  }
+  return sum / (4.0 * kPi);
+}
+
+/// True when every edge of the mesh (vertices welded by their coordinates) is shared by an even number of
+/// triangles: a closed surface.
+inline bool closedMesh(const TriangleMesh& m) {
+  std::vector<std::array<double, 6>> edges;
+  for (const auto& t : m.triangles)
+    for (int e = 0; e < 3; ++e) {
+      const Vec3 &p = m.vertices[t[e]], &q = m.vertices[t[(e + 1) % 3]];
+      std::array<double, 6> a{p.x(), p.y(), p.z(), q.x(), q.y(), q.z()};
+      if (std::lexicographical_compare(a.begin() + 3, a.end(), a.begin(), a.begin() + 3))
+        a = {q.x(), q.y(), q.z(), p.x(), p.y(), p.z()};
+      if (p != q) edges.push_back(a);
+    }
+  std::sort(edges.begin(), edges.end());
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    while (j < edges.size() && edges[j] == edges[i]) ++j;
+    if ((j - i) % 2) return false;
+    i = j;
+  }
+  return !m.triangles.empty();
+}
+
+/// Whether a point of `a` (up to `samples` of its vertices, spread over the list) lies inside the closed
+/// mesh b: Collide when a winding number is near ±1, Band when one is near ½, Free otherwise. Meaningful
+/// when the surfaces do not meet (then each connected piece of a is wholly inside or outside).
+inline Verdict containment(const WorldMesh& a, const WorldMesh& b, int samples = 4) {
+  Box box{{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}};
+  for (const Box& t : b.boxes)
+    for (int k = 0; k < 3; ++k) box.lo[k] = std::min(box.lo[k], t.lo[k]), box.hi[k] = std::max(box.hi[k], t.hi[k]);
+  Verdict v = Verdict::Free;
+  const std::size_t n = a.tris.size();
+  for (int k = 0; k < samples && n > 0; ++k) {
+    const Vec3& p = a.tris[k * n / samples].v[0];
+    bool in_box = true;
+    for (int i = 0; i < 3; ++i) in_box &= p[i] >= box.lo[i] && p[i] <= box.hi[i];
+    if (!in_box) continue;
+    const double w = std::abs(windingNumber(p, b));
+    if (w > 0.75) return Verdict::Collide;
+    if (w > 0.25) v = Verdict::Band;
+  }
+  return v;
+}
+
 // ---- Test meshes (closed, outward-facing) --------------------------------------------------------------
 
 inline TriangleMesh uvSphere(double radius, int rings, int segments) {

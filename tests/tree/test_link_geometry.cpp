@@ -182,14 +182,34 @@ TEST(LinkGeometry, TouchingCountsAndSurfacesInsideDoNot) {
   EXPECT_FALSE(meshesIntersect(g, id, g, Pose::translation(Vec3(1 + 1e-6, 0.3, -0.2)), tol, GeometryMode::Hull));
   EXPECT_TRUE(meshesIntersect(g, id, g, Pose::translation(Vec3(1 + 1e-6, 0, 0)), tol, GeometryMode::Mesh, 1.1e-6));
   EXPECT_FALSE(meshesIntersect(g, id, g, Pose::translation(Vec3(1 + 1e-6, 0, 0)), tol, GeometryMode::Mesh, 0.9e-6));
-  // A small cube inside a large one: surfaces apart (Mesh), hulls overlap (Hull).
+  // A small cube inside a large one: surfaces apart, but a closed mesh is a solid, so they collide, in
+  // either order, at distance 0 (and the parts' lower bound is 0).
   const LinkGeometry small(tree_ref::gridBox(Vec3(0.1, 0.1, 0.1), 1));
-  EXPECT_FALSE(meshesIntersect(g, id, small, Pose::translation(Vec3(0.1, 0, 0)), tol, GeometryMode::Mesh));
-  EXPECT_TRUE(meshesIntersect(g, id, small, Pose::translation(Vec3(0.1, 0, 0)), tol, GeometryMode::Hull));
-  // Inside a torus's hole: hull collision only.
+  const Pose inside = Pose::translation(Vec3(0.1, 0, 0));
+  EXPECT_TRUE(meshesIntersect(g, id, small, inside, tol, GeometryMode::Mesh));
+  EXPECT_TRUE(meshesIntersect(small, inside, g, id, tol, GeometryMode::Mesh));
+  EXPECT_TRUE(meshesIntersect(g, id, small, inside, tol, GeometryMode::Hull));
+  EXPECT_EQ(meshDistance(g, id, small, inside, tol).lower_bound, 0.0);
+  EXPECT_EQ(meshDistance(small, inside, g, id, tol, 0.1, 0.01).lower_bound, 0.0);
+  EXPECT_EQ(partsLowerBound(g, id, small, inside, tol, 1.0, 0.1), 0.0);
+  EXPECT_EQ(partsLowerBound(small, inside, g, id, tol, 1.0, 0.1), 0.0);
+  // Open (one triangle of the large cube's removed): a surface, free while the surfaces are apart.
+  TriangleMesh open_cube = cube;
+  open_cube.triangles.pop_back();
+  const LinkGeometry open(open_cube);
+  EXPECT_EQ(open.solidCount(), 0);
+  EXPECT_EQ(g.solidCount(), 1);
+  EXPECT_FALSE(meshesIntersect(open, id, small, inside, tol, GeometryMode::Mesh));
+  EXPECT_NEAR(meshDistance(open, id, small, inside, tol).distance, 0.3, 1e-9);
+  // Inside a torus's hole: outside its solid, so hull collision only.
   const LinkGeometry ring(tree_ref::torus(0.5, 0.1, 24, 12));
   EXPECT_FALSE(meshesIntersect(ring, id, small, id, tol, GeometryMode::Mesh));
   EXPECT_TRUE(meshesIntersect(ring, id, small, id, tol, GeometryMode::Hull));
+  // Inside the torus's tube: a small ball in the solid ring.
+  const LinkGeometry pebble(tree_ref::uvSphere(0.02, 6, 8));
+  EXPECT_TRUE(meshesIntersect(ring, id, pebble, Pose::translation(Vec3(0.5, 0, 0)), tol, GeometryMode::Mesh));
+  EXPECT_TRUE(shapeIntersectsLink(Sphere(0.02), Pose::translation(Vec3(0, 0.5, 0)), ring, id, tol, GeometryMode::Mesh));
+  EXPECT_FALSE(shapeIntersectsLink(Sphere(0.02), id, ring, id, tol, GeometryMode::Mesh));
 }
 
 TEST(LinkGeometry, NeverFreeByAccident) {
@@ -299,6 +319,8 @@ TEST(LinkGeometry, SpheresAndCapsulesAgainstMeshesMatchBruteForce) {
         const auto pr = tree_ref::comparePair(tree_ref::Tri{{p0, p1, p1}}, t);
         d = std::min(d, pr.margin >= 0.0 ? 0.0 : pr.dist);
       }
+      // A closed mesh is a solid: a core wholly inside it collides.
+      if (d > r + kBand && std::abs(tree_ref::windingNumber(p0, w)) > 0.75) d = 0.0;
       const bool got = shapeIntersectsLink(shape, ps, g, pl, tol, GeometryMode::Mesh);
       const bool hull = shapeIntersectsLink(shape, ps, g, pl, tol, GeometryMode::Hull);
       EXPECT_TRUE(hull || !got);

@@ -5,8 +5,11 @@
 // overlap do the triangles decide (seeds/000: oriented AABB trees descended together, then
 // primitive–primitive tests through the narrow phase).
 //
-// A mesh is its triangles, a surface: a mesh wholly inside another mesh does not intersect it (as in
-// FCL's BVHModel), though its hull does. Primitives (boxes, spheres, ...) are solids. Closed sets
+// A closed (watertight) mesh is a solid: every edge of its triangles is shared by an even number of
+// them, so a ray from a point crosses it an odd number of times exactly when the point is inside. When no
+// surfaces meet, one point of each connected piece of a body (probes()) decides whether it lies inside a
+// closed mesh of the other. An open mesh stays a surface (as in FCL's BVHModel): a body wholly inside it
+// does not touch it, though its hull does. Primitives (boxes, spheres, ...) are solids. Closed sets
 // throughout: touching counts as intersecting.
 //
 // Every query answers in the frames of the poses given; a LinkGeometry itself is in the link frame.
@@ -78,9 +81,23 @@ class LinkGeometry {
   const Vec3& sphereCenter() const noexcept { return sphere_center_; }
   double sphereRadius() const noexcept { return sphere_radius_; }
 
+  /// How many closed pieces of triangles (solids) the link has; the other triangles are open surfaces.
+  int solidCount() const noexcept { return static_cast<int>(solid_boxes_.size()); }
+  /// True when the point (link frame) lies inside one of the link's closed meshes, or on it, or so near
+  /// it that no ray decides (never "outside" by accident). False for a link without solids.
+  bool containsPoint(const Vec3& p) const noexcept;
+  /// One point of each connected piece of the link (triangles joined by shared vertices; each primitive),
+  /// link frame: while the surfaces of two bodies do not meet, each piece lies wholly inside or wholly
+  /// outside the other's solids.
+  const std::vector<Vec3>& probes() const noexcept { return probes_; }
+
  private:
   LinkGeometry(std::vector<Triangle> triangles, std::vector<Primitive> primitives, const TreeBuildOptions& options);
   void buildParts();
+  void findSolids();
+  // Ray parity of solid s at p along `dir`: 1 inside, 0 outside, −1 when the ray passes too near an edge,
+  // a vertex or a plane to tell.
+  int rayParity(int s, const Vec3& p, const Vec3& dir) const noexcept;
 
   std::vector<Triangle> triangles_;
   std::vector<Primitive> primitives_;
@@ -91,7 +108,17 @@ class LinkGeometry {
   double bounding_radius_ = 0.0;
   Vec3 sphere_center_ = Vec3::Zero();
   double sphere_radius_ = 0.0;
+  std::vector<std::int32_t> solid_of_;  // per triangle: its closed piece, −1 for an open one
+  std::vector<Aabb> solid_boxes_;       // per closed piece
+  std::vector<Vec3> probes_;
 };
+
+/// True when a piece of one link lies inside a closed mesh of the other (b placed in a's frame by b_in_a).
+/// Meaningful once their surfaces are known not to meet: then it decides whether the solids overlap.
+bool linkContained(const LinkGeometry& a, const LinkGeometry& b, const Pose& b_in_a) noexcept;
+/// True when the convex shape (placed in the link's frame) lies inside one of the link's closed meshes,
+/// given that it meets none of the link's triangles.
+bool shapeInsideLink(const Shape& shape, const Pose& shape_in_link, const LinkGeometry& link) noexcept;
 
 /// True when the two links are within `padding` metres of each other (padding ≥ 0; 0: touching counts).
 /// Hull: the bounding spheres, then one GJK test of the hulls. Mesh: the same, then the two triangle trees descended together
