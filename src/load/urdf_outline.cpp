@@ -271,7 +271,8 @@ UrdfOutline Reader::read() {
   }
   for (std::size_t j = 0; j < out_.joints.size(); ++j) {
     const XMLElement* mimic = joint_elements_[j]->FirstChildElement("mimic");
-    if (mimic != nullptr && joint_names.count(attribute(mimic, "joint")) == 0)
+    // A fixed joint's mimic is ignored (with a warning, by the loader), whatever it names.
+    if (mimic != nullptr && attribute(joint_elements_[j], "type") != "fixed" && joint_names.count(attribute(mimic, "joint")) == 0)
       fail(mimic, "mimics '" + attribute(mimic, "joint") + "', which is not a joint");
   }
   orderTree();

@@ -142,6 +142,31 @@ TEST_F(BadInput, Mimics) {
     <joint name="j2" type="continuous"><parent link="b"/><child link="c"/><mimic joint="j1"/></joint>
   </robot>)");
   EXPECT_LOAD_ERROR(loadRobot(fixed_leader), fixed_leader, "joint 'j2'", "a fixed joint (not one variable)");
+  const std::string planar = dir.write("mimic_planar.urdf", R"(<robot name="r">
+    <link name="a"/><link name="b"/><link name="c"/>
+    <joint name="j1" type="continuous"><parent link="a"/><child link="b"/></joint>
+    <joint name="j2" type="planar"><parent link="b"/><child link="c"/><mimic joint="j1"/></joint>
+  </robot>)");
+  EXPECT_LOAD_ERROR(loadRobot(planar), planar, "joint 'j2'", "a planar joint cannot mimic");
+}
+
+TEST_F(BadInput, AMimicOnAFixedJointIsIgnoredWithAWarning) {
+  // urdfdom accepts it and it does nothing (MoveIt too), whether the joint it names exists or not.
+  for (const std::string leader : {"j1", "ghost"}) {
+    const std::string urdf = dir.write("fixed_mimic_" + leader + ".urdf", R"(<robot name="r">
+    <link name="a"/><link name="b"/><link name="c"/>
+    <joint name="j1" type="continuous"><parent link="a"/><child link="b"/></joint>
+    <joint name="j2" type="fixed"><parent link="b"/><child link="c"/><mimic joint=")" + leader + R"(" multiplier="2"/></joint>
+  </robot>)");
+    const RobotModel m = loadRobot(urdf);
+    EXPECT_EQ(m.variableCount(), 1);
+    const Joint& j2 = m.joint(m.jointIndex("j2"));
+    EXPECT_EQ(j2.type, JointType::Fixed);
+    EXPECT_FALSE(j2.isMimic());
+    ASSERT_EQ(m.loadWarnings().size(), 1u);
+    EXPECT_EQ(m.loadWarnings()[0], urdf + ": joint 'j2' (line 4): a fixed joint cannot mimic: <mimic joint=\"" + leader +
+                                       "\"> ignored");
+  }
 }
 
 TEST_F(BadInput, UnsupportedGeometry) {
@@ -184,13 +209,31 @@ TEST_F(BadInput, BadMeshUris) {
   EXPECT_LOAD_ERROR(loadRobot(file), file, "link 'b' <collision>", "without an absolute path");
 }
 
-TEST_F(BadInput, SrdfNamingAMissingLink) {
+TEST_F(BadInput, SrdfPairsNamingMissingLinksAreSkippedWithOneWarning) {
+  // MoveIt skips such pairs; shipped SRDFs often name links of another variant of the robot.
   const std::string urdf = dir.write("r.urdf", twoLinks());
-  const std::string srdf = dir.write("r.srdf", "<robot name=\"r\">\n"
-                                               "  <disable_collisions link1=\"a\" link2=\"b\" reason=\"Adjacent\"/>\n"
-                                               "  <disable_collisions link1=\"a\" link2=\"ghost\" reason=\"Never\"/>\n"
-                                               "</robot>\n");
-  EXPECT_LOAD_ERROR(loadRobot(urdf, srdf), srdf, "<disable_collisions> (line 3)", "link2 'ghost' is not a link of");
+  std::string text = "<robot name=\"r\">\n  <disable_collisions link1=\"a\" link2=\"b\" reason=\"Adjacent\"/>\n";
+  for (int i = 0; i < 8; ++i)  // 8 pairs, 7 distinct missing names (ghost0 twice)
+    text += "  <disable_collisions link1=\"a\" link2=\"ghost" + std::to_string(i % 7) + "\" reason=\"Never\"/>\n";
+  text += "  <disable_collisions link1=\"ghost0\" link2=\"gone\" reason=\"Never\"/>\n</robot>\n";
+  const std::string srdf = dir.write("r.srdf", text);
+  const RobotModel m = loadRobot(urdf, srdf);
+  ASSERT_EQ(m.disabledCollisions().size(), 1u);
+  EXPECT_EQ(m.disabledCollisions()[0].reason, "Adjacent");
+  ASSERT_EQ(m.loadWarnings().size(), 1u) << m.loadWarnings()[0];
+  const std::string& w = m.loadWarnings()[0];
+  EXPECT_EQ(w.rfind(srdf + ": 9 <disable_collisions> pairs skipped (as MoveIt does): 8 link names not in " + urdf +
+                        ": 'ghost0', 'ghost1', 'ghost2', 'ghost3', 'ghost4', ...", 0),
+            0u)
+      << w;
+  EXPECT_EQ(w.find("ghost5"), std::string::npos) << "only the first few names: " << w;
+
+  const std::string one = dir.write("one.srdf", "<robot name=\"r\"><disable_collisions link1=\"ghost\" link2=\"b\"/></robot>");
+  const RobotModel m1 = loadRobot(urdf, one);
+  EXPECT_TRUE(m1.disabledCollisions().empty());
+  ASSERT_EQ(m1.loadWarnings().size(), 1u);
+  EXPECT_EQ(m1.loadWarnings()[0], one + ": 1 <disable_collisions> pair skipped (as MoveIt does): 1 link name not in " +
+                                      urdf + ": 'ghost'");
 }
 
 TEST_F(BadInput, BadSrdfFile) {

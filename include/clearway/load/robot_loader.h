@@ -27,10 +27,11 @@ struct LoadOptions {
 /// Errors (LoadError): a missing or malformed URDF/SRDF; an unknown joint type; a non-finite number
 /// in an origin, axis, limit or geometry; a loop in the kinematic tree or several roots; inverted
 /// limits; a mimic of a missing joint or a mimic cycle; an unresolved package:// or other bad URI; a
-/// missing, unsupported or empty mesh; an SRDF naming a link the URDF does not have; anything urdfdom
-/// rejects or drops. Warnings: a link with <visual> but no <collision>; mesh warnings (zero-area
-/// triangles, not closed, probably millimetres, a COLLADA file that is not Z_UP); urdfdom's warnings;
-/// SRDF pairs listed twice or naming one link twice.
+/// missing, unsupported or empty mesh; anything urdfdom rejects or drops. Warnings (the file still
+/// loads, as it does in MoveIt): a link with <visual> but no <collision>; a <mimic> on a fixed joint
+/// (ignored); mesh warnings (zero-area triangles, not closed, probably millimetres, a COLLADA file that
+/// is not Z_UP); urdfdom's warnings; SRDF pairs listed twice or naming one link twice; SRDF pairs naming
+/// a link the URDF does not have (skipped; one warning per SRDF with their count and first names).
 RobotModel loadRobot(const std::string& urdf_path, const std::string& srdf_path = "", const LoadOptions& options = {});
 
 }  // namespace clearway
