@@ -16,6 +16,7 @@ constexpr int kExitOk = 0, kExitBadLine = 1, kExitUsage = 2;
 
 const char* const kMotionUsage =
     "usage: clearway motion SCENE [--motions FILE] [--mode certified|cast|sampled:RES] [--geometry mesh|hull]\n"
+    "                        [--package-path DIR]...\n"
     "\n"
     "Checks straight joint-space segments. Each line holds two joint vectors (the group's joints in order,\n"
     "2n numbers separated by spaces or commas; '#' starts a comment); each output line is 'free',\n"
@@ -48,8 +49,14 @@ int motionCommand(const std::vector<std::string>& args) {
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     if (a == "-h" || a == "--help") {
-      std::cout << kMotionUsage;
+      std::cout << kMotionUsage << kLoadOptionsUsage;
       return kExitOk;
+    }
+    std::string error;
+    if (parseLoadOption(args, i, options.load, error)) {
+      if (error.empty()) continue;
+      std::cerr << "clearway motion: " << error << "\n" << kMotionUsage << kLoadOptionsUsage;
+      return kExitUsage;
     }
     if ((a == "--motions" || a == "--mode" || a == "--geometry") && i + 1 >= args.size()) {
       std::cerr << "clearway motion: " << a << " needs a value\n" << kMotionUsage;

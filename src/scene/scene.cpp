@@ -18,8 +18,10 @@ std::atomic<std::uint64_t> g_next_serial{1};
 
 }  // namespace
 
-std::shared_ptr<const RobotGeometry> loadRobotGeometry(const SceneDescription& d) {
-  auto model = std::make_shared<const RobotModel>(loadRobot(d.urdf, d.srdf));
+std::shared_ptr<const RobotGeometry> loadRobotGeometry(const SceneDescription& d, const LoadOptions& options) {
+  LoadOptions load = options;
+  load.package_paths.insert(load.package_paths.end(), d.package_paths.begin(), d.package_paths.end());
+  auto model = std::make_shared<const RobotModel>(loadRobot(d.urdf, d.srdf, load));
   return std::make_shared<const RobotGeometry>(std::move(model));
 }
 
@@ -49,7 +51,7 @@ std::shared_ptr<const Environment> loadEnvironment(const SceneDescription& d) {
 }
 
 Scene::Scene(const SceneDescription& description, const SceneOptions& options)
-    : Scene(description, loadRobotGeometry(description), loadEnvironment(description), options) {}
+    : Scene(description, loadRobotGeometry(description, options.load), loadEnvironment(description), options) {}
 
 Scene::Scene(const SceneDescription& description, std::shared_ptr<const RobotGeometry> robot,
              std::shared_ptr<const Environment> environment, const SceneOptions& options)

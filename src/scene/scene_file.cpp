@@ -67,11 +67,12 @@ class Parser {
     return v;
   }
   // A path relative to the scene file's folder.
-  std::string path(const YAML::Node& n, const std::string& key) const {
+  std::string path(const YAML::Node& n, const std::string& key, bool folder = false) const {
     const fs::path p = text(n, key);
     const fs::path full = p.is_absolute() ? p : fs::path(file_).parent_path() / p;
     std::error_code ec;
-    if (!fs::is_regular_file(full, ec)) fail(key, "file not found: " + full.string() + where(n));
+    if (folder && !fs::is_directory(full, ec)) fail(key, "folder not found: " + full.string() + where(n));
+    if (!folder && !fs::is_regular_file(full, ec)) fail(key, "file not found: " + full.string() + where(n));
     return full.lexically_normal().string();
   }
 
@@ -148,10 +149,16 @@ class Parser {
     }
     SceneDescription d;
     d.file = file_;
-    requireMap(root, "", {"format", "name", "source", "robot", "environment", "checks", "start", "goal"});
+    requireMap(root, "", {"format", "name", "source", "package_paths", "robot", "environment", "checks", "start", "goal"});
     if (!root["format"]) fail("format", "missing (this reader knows format 1)");
     if (number(root["format"], "format") != 1.0) fail("format", "unsupported format " + root["format"].Scalar() + " (this reader knows 1)");
     d.name = root["name"] ? text(root["name"], "name") : fs::path(file_).stem().string();
+
+    if (const YAML::Node p = root["package_paths"]; p && !p.IsNull()) {
+      if (!p.IsSequence()) fail("package_paths", "expected a list of folders" + where(p));
+      for (std::size_t i = 0; i < p.size(); ++i)
+        d.package_paths.push_back(path(p[i], "package_paths[" + std::to_string(i) + "]", /*folder=*/true));
+    }
 
     const YAML::Node robot = root["robot"];
     if (!robot) fail("robot", "missing");
