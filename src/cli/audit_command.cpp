@@ -24,7 +24,7 @@ constexpr int kExitOk = 0, kExitUsage = 2;
 
 const char* const kAuditUsage =
     "usage: clearway audit URDF [--srdf SRDF] [--samples N] [--seed N] [--srdf-out FILE] [--report FILE]\n"
-    "                           [--package-path DIR]...\n"
+    "                           [--package-path DIR]... [--honour-up-axis]\n"
     "\n"
     "Classifies every pair of links with collision geometry as MoveIt Setup Assistant does: Adjacent,\n"
     "Default (colliding at the default configuration), Always (colliding in >= 95% of N random\n"

@@ -16,7 +16,7 @@ constexpr int kExitOk = 0, kExitBadLine = 1, kExitUsage = 2;
 
 const char* const kMotionUsage =
     "usage: clearway motion SCENE [--motions FILE] [--mode certified|cast|sampled:RES] [--geometry mesh|hull]\n"
-    "                        [--package-path DIR]...\n"
+    "                        [--package-path DIR]... [--honour-up-axis]\n"
     "\n"
     "Checks straight joint-space segments. Each line holds two joint vectors (the group's joints in order,\n"
     "2n numbers separated by spaces or commas; '#' starts a comment); each output line is 'free',\n"

@@ -49,7 +49,7 @@ constexpr int kExitOk = 0, kExitNoPath = 1, kExitUsage = 2;
 
 const char* const kPlanUsage =
     "usage: clearway plan [SCENE] [--planner NAME] [--time SECONDS] [--seed N] [--mode mesh|hull]\n"
-    "                     [--no-simplify] [--package-path DIR]...\n"
+    "                     [--no-simplify] [--package-path DIR]... [--honour-up-axis]\n"
     "\n"
     "Plans from the scene's start to its goal with an OMPL geometric planner (RRTConnect by default)\n"
     "using Clearway's validity checker and certified motion validator; simplifies the path and checks\n"

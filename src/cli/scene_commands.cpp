@@ -17,7 +17,7 @@ namespace {
 constexpr int kExitOk = 0, kExitBadLine = 1, kExitUsage = 2;
 
 const char* const kCheckUsage =
-    "usage: clearway check SCENE [--states FILE] [--mode mesh|hull] [--package-path DIR]...\n"
+    "usage: clearway check SCENE [--states FILE] [--mode mesh|hull] [--package-path DIR]... [--honour-up-axis]\n"
     "\n"
     "Classifies joint vectors (group order, numbers separated by spaces or commas, one per line; '#'\n"
     "starts a comment) and prints one line per state: 'free', 'collision LINK OTHER' (OTHER is a link,\n"
@@ -38,10 +38,16 @@ std::string verdict(const Scene& scene, const std::vector<double>& q, SceneConte
 
 const char* const kLoadOptionsUsage =
     "Robot loading: --package-path DIR (repeatable) is searched for package://NAME/... meshes before the\n"
-    "scene file's package_paths, ROS_PACKAGE_PATH and AMENT_PREFIX_PATH.\n";
+    "scene file's package_paths, ROS_PACKAGE_PATH and AMENT_PREFIX_PATH. COLLADA meshes are read as ROS\n"
+    "reads them, ignoring <up_axis> (their <unit> applies); --honour-up-axis rotates each so that its up\n"
+    "axis is z.\n";
 
 bool parseLoadOption(const std::vector<std::string>& args, std::size_t& i, LoadOptions& options, std::string& error) {
   const std::string& a = args[i];
+  if (a == "--honour-up-axis") {
+    options.mesh.honour_up_axis = true;
+    return true;
+  }
   if (a != "--package-path") return false;
   if (i + 1 >= args.size() || args[i + 1].empty()) {
     error = a + " needs a folder";

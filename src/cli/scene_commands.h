@@ -35,7 +35,7 @@ bool runGnuplot(const std::string& script, std::string& why);
 /// The usage lines of the options that every command loading a robot takes (parseLoadOption).
 extern const char* const kLoadOptionsUsage;
 
-/// Reads a robot-loading option at args[i] (--package-path DIR, repeatable). True when args[i] was one
+/// Reads a robot-loading option at args[i] (--package-path DIR, repeatable; --honour-up-axis). True when args[i] was one
 /// (i is then at its last word), with `error` set when it is malformed; false for any other argument.
 bool parseLoadOption(const std::vector<std::string>& args, std::size_t& i, LoadOptions& options, std::string& error);
 

@@ -57,15 +57,28 @@ std::string number(double x) {
   return buf;
 }
 
-// Assimp turns every COLLADA scene y-up by a rotation in the root node (after the <unit> scale). The
-// rotation it uses for a Z_UP file maps (x, y, z) to (x, z, −y); seeing it tells us the file was Z_UP.
-bool isColladaZUpRotation(const Mat3& root) {
-  const double det = root.determinant();
-  if (!(det > 0.0)) return false;
-  const Mat3 rotation = root / std::cbrt(det);
-  Mat3 z_up_to_y_up;
-  z_up_to_y_up << 1, 0, 0, 0, 0, 1, 0, -1, 0;
-  return (rotation - z_up_to_y_up).cwiseAbs().maxCoeff() < 1e-9;
+// Assimp folds a COLLADA file's <unit> scale s and a rotation R that turns its <up_axis> into y into the
+// root node's transform (s·R). The up axis, read from R.
+enum class UpAxis { X, Y, Z, Unknown };
+
+UpAxis colladaUpAxis(const Mat3& rotation) {
+  Mat3 z_to_y, x_to_y;  // assimp's: (x, y, z) ↦ (x, z, −y) for Z_UP, (−y, x, z) for X_UP
+  z_to_y << 1, 0, 0, 0, 0, 1, 0, -1, 0;
+  x_to_y << 0, -1, 0, 1, 0, 0, 0, 0, 1;
+  auto near = [&](const Mat3& m) { return (rotation - m).cwiseAbs().maxCoeff() < 1e-9; };
+  if (near(z_to_y)) return UpAxis::Z;
+  if (near(Mat3::Identity())) return UpAxis::Y;
+  if (near(x_to_y)) return UpAxis::X;
+  return UpAxis::Unknown;
+}
+
+const char* upAxisName(UpAxis axis) {
+  switch (axis) {
+    case UpAxis::X: return "X_UP";
+    case UpAxis::Y: return "Y_UP";
+    case UpAxis::Z: return "Z_UP";
+    default: return "not one of X_UP, Y_UP, Z_UP";
+  }
 }
 
 // Vertices at bit-identical positions become one (−0 and +0 are one position).
@@ -90,10 +103,12 @@ class Merger {
  public:
   Merger(const aiScene& scene, const std::string& path, const Vec3& scale) : scene_(scene), path_(path), scale_(scale) {}
 
-  void addNode(const aiNode& node, const Affine& parent) {
-    const Affine world = parent * toAffine(node.mTransformation);
+  // The node and its subtree; world is the node's own transform in the mesh frame (the root's is chosen
+  // by the caller), parent * the node's transform for the others.
+  void addNode(const aiNode& node, const Affine& world) {
     for (unsigned i = 0; i < node.mNumMeshes; ++i) addMesh(*scene_.mMeshes[node.mMeshes[i]], world);
-    for (unsigned i = 0; i < node.mNumChildren; ++i) addNode(*node.mChildren[i], world);
+    for (unsigned i = 0; i < node.mNumChildren; ++i)
+      addNode(*node.mChildren[i], world * toAffine(node.mChildren[i]->mTransformation));
   }
 
   TriangleMesh mesh;
@@ -180,7 +195,8 @@ bool isClosed(const TriangleMesh& mesh) {
   return !mesh.triangles.empty() && open == 0 && non_manifold == 0;
 }
 
-TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<std::string>* warnings) {
+TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<std::string>* warnings,
+                      const MeshOptions& options) {
   auto warn = [&](const std::string& reason) {
     if (warnings) warnings->push_back(LoadError::format(path, "", reason));
   };
@@ -209,13 +225,31 @@ TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<st
   if (scene == nullptr || scene->mRootNode == nullptr)
     throw LoadError(path, "", std::string("assimp cannot read it: ") + importer.GetErrorString());
 
-  Affine root;
+  Affine root = toAffine(scene->mRootNode->mTransformation);
   if (ext == "dae" || ext == "zae") {
-    // Assimp has made the scene y-up (after the <unit> scale); turn it z-up: y → z, z → −y.
-    root.A << 1, 0, 0, 0, 0, -1, 0, 1, 0;
-    if (!isColladaZUpRotation(toAffine(scene->mRootNode->mTransformation).A))
-      warn("COLLADA <up_axis> is not Z_UP: rotated so that the file's up axis is z "
-           "(RViz and MoveIt ignore <up_axis> and show this mesh unrotated)");
+    // root = s·R (see colladaUpAxis). ROS (geometric_shapes for MoveIt, RViz) drops assimp's root
+    // transform: a mesh's coordinates are the link's, z up whatever <up_axis> says. We keep the same
+    // geometry, but with the <unit> scale s, which is a unit and not a convention.
+    const double s = std::cbrt(root.A.determinant());
+    if (!std::isfinite(s) || s == 0.0)
+      throw LoadError(path, "<unit>", "the unit scale is zero or not finite");
+    const UpAxis up = colladaUpAxis(root.A / s);
+    if (options.honour_up_axis) {
+      // Assimp has made the scene y-up; turn it z-up: y → z, z → −y.
+      Affine y_to_z;
+      y_to_z.A << 1, 0, 0, 0, 0, -1, 0, 1, 0;
+      root = y_to_z * root;
+      if (up != UpAxis::Z)
+        warn(std::string("COLLADA <up_axis> is ") + upAxisName(up) +
+             ": rotated so that the file's up axis is z (as asked; ROS, RViz and MoveIt ignore <up_axis> "
+             "and use this mesh unrotated)");
+    } else {
+      root.A = s * Mat3::Identity();
+      if (up != UpAxis::Z)
+        warn(std::string("COLLADA <up_axis> is ") + upAxisName(up) +
+             ": ignored as ROS, RViz and MoveIt ignore it (the mesh is not rotated; its <unit> is applied); "
+             "honour_up_axis (clearway --honour-up-axis) rotates the file's up axis to z");
+    }
   }
 
   Merger merger(*scene, path, scale);

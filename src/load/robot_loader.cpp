@@ -110,6 +110,7 @@ class Loader {
   std::map<std::tuple<std::string, double, double, double>, int> mesh_index_;
   std::unordered_map<std::string, int> link_index_;
   std::vector<std::string> warnings_;
+  std::set<std::string> mesh_warnings_;  // mesh warnings given so far (each begins with the mesh's path)
 };
 
 RobotModel Loader::load(const std::string& srdf) {
@@ -197,11 +198,13 @@ int Loader::mesh(const urdf::Mesh& m, const std::string& element) {
 
   std::vector<std::string> mesh_warnings;
   try {
-    meshes_.push_back(loadMesh(uri.path, Vec3(m.scale.x, m.scale.y, m.scale.z), &mesh_warnings));
+    meshes_.push_back(loadMesh(uri.path, Vec3(m.scale.x, m.scale.y, m.scale.z), &mesh_warnings, options_.mesh));
   } catch (const LoadError& error) {
     throw LoadError(urdf_, element, "mesh '" + m.filename + "': " + error.what());
   }
-  for (const std::string& w : mesh_warnings) warn(element, "mesh '" + m.filename + "': " + w);
+  // Once per file: a mesh used at two scales (or through two URIs) says the same things twice.
+  for (const std::string& w : mesh_warnings)
+    if (mesh_warnings_.insert(w).second) warn(element, "mesh '" + m.filename + "': " + w);
   const int index = static_cast<int>(meshes_.size()) - 1;
   mesh_index_.emplace(key, index);
   return index;

@@ -25,7 +25,7 @@ std::shared_ptr<const RobotGeometry> loadRobotGeometry(const SceneDescription& d
   return std::make_shared<const RobotGeometry>(std::move(model));
 }
 
-std::shared_ptr<const Environment> loadEnvironment(const SceneDescription& d) {
+std::shared_ptr<const Environment> loadEnvironment(const SceneDescription& d, const LoadOptions& options) {
   std::vector<Obstacle> obstacles;
   for (std::size_t i = 0; i < d.obstacles.size(); ++i) {
     const SceneDescription::ObstacleSpec& s = d.obstacles[i];
@@ -36,7 +36,7 @@ std::shared_ptr<const Environment> loadEnvironment(const SceneDescription& d) {
     o.velocity = s.velocity;
     if (!s.mesh_file.empty()) {
       std::vector<std::string> warnings;
-      const TriangleMesh mesh = loadMesh(s.mesh_file, s.mesh_scale, &warnings);
+      const TriangleMesh mesh = loadMesh(s.mesh_file, s.mesh_scale, &warnings, options.mesh);
       try {
         o.mesh = std::make_shared<const LinkGeometry>(mesh);
       } catch (const std::exception& e) {
@@ -51,7 +51,8 @@ std::shared_ptr<const Environment> loadEnvironment(const SceneDescription& d) {
 }
 
 Scene::Scene(const SceneDescription& description, const SceneOptions& options)
-    : Scene(description, loadRobotGeometry(description, options.load), loadEnvironment(description), options) {}
+    : Scene(description, loadRobotGeometry(description, options.load), loadEnvironment(description, options.load),
+            options) {}
 
 Scene::Scene(const SceneDescription& description, std::shared_ptr<const RobotGeometry> robot,
              std::shared_ptr<const Environment> environment, const SceneOptions& options)

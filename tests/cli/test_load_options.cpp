@@ -97,3 +97,28 @@ TEST_F(PackagePath, AuditPrintsTheWarningsOfTheSrdfItComparesWith) {
   EXPECT_TRUE(mentions(r.err, "warning: " + srdf + ": 1 <disable_collisions> pair skipped")) << r.err;
   EXPECT_TRUE(mentions(r.err, "'gripper'")) << r.err;
 }
+
+TEST(HonourUpAxis, TheOptionTurnsYUpMeshesAndIsOffByDefault) {
+  // Link b is a Y_UP COLLADA box 1 m long along the file's z: as ROS reads it, it stands up and misses
+  // the block at y = -0.5; with the up axis honoured it lies along -y, through the block (wider than
+  // the box, so that their surfaces cross).
+  TempDir dir;
+  dir.write("tall.dae", clearway::test::colladaBox({-0.05, -0.05, 0}, {0.05, 0.05, 1}, "Y_UP"));
+  dir.write("r.urdf", R"(<robot name="r">
+    <link name="a"><collision><geometry><sphere radius="0.01"/></geometry></collision></link>
+    <link name="b"><collision><geometry><mesh filename="tall.dae"/></geometry></collision></link>
+    <joint name="j" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>
+      <limit lower="-2" upper="2" velocity="1" effort="1"/></joint>
+  </robot>)");
+  const std::string scene = dir.write("s.yaml", "format: 1\nrobot:\n  urdf: r.urdf\n  group: [j]\nenvironment:\n"
+                                                "  obstacles:\n    - {name: block, box: {size: [0.3, 0.1, 0.3]}, "
+                                                "pose: {position: [0, -0.5, 0]}}\nchecks: [environment]\nstart: [0]\n");
+  ToolRun r = runTool("check '" + scene + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, "start: free\n");
+  EXPECT_TRUE(mentions(r.err, "<up_axis> is Y_UP: ignored")) << r.err;
+  r = runTool("check '" + scene + "' --honour-up-axis");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, "start: collision b block\n");
+  EXPECT_TRUE(mentions(r.err, "<up_axis> is Y_UP: rotated")) << r.err;
+}

@@ -93,14 +93,15 @@ SceneDescription parseSceneFile(const std::string& path);
 /// searched before the description's. Throws LoadError.
 std::shared_ptr<const RobotGeometry> loadRobotGeometry(const SceneDescription& description,
                                                        const LoadOptions& options = {});
-/// The environment a description names (obstacles, meshes, OctoMap). Throws LoadError.
-std::shared_ptr<const Environment> loadEnvironment(const SceneDescription& description);
+/// The environment a description names (obstacles, meshes read with options.mesh, OctoMap). Throws LoadError.
+std::shared_ptr<const Environment> loadEnvironment(const SceneDescription& description, const LoadOptions& options = {});
 
 /// How a scene checks geometry (not part of the scene file: a choice of the caller).
 struct SceneOptions {
   GeometryMode mode = GeometryMode::Mesh;
   Tolerances tolerances;
-  /// How the robot's files are read (package:// folders searched before the scene file's own).
+  /// How robot and mesh files are read (package:// folders searched before the scene file's own; the
+  /// COLLADA up axis).
   LoadOptions load;
 };
 
