@@ -2,8 +2,11 @@
 // decides what the triangles *are* (node transforms, unit and up axis, scale, welding, degenerate faces)
 // is done here in double precision, so that the result does not depend on assimp's post-processing
 // choices beyond triangulation.
+#include <clearway/load/input_limits.h>
 #include <clearway/load/load_error.h>
 #include <clearway/load/triangle_mesh.h>
+
+#include "load/collada_check.h"
 
 #include <assimp/Importer.hpp>
 #include <assimp/config.h>
@@ -43,6 +46,12 @@ Affine toAffine(const aiMatrix4x4& m) {
   t.b << m.a4, m.b4, m.c4;
   return t;
 }
+
+// The formats read, by extension. Each has exactly one assimp importer, which assimp then picks by the
+// extension alone (no content sniffing that could hand a file to an unchecked importer); COLLADA is
+// checked by collada_check.cpp first.
+constexpr const char* kFormats[] = {"stl", "obj", "dae", "ply"};
+constexpr const char* kFormatList = "STL, OBJ, COLLADA (.dae) or PLY";
 
 std::string lowerExtension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
@@ -126,7 +135,14 @@ class Merger {
         continue;
       }
       std::array<std::int32_t, 3> t{};
-      for (int k = 0; k < 3; ++k) t[k] = vertex(m, face.mIndices[k], world);
+      for (int k = 0; k < 3; ++k) {
+        // Assimp's PLY reader passes face indices on unchecked.
+        if (face.mIndices[k] >= m.mNumVertices)
+          throw LoadError(path_, "", "face " + std::to_string(f) + " of mesh '" + m.mName.C_Str() + "' uses vertex " +
+                                         std::to_string(face.mIndices[k]) + ", but the mesh has " +
+                                         std::to_string(m.mNumVertices) + " vertices");
+        t[k] = vertex(m, face.mIndices[k], world);
+      }
       if (mirrored) std::swap(t[1], t[2]);
       if (isDegenerate(t)) {
         ++degenerate;
@@ -144,6 +160,10 @@ class Merger {
     if (!p.allFinite())
       throw LoadError(path_, "", "vertex " + std::to_string(i) + " of mesh '" + m.mName.C_Str() +
                                      "' has a non-finite coordinate");
+    if (!(p.cwiseAbs().maxCoeff() <= kMaxInputLength))
+      throw LoadError(path_, "", "vertex " + std::to_string(i) + " of mesh '" + m.mName.C_Str() + "' lies " +
+                                     number(p.cwiseAbs().maxCoeff()) + " m from the origin after scale, beyond "
+                                     "the largest length an input may give (1e6 m)");
     p += Vec3::Zero();  // −0 → +0
     const auto [it, inserted] = welded_.try_emplace(PositionKey{p.x(), p.y(), p.z()},
                                                     static_cast<std::int32_t>(mesh.vertices.size()));
@@ -209,8 +229,9 @@ TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<st
 
   const std::string ext = lowerExtension(path);
   Assimp::Importer importer;
-  if (ext.empty() || !importer.IsExtensionSupported(ext))
-    throw LoadError(path, "", "unsupported mesh format '" + ext + "' (use STL, DAE or OBJ)");
+  if (std::none_of(std::begin(kFormats), std::end(kFormats), [&](const char* f) { return ext == f; }))
+    throw LoadError(path, "", "unsupported mesh format '" + ext + "' (Clearway reads " + kFormatList + ")");
+  if (ext == "dae") detail::checkCollada(path);
 
   // Only positions matter. Vertices are joined below by exact position, not by assimp's
   // JoinIdenticalVertices: on every mesh of ../shared/robots both give the same vertices, ours in a
@@ -226,7 +247,7 @@ TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<st
     throw LoadError(path, "", std::string("assimp cannot read it: ") + importer.GetErrorString());
 
   Affine root = toAffine(scene->mRootNode->mTransformation);
-  if (ext == "dae" || ext == "zae") {
+  if (ext == "dae") {
     // root = s·R (see colladaUpAxis). ROS (geometric_shapes for MoveIt, RViz) drops assimp's root
     // transform: a mesh's coordinates are the link's, z up whatever <up_axis> says. We keep the same
     // geometry, but with the <unit> scale s, which is a unit and not a convention.
@@ -288,6 +309,9 @@ TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<st
     hi = hi.cwiseMax(v);
   }
   const double extent = (hi - lo).maxCoeff();
+  if (!(extent >= kMinInputLength))
+    throw LoadError(path, "", "the mesh spans " + number(extent) + " m after scale, below the smallest length an "
+                              "input may give (1e-9 m)");
   if (extent > kMillimetreExtent)
     warn("largest extent is " + number(extent) + " m after scale: probably millimetres (scale=\"0.001 0.001 0.001\"?)");
   return mesh;
