@@ -93,6 +93,28 @@ TEST(SceneFile, BadInputNamesFileAndKey) {
       {"format: 1\nrobot: [\n", "", "not valid YAML"},
       {replaced("environment:\n  obstacles:", "environment:\n  octomap: missing.bt\n  obstacles:"),
        "key 'environment.octomap'", "file not found"},
+      // A repeated key silently lost to the first (a colliding state was called free).
+      {replaced("checks:", "checks: [self]\nchecks:"), "key 'checks'", "given twice with different values (lines 9 and 10)"},
+      {replaced("  group:", "  padding: 0\n  padding: 0.1\n  group:"), "key 'robot.padding'", "given twice"},
+      {replaced("  group:", "  hold: {elbow: 0, elbow: 1}\n  group:"), "key 'robot.hold.elbow'", "given twice"},
+      {replaced("  group:", "  bounds: {elbow: [0, 1], elbow: [0, 2]}\n  group:"), "key 'robot.bounds.elbow'", "given twice"},
+      {replaced("{name: wall, box:", "{name: wall, name: post, box:"), "key 'environment.obstacles[0].name'", "given twice"},
+      // Complex keys: yaml-cpp's "bad conversion" named neither the file nor the key.
+      {replaced("  group:", "  hold: {? [a, b] : 1}\n  group:"), "key 'robot.hold'", "a key must be a plain name, not a list"},
+      {"? {a: 1}\n: 2\n" + good, "", "a key must be a plain name, not a mapping"},
+      // Checks that check nothing: every state was free without a word.
+      {replaced("[self, environment]", "[]"), "key 'checks'", "is empty: every state would be free"},
+      {replaced("[self, environment]", "[continuous, clearance]"), "key 'checks'", "names no collision check"},
+      // Lengths beyond the input limits: an infinite box centre crashed the tree builder, a subnormal
+      // radius the hull builder.
+      {replaced("position: [1.2, 0, 0]", "position: [1e308, 0, 0]"), "key 'environment.obstacles[0].pose.position[0]'",
+       "'1e308' m is beyond the largest length an input may give"},
+      {replaced("size: [0.1, 2, 1]", "size: [0.1, 2, 1e-310]"), "key 'environment.obstacles[0].box.size[2]'",
+       "below the smallest length"},
+      {replaced("box: {size: [0.1, 2, 1]}", "sphere: {radius: 1e-310}"), "key 'environment.obstacles[0].sphere.radius'",
+       "below the smallest length"},
+      {replaced("box: {size: [0.1, 2, 1]}", "capsule: {radius: 0.1, length: 2e6}"),
+       "key 'environment.obstacles[0].capsule.length'", "beyond the largest length"},
   };
   for (const Case& c : cases) {
     const std::string path = dir.write("bad.yaml", c.text);
@@ -100,6 +122,9 @@ TEST(SceneFile, BadInputNamesFileAndKey) {
   }
   const std::string missing = dir.path("absent.yaml");
   EXPECT_LOAD_ERROR(parseSceneFile(missing), missing, "", "not found");
+  // A key repeated with the same value says nothing new: read once.
+  const std::string same = dir.write("same.yaml", replaced("checks:", "checks: [self, environment]\nchecks:"));
+  EXPECT_TRUE(parseSceneFile(same).effects.environment);
 }
 
 TEST(SceneFile, PackagePathsAreFoldersRelativeToTheSceneFile) {
