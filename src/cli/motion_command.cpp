@@ -21,7 +21,8 @@ const char* const kMotionUsage =
     "Checks straight joint-space segments. Each line holds two joint vectors (the group's joints in order,\n"
     "2n numbers separated by spaces or commas; '#' starts a comment); each output line is 'free',\n"
     "'collision F WHAT' (F: the last valid fraction of the segment; WHAT: the links, obstacle or\n"
-    "'invalid state'), or 'error REASON'. Without --motions it checks the scene's start -> goal.\n"
+    "'invalid state', or 'capped: ...' when the check would take more work than its cap), or\n"
+    "'error REASON'. Without --motions it checks the scene's start -> goal.\n"
     "In a scene with moving obstacles (checks: moving) a line may also hold each state's time, 2n + 2\n"
     "numbers 't0 q0... t1 q1...' (seconds): the obstacles are where they are at each moment of the segment.\n"
     "Modes: certified (default: conservative advancement, never steps over an obstacle, contact within\n"
@@ -35,6 +36,12 @@ std::string verdict(const MotionChecker& checker, const double* q0, const double
                     double t0 = 0.0, double t1 = 0.0) {
   const MotionResult r = checker.check(q0, t0, q1, t1, ctx);
   if (r.free) return "free";
+  if (r.capped)
+    return checker.options().mode == MotionMode::Sampled
+               ? "collision 0 capped: more than " + std::to_string(checker.options().max_samples) +
+                     " states at this resolution (never called free)"
+               : "collision 0 capped: more than " + std::to_string(checker.options().max_queries) +
+                     " distance queries (never called free)";
   char fraction[32];
   std::snprintf(fraction, sizeof fraction, "%.9g", r.last_valid);
   return std::string("collision ") + fraction + " " + checker.scene().describe(r.report);
