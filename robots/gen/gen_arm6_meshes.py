@@ -7,7 +7,8 @@ of it (unit, up axis, scale, node transform, triangulation):
   base.stl        ASCII STL, metres            cylinder r 0.08, z in [0, 0.10]
   shoulder.stl    binary STL, metres           cylinder r 0.06, z in [0, 0.15]
   upper_arm.obj   OBJ with quad faces, metres  box x, y in [-0.04, 0.04], z in [0, 0.40]
-  forearm.dae     COLLADA, centimetres, Y_UP   box x, y in [-0.03, 0.03], z in [0, 0.35] once z-up in metres
+  forearm.dae     COLLADA, centimetres, Y_UP   box x, y in [-0.03, 0.03], z in [0, 0.35] in metres, <up_axis>
+                                               ignored as ROS does (honoured: y in [-0.35, 0], z in [-0.03, 0.03])
   wrist1_mm.stl   ASCII STL, millimetres       cylinder r 35, z in [0, 100] (the URDF scales it by 0.001)
   wrist2.dae      COLLADA, metres, Z_UP        box x, y in [-0.03, 0.03], z in [0, 0.06], under a node
                                                translated by (0, 0, 0.02): z in [0.02, 0.08] once loaded
@@ -162,10 +163,12 @@ def main():
     v, q = box((-0.04, -0.04, 0.0), (0.04, 0.04, 0.40))
     write_obj("upper_arm.obj", v, q)
 
-    # Forearm, modelled y-up in centimetres: the file's (x, y, z) is the link's (x, z, −y) · 100.
+    # Forearm in centimetres, in a file that declares Y_UP (as exporters often do) while its coordinates
+    # are the link's, z up: ROS (RViz, MoveIt) ignores <up_axis>, and so does the loader by default.
+    # Honouring the up axis would lay it along -y.
     v, q = box((-0.03, -0.03, 0.0), (0.03, 0.03, 0.35))
-    y_up_cm = [(100.0 * x, 100.0 * z, -100.0 * y) for x, y, z in v]
-    write_dae("forearm.dae", y_up_cm, quads_to_triangles(q), 0.01, "centimeter", "Y_UP")
+    cm = [(100.0 * x, 100.0 * y, 100.0 * z) for x, y, z in v]
+    write_dae("forearm.dae", cm, quads_to_triangles(q), 0.01, "centimeter", "Y_UP")
 
     v, t = prism(35.0, 0.0, 100.0)
     write_ascii_stl("wrist1_mm.stl", v, t)

@@ -24,6 +24,7 @@ constexpr int kExitOk = 0, kExitUsage = 2;
 
 const char* const kAuditUsage =
     "usage: clearway audit URDF [--srdf SRDF] [--samples N] [--seed N] [--srdf-out FILE] [--report FILE]\n"
+    "                           [--package-path DIR]... [--honour-up-axis]\n"
     "\n"
     "Classifies every pair of links with collision geometry as MoveIt Setup Assistant does: Adjacent,\n"
     "Default (colliding at the default configuration), Always (colliding in >= 95% of N random\n"
@@ -127,11 +128,18 @@ bool writeHeatmap(const RobotModel& model, const std::vector<PairAudit>& audit, 
 int auditCommand(const std::vector<std::string>& args) {
   std::string urdf, srdf, srdf_out, report;
   AuditOptions options;
+  LoadOptions load;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     if (a == "-h" || a == "--help") {
-      std::cout << kAuditUsage;
+      std::cout << kAuditUsage << kLoadOptionsUsage;
       return kExitOk;
+    }
+    std::string error;
+    if (parseLoadOption(args, i, load, error)) {
+      if (error.empty()) continue;
+      std::cerr << "clearway audit: " << error << "\n" << kAuditUsage << kLoadOptionsUsage;
+      return kExitUsage;
     }
     const bool valued = a == "--srdf" || a == "--samples" || a == "--seed" || a == "--srdf-out" || a == "--report";
     if (valued && i + 1 >= args.size()) {
@@ -171,17 +179,20 @@ int auditCommand(const std::vector<std::string>& args) {
   std::shared_ptr<const RobotModel> model;
   std::map<std::pair<int, int>, std::string> shipped;  // the given SRDF's disabled pairs
   try {
-    model = std::make_shared<const RobotModel>(loadRobot(urdf));
+    model = std::make_shared<const RobotModel>(loadRobot(urdf, "", load));
+    for (const std::string& w : model->loadWarnings()) std::cerr << "warning: " << w << "\n";
     if (!srdf.empty()) {
-      const RobotModel with_srdf = loadRobot(urdf, srdf);
+      const RobotModel with_srdf = loadRobot(urdf, srdf, load);
       for (const DisabledCollision& d : with_srdf.disabledCollisions())
         shipped[{std::min(d.link_a, d.link_b), std::max(d.link_a, d.link_b)}] = d.reason;
+      // The URDF's own warnings were printed above; those about the SRDF come only from this load.
+      for (const std::string& w : with_srdf.loadWarnings())
+        if (w.rfind(srdf + ":", 0) == 0) std::cerr << "warning: " << w << "\n";
     }
   } catch (const std::exception& e) {
     std::cerr << "clearway audit: " << e.what() << "\n";
     return kExitUsage;
   }
-  for (const std::string& w : model->loadWarnings()) std::cerr << "warning: " << w << "\n";
   const auto geometry = std::make_shared<const RobotGeometry>(model);
   std::cerr << "clearway audit: " << model->name() << ", " << geometry->geometricLinks().size()
             << " links with geometry, " << options.samples << " samples (seed " << options.seed << ")\n";

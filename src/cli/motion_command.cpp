@@ -16,11 +16,13 @@ constexpr int kExitOk = 0, kExitBadLine = 1, kExitUsage = 2;
 
 const char* const kMotionUsage =
     "usage: clearway motion SCENE [--motions FILE] [--mode certified|cast|sampled:RES] [--geometry mesh|hull]\n"
+    "                        [--package-path DIR]... [--honour-up-axis]\n"
     "\n"
     "Checks straight joint-space segments. Each line holds two joint vectors (the group's joints in order,\n"
     "2n numbers separated by spaces or commas; '#' starts a comment); each output line is 'free',\n"
     "'collision F WHAT' (F: the last valid fraction of the segment; WHAT: the links, obstacle or\n"
-    "'invalid state'), or 'error REASON'. Without --motions it checks the scene's start -> goal.\n"
+    "'invalid state', or 'capped: ...' when the check would take more work than its cap), or\n"
+    "'error REASON'. Without --motions it checks the scene's start -> goal.\n"
     "In a scene with moving obstacles (checks: moving) a line may also hold each state's time, 2n + 2\n"
     "numbers 't0 q0... t1 q1...' (seconds): the obstacles are where they are at each moment of the segment.\n"
     "Modes: certified (default: conservative advancement, never steps over an obstacle, contact within\n"
@@ -34,6 +36,12 @@ std::string verdict(const MotionChecker& checker, const double* q0, const double
                     double t0 = 0.0, double t1 = 0.0) {
   const MotionResult r = checker.check(q0, t0, q1, t1, ctx);
   if (r.free) return "free";
+  if (r.capped)
+    return checker.options().mode == MotionMode::Sampled
+               ? "collision 0 capped: more than " + std::to_string(checker.options().max_samples) +
+                     " states at this resolution (never called free)"
+               : "collision 0 capped: more than " + std::to_string(checker.options().max_queries) +
+                     " distance queries (never called free)";
   char fraction[32];
   std::snprintf(fraction, sizeof fraction, "%.9g", r.last_valid);
   return std::string("collision ") + fraction + " " + checker.scene().describe(r.report);
@@ -48,8 +56,14 @@ int motionCommand(const std::vector<std::string>& args) {
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     if (a == "-h" || a == "--help") {
-      std::cout << kMotionUsage;
+      std::cout << kMotionUsage << kLoadOptionsUsage;
       return kExitOk;
+    }
+    std::string error;
+    if (parseLoadOption(args, i, options.load, error)) {
+      if (error.empty()) continue;
+      std::cerr << "clearway motion: " << error << "\n" << kMotionUsage << kLoadOptionsUsage;
+      return kExitUsage;
     }
     if ((a == "--motions" || a == "--mode" || a == "--geometry") && i + 1 >= args.size()) {
       std::cerr << "clearway motion: " << a << " needs a value\n" << kMotionUsage;

@@ -49,7 +49,7 @@ constexpr int kExitOk = 0, kExitNoPath = 1, kExitUsage = 2;
 
 const char* const kPlanUsage =
     "usage: clearway plan [SCENE] [--planner NAME] [--time SECONDS] [--seed N] [--mode mesh|hull]\n"
-    "                     [--no-simplify]\n"
+    "                     [--no-simplify] [--package-path DIR]... [--honour-up-axis]\n"
     "\n"
     "Plans from the scene's start to its goal with an OMPL geometric planner (RRTConnect by default)\n"
     "using Clearway's validity checker and certified motion validator; simplifies the path and checks\n"
@@ -111,9 +111,16 @@ int planCommand(const std::vector<std::string>& args) {
     const std::string& a = args[i];
     const bool has_value = i + 1 < args.size();
     if (a == "-h" || a == "--help") {
-      std::cout << kPlanUsage;
+      std::cout << kPlanUsage << kLoadOptionsUsage;
       return kExitOk;
-    } else if (a == "--planner" && has_value) {
+    }
+    std::string error;
+    if (parseLoadOption(args, i, options.load, error)) {
+      if (error.empty()) continue;
+      std::cerr << "clearway plan: " << error << "\n" << kPlanUsage << kLoadOptionsUsage;
+      return kExitUsage;
+    }
+    if (a == "--planner" && has_value) {
       planner_name = args[++i];
     } else if (a == "--time" && has_value) {
       if (!parseDouble(args[++i], time_limit) || time_limit <= 0) {

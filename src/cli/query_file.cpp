@@ -246,6 +246,31 @@ ordered_json errorResult(const json& id, long line_number, const std::string& me
   return r;
 }
 
+// The deepest nesting of arrays and objects a line may have. The format needs 4 ({"a": {"shape":
+// {"vertices": [[x, y, z]]}}}); nlohmann's dump (used in error messages) recurses once per level, so a
+// line nested tens of thousands deep would overflow the stack.
+constexpr int kMaxJsonDepth = 32;
+
+// The nesting depth of JSON text ([ and { outside strings), counted up to limit + 1.
+int nestingDepth(const std::string& text, int limit) {
+  int depth = 0, deepest = 0;
+  bool in_string = false;
+  for (std::size_t i = 0; i < text.size() && deepest <= limit; ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\') ++i;  // the escaped character cannot end the string
+      else if (c == '"') in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      deepest = std::max(deepest, ++depth);
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return deepest;
+}
+
 // The text of a nlohmann exception without its "[json.exception.parse_error.101] " prefix.
 std::string bareMessage(const std::exception& e) {
   const std::string s = e.what();
@@ -380,6 +405,10 @@ ordered_json runQueryCase(const QueryCase& q) {
 }
 
 QueryLineResult runQueryLine(const std::string& line, long line_number) {
+  if (nestingDepth(line, kMaxJsonDepth) > kMaxJsonDepth)
+    return {errorResult(nullptr, line_number, "arrays and objects nested deeper than " + std::to_string(kMaxJsonDepth) +
+                                                  " levels (a query needs at most 4)"),
+            true};
   json parsed;
   try {
     parsed = json::parse(line);

@@ -17,7 +17,7 @@ namespace {
 constexpr int kExitOk = 0, kExitBadLine = 1, kExitUsage = 2;
 
 const char* const kCheckUsage =
-    "usage: clearway check SCENE [--states FILE] [--mode mesh|hull]\n"
+    "usage: clearway check SCENE [--states FILE] [--mode mesh|hull] [--package-path DIR]... [--honour-up-axis]\n"
     "\n"
     "Classifies joint vectors (group order, numbers separated by spaces or commas, one per line; '#'\n"
     "starts a comment) and prints one line per state: 'free', 'collision LINK OTHER' (OTHER is a link,\n"
@@ -35,6 +35,33 @@ std::string verdict(const Scene& scene, const std::vector<double>& q, SceneConte
 }
 
 }  // namespace
+
+const char* const kLoadOptionsUsage =
+    "Robot loading: --package-path DIR (repeatable) is searched for package://NAME/... meshes before the\n"
+    "scene file's package_paths, ROS_PACKAGE_PATH and AMENT_PREFIX_PATH. COLLADA meshes are read as ROS\n"
+    "reads them, ignoring <up_axis> (their <unit> applies); --honour-up-axis rotates each so that its up\n"
+    "axis is z.\n";
+
+bool parseLoadOption(const std::vector<std::string>& args, std::size_t& i, LoadOptions& options, std::string& error) {
+  const std::string& a = args[i];
+  if (a == "--honour-up-axis") {
+    options.mesh.honour_up_axis = true;
+    return true;
+  }
+  if (a != "--package-path") return false;
+  if (i + 1 >= args.size() || args[i + 1].empty()) {
+    error = a + " needs a folder";
+    return true;
+  }
+  const std::string& dir = args[++i];
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) {
+    error = a + " " + dir + ": folder not found";
+    return true;
+  }
+  options.package_paths.push_back(dir);
+  return true;
+}
 
 std::shared_ptr<const Scene> loadScene(const char* command, const std::string& path, const SceneOptions& options) {
   try {
@@ -85,8 +112,14 @@ int checkCommand(const std::vector<std::string>& args) {
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     if (a == "-h" || a == "--help") {
-      std::cout << kCheckUsage;
+      std::cout << kCheckUsage << kLoadOptionsUsage;
       return kExitOk;
+    }
+    std::string error;
+    if (parseLoadOption(args, i, options.load, error)) {
+      if (error.empty()) continue;
+      std::cerr << "clearway check: " << error << "\n" << kCheckUsage << kLoadOptionsUsage;
+      return kExitUsage;
     }
     if ((a == "--states" || a == "--mode") && i + 1 >= args.size()) {
       std::cerr << "clearway check: " << a << " needs a value\n" << kCheckUsage;

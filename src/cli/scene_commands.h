@@ -1,5 +1,6 @@
 #pragma once
 // Subcommands that work on a scene file: check (states), motion (segments) and plan.
+#include <clearway/load/robot_loader.h>
 #include <clearway/scene/scene.h>
 
 #include <fstream>
@@ -30,6 +31,13 @@ int benchCommand(const std::vector<std::string>& args);
 /// Runs gnuplot on `script` inside the script's folder (so the outputs it names land beside it). False,
 /// with `why`, when gnuplot is not installed or fails; the script stays for the user to run.
 bool runGnuplot(const std::string& script, std::string& why);
+
+/// The usage lines of the options that every command loading a robot takes (parseLoadOption).
+extern const char* const kLoadOptionsUsage;
+
+/// Reads a robot-loading option at args[i] (--package-path DIR, repeatable; --honour-up-axis). True when args[i] was one
+/// (i is then at its last word), with `error` set when it is malformed; false for any other argument.
+bool parseLoadOption(const std::vector<std::string>& args, std::size_t& i, LoadOptions& options, std::string& error);
 
 /// Scene::load, printing the robot's load warnings; on failure prints "clearway COMMAND: reason" and
 /// returns null.

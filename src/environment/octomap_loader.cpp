@@ -9,12 +9,14 @@
 // keys), so neighbouring leaves and unknown cubes share their faces exactly: key·resolution is the same
 // double on both sides.
 #include <clearway/environment/environment.h>
+#include <clearway/load/input_limits.h>
 
 #include <octomap/OcTree.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -95,6 +97,15 @@ Header parseHeader(const std::string& path, const std::string& bytes, Format for
       if (h.id.empty()) fail(path, "the header has no 'id' line");
       if (!(h.resolution > 0.0) || !std::isfinite(h.resolution))
         fail(path, "the header has no valid 'res' line (a finite resolution > 0)");
+      // The map spans resolution · 2^16 around the origin; its cubes must stay within the input limits.
+      char res[32], span[32];
+      std::snprintf(res, sizeof res, "%g", h.resolution);
+      std::snprintf(span, sizeof span, "%g", h.resolution * std::ldexp(1.0, kTreeDepth));
+      if (h.resolution * std::ldexp(1.0, kTreeDepth) > 2.0 * kMaxInputLength)
+        fail(path, std::string("resolution ") + res + " m: the map would span " + span +
+                       " m, beyond the largest length an input may give (1e6 m)");
+      if (h.resolution < kMinInputLength)
+        fail(path, std::string("resolution ") + res + " m is below the smallest length an input may give (1e-9 m)");
       if (h.size < 0) fail(path, "the header has no valid 'size' line");
       return h;
     }
@@ -184,6 +195,11 @@ std::unique_ptr<octomap::OcTree> parseTree(const std::string& path, const std::s
   if (format == Format::Full && h.id != "OcTree")
     fail(path, "an OctoMap of type '" + h.id + "': only OcTree maps are supported (write the map as an OcTree, or as .bt)");
   long long nodes = 0;
+  // OctoMap writes nothing after 'data' for an empty tree: bytes there with 'size 0' are a tree the
+  // header forgot, and reading it as empty would call everything in it free.
+  if (h.size == 0 && bytes.find_first_not_of(" \t\r\n", h.data_offset) != std::string::npos)
+    fail(path, "corrupt file: the header declares 0 nodes, but " + std::to_string(bytes.size() - h.data_offset) +
+                   " bytes of node data follow it");
   if (h.size > 0) {
     NodeStreamCheck check(path, bytes, h.data_offset);
     if (format == Format::Binary) check.binaryNode(0);

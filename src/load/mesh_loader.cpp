@@ -2,8 +2,11 @@
 // decides what the triangles *are* (node transforms, unit and up axis, scale, welding, degenerate faces)
 // is done here in double precision, so that the result does not depend on assimp's post-processing
 // choices beyond triangulation.
+#include <clearway/load/input_limits.h>
 #include <clearway/load/load_error.h>
 #include <clearway/load/triangle_mesh.h>
+
+#include "load/collada_check.h"
 
 #include <assimp/Importer.hpp>
 #include <assimp/config.h>
@@ -44,6 +47,12 @@ Affine toAffine(const aiMatrix4x4& m) {
   return t;
 }
 
+// The formats read, by extension. Each has exactly one assimp importer, which assimp then picks by the
+// extension alone (no content sniffing that could hand a file to an unchecked importer); COLLADA is
+// checked by collada_check.cpp first.
+constexpr const char* kFormats[] = {"stl", "obj", "dae", "ply"};
+constexpr const char* kFormatList = "STL, OBJ, COLLADA (.dae) or PLY";
+
 std::string lowerExtension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   if (!ext.empty() && ext[0] == '.') ext.erase(0, 1);
@@ -57,15 +66,28 @@ std::string number(double x) {
   return buf;
 }
 
-// Assimp turns every COLLADA scene y-up by a rotation in the root node (after the <unit> scale). The
-// rotation it uses for a Z_UP file maps (x, y, z) to (x, z, −y); seeing it tells us the file was Z_UP.
-bool isColladaZUpRotation(const Mat3& root) {
-  const double det = root.determinant();
-  if (!(det > 0.0)) return false;
-  const Mat3 rotation = root / std::cbrt(det);
-  Mat3 z_up_to_y_up;
-  z_up_to_y_up << 1, 0, 0, 0, 0, 1, 0, -1, 0;
-  return (rotation - z_up_to_y_up).cwiseAbs().maxCoeff() < 1e-9;
+// Assimp folds a COLLADA file's <unit> scale s and a rotation R that turns its <up_axis> into y into the
+// root node's transform (s·R). The up axis, read from R.
+enum class UpAxis { X, Y, Z, Unknown };
+
+UpAxis colladaUpAxis(const Mat3& rotation) {
+  Mat3 z_to_y, x_to_y;  // assimp's: (x, y, z) ↦ (x, z, −y) for Z_UP, (−y, x, z) for X_UP
+  z_to_y << 1, 0, 0, 0, 0, 1, 0, -1, 0;
+  x_to_y << 0, -1, 0, 1, 0, 0, 0, 0, 1;
+  auto near = [&](const Mat3& m) { return (rotation - m).cwiseAbs().maxCoeff() < 1e-9; };
+  if (near(z_to_y)) return UpAxis::Z;
+  if (near(Mat3::Identity())) return UpAxis::Y;
+  if (near(x_to_y)) return UpAxis::X;
+  return UpAxis::Unknown;
+}
+
+const char* upAxisName(UpAxis axis) {
+  switch (axis) {
+    case UpAxis::X: return "X_UP";
+    case UpAxis::Y: return "Y_UP";
+    case UpAxis::Z: return "Z_UP";
+    default: return "not one of X_UP, Y_UP, Z_UP";
+  }
 }
 
 // Vertices at bit-identical positions become one (−0 and +0 are one position).
@@ -90,10 +112,12 @@ class Merger {
  public:
   Merger(const aiScene& scene, const std::string& path, const Vec3& scale) : scene_(scene), path_(path), scale_(scale) {}
 
-  void addNode(const aiNode& node, const Affine& parent) {
-    const Affine world = parent * toAffine(node.mTransformation);
+  // The node and its subtree; world is the node's own transform in the mesh frame (the root's is chosen
+  // by the caller), parent * the node's transform for the others.
+  void addNode(const aiNode& node, const Affine& world) {
     for (unsigned i = 0; i < node.mNumMeshes; ++i) addMesh(*scene_.mMeshes[node.mMeshes[i]], world);
-    for (unsigned i = 0; i < node.mNumChildren; ++i) addNode(*node.mChildren[i], world);
+    for (unsigned i = 0; i < node.mNumChildren; ++i)
+      addNode(*node.mChildren[i], world * toAffine(node.mChildren[i]->mTransformation));
   }
 
   TriangleMesh mesh;
@@ -111,7 +135,14 @@ class Merger {
         continue;
       }
       std::array<std::int32_t, 3> t{};
-      for (int k = 0; k < 3; ++k) t[k] = vertex(m, face.mIndices[k], world);
+      for (int k = 0; k < 3; ++k) {
+        // Assimp's PLY reader passes face indices on unchecked.
+        if (face.mIndices[k] >= m.mNumVertices)
+          throw LoadError(path_, "", "face " + std::to_string(f) + " of mesh '" + m.mName.C_Str() + "' uses vertex " +
+                                         std::to_string(face.mIndices[k]) + ", but the mesh has " +
+                                         std::to_string(m.mNumVertices) + " vertices");
+        t[k] = vertex(m, face.mIndices[k], world);
+      }
       if (mirrored) std::swap(t[1], t[2]);
       if (isDegenerate(t)) {
         ++degenerate;
@@ -129,6 +160,10 @@ class Merger {
     if (!p.allFinite())
       throw LoadError(path_, "", "vertex " + std::to_string(i) + " of mesh '" + m.mName.C_Str() +
                                      "' has a non-finite coordinate");
+    if (!(p.cwiseAbs().maxCoeff() <= kMaxInputLength))
+      throw LoadError(path_, "", "vertex " + std::to_string(i) + " of mesh '" + m.mName.C_Str() + "' lies " +
+                                     number(p.cwiseAbs().maxCoeff()) + " m from the origin after scale, beyond "
+                                     "the largest length an input may give (1e6 m)");
     p += Vec3::Zero();  // −0 → +0
     const auto [it, inserted] = welded_.try_emplace(PositionKey{p.x(), p.y(), p.z()},
                                                     static_cast<std::int32_t>(mesh.vertices.size()));
@@ -180,7 +215,8 @@ bool isClosed(const TriangleMesh& mesh) {
   return !mesh.triangles.empty() && open == 0 && non_manifold == 0;
 }
 
-TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<std::string>* warnings) {
+TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<std::string>* warnings,
+                      const MeshOptions& options) {
   auto warn = [&](const std::string& reason) {
     if (warnings) warnings->push_back(LoadError::format(path, "", reason));
   };
@@ -193,8 +229,9 @@ TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<st
 
   const std::string ext = lowerExtension(path);
   Assimp::Importer importer;
-  if (ext.empty() || !importer.IsExtensionSupported(ext))
-    throw LoadError(path, "", "unsupported mesh format '" + ext + "' (use STL, DAE or OBJ)");
+  if (std::none_of(std::begin(kFormats), std::end(kFormats), [&](const char* f) { return ext == f; }))
+    throw LoadError(path, "", "unsupported mesh format '" + ext + "' (Clearway reads " + kFormatList + ")");
+  if (ext == "dae") detail::checkCollada(path);
 
   // Only positions matter. Vertices are joined below by exact position, not by assimp's
   // JoinIdenticalVertices: on every mesh of ../shared/robots both give the same vertices, ours in a
@@ -209,13 +246,31 @@ TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<st
   if (scene == nullptr || scene->mRootNode == nullptr)
     throw LoadError(path, "", std::string("assimp cannot read it: ") + importer.GetErrorString());
 
-  Affine root;
-  if (ext == "dae" || ext == "zae") {
-    // Assimp has made the scene y-up (after the <unit> scale); turn it z-up: y → z, z → −y.
-    root.A << 1, 0, 0, 0, 0, -1, 0, 1, 0;
-    if (!isColladaZUpRotation(toAffine(scene->mRootNode->mTransformation).A))
-      warn("COLLADA <up_axis> is not Z_UP: rotated so that the file's up axis is z "
-           "(RViz and MoveIt ignore <up_axis> and show this mesh unrotated)");
+  Affine root = toAffine(scene->mRootNode->mTransformation);
+  if (ext == "dae") {
+    // root = s·R (see colladaUpAxis). ROS (geometric_shapes for MoveIt, RViz) drops assimp's root
+    // transform: a mesh's coordinates are the link's, z up whatever <up_axis> says. We keep the same
+    // geometry, but with the <unit> scale s, which is a unit and not a convention.
+    const double s = std::cbrt(root.A.determinant());
+    if (!std::isfinite(s) || s == 0.0)
+      throw LoadError(path, "<unit>", "the unit scale is zero or not finite");
+    const UpAxis up = colladaUpAxis(root.A / s);
+    if (options.honour_up_axis) {
+      // Assimp has made the scene y-up; turn it z-up: y → z, z → −y.
+      Affine y_to_z;
+      y_to_z.A << 1, 0, 0, 0, 0, -1, 0, 1, 0;
+      root = y_to_z * root;
+      if (up != UpAxis::Z)
+        warn(std::string("COLLADA <up_axis> is ") + upAxisName(up) +
+             ": rotated so that the file's up axis is z (as asked; ROS, RViz and MoveIt ignore <up_axis> "
+             "and use this mesh unrotated)");
+    } else {
+      root.A = s * Mat3::Identity();
+      if (up != UpAxis::Z)
+        warn(std::string("COLLADA <up_axis> is ") + upAxisName(up) +
+             ": ignored as ROS, RViz and MoveIt ignore it (the mesh is not rotated; its <unit> is applied); "
+             "honour_up_axis (clearway --honour-up-axis) rotates the file's up axis to z");
+    }
   }
 
   Merger merger(*scene, path, scale);
@@ -254,6 +309,9 @@ TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<st
     hi = hi.cwiseMax(v);
   }
   const double extent = (hi - lo).maxCoeff();
+  if (!(extent >= kMinInputLength))
+    throw LoadError(path, "", "the mesh spans " + number(extent) + " m after scale, below the smallest length an "
+                              "input may give (1e-9 m)");
   if (extent > kMillimetreExtent)
     warn("largest extent is " + number(extent) + " m after scale: probably millimetres (scale=\"0.001 0.001 0.001\"?)");
   return mesh;

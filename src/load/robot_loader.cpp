@@ -110,6 +110,7 @@ class Loader {
   std::map<std::tuple<std::string, double, double, double>, int> mesh_index_;
   std::unordered_map<std::string, int> link_index_;
   std::vector<std::string> warnings_;
+  std::set<std::string> mesh_warnings_;  // mesh warnings given so far (each begins with the mesh's path)
 };
 
 RobotModel Loader::load(const std::string& srdf) {
@@ -197,11 +198,13 @@ int Loader::mesh(const urdf::Mesh& m, const std::string& element) {
 
   std::vector<std::string> mesh_warnings;
   try {
-    meshes_.push_back(loadMesh(uri.path, Vec3(m.scale.x, m.scale.y, m.scale.z), &mesh_warnings));
+    meshes_.push_back(loadMesh(uri.path, Vec3(m.scale.x, m.scale.y, m.scale.z), &mesh_warnings, options_.mesh));
   } catch (const LoadError& error) {
     throw LoadError(urdf_, element, "mesh '" + m.filename + "': " + error.what());
   }
-  for (const std::string& w : mesh_warnings) warn(element, "mesh '" + m.filename + "': " + w);
+  // Once per file: a mesh used at two scales (or through two URIs) says the same things twice.
+  for (const std::string& w : mesh_warnings)
+    if (mesh_warnings_.insert(w).second) warn(element, "mesh '" + m.filename + "': " + w);
   const int index = static_cast<int>(meshes_.size()) - 1;
   mesh_index_.emplace(key, index);
   return index;
@@ -230,7 +233,10 @@ void Loader::buildJoints(const urdf::ModelInterface& model) {
       }
       if (joint->limits->velocity > 0.0) out.velocity = joint->limits->velocity;
     }
-    if (joint->mimic) {
+    if (joint->mimic && out.type == JointType::Fixed) {
+      // urdfdom accepts it and MoveIt ignores it: a fixed joint has no value for a mimic to set.
+      warn(outline.element, "a fixed joint cannot mimic: <mimic joint=\"" + joint->mimic->joint_name + "\"> ignored");
+    } else if (joint->mimic) {
       const auto leader = joint_index.find(joint->mimic->joint_name);
       if (leader == joint_index.end())
         throw LoadError(urdf_, outline.element, "mimics '" + joint->mimic->joint_name + "', which is not a joint");
@@ -279,6 +285,10 @@ std::vector<DisabledCollision> Loader::readSrdf(const std::string& srdf) {
 
   std::vector<DisabledCollision> pairs;
   std::set<std::pair<int, int>> seen;
+  // Pairs naming a link the URDF lacks are skipped as MoveIt skips them (SRDFs shipped with robots often
+  // name links of another variant); one warning for all of them, not one per pair.
+  std::size_t unknown_pairs = 0;
+  std::vector<std::string> unknown_links;
   for (const XMLElement* e = robot->FirstChildElement(); e != nullptr; e = e->NextSiblingElement()) {
     const std::string tag = e->Name();
     const std::string element = "<" + tag + "> (line " + std::to_string(e->GetLineNum()) + ")";
@@ -288,14 +298,23 @@ std::vector<DisabledCollision> Loader::readSrdf(const std::string& srdf) {
     }
     if (tag != "disable_collisions") continue;
     int link[2];
+    bool known = true;
     for (int k = 0; k < 2; ++k) {
       const char* attribute = k == 0 ? "link1" : "link2";
       const char* value = e->Attribute(attribute);
       if (value == nullptr) throw LoadError(srdf, element, std::string("no ") + attribute + " attribute");
       const auto it = link_index_.find(value);
-      if (it == link_index_.end())
-        throw LoadError(srdf, element, std::string(attribute) + " '" + value + "' is not a link of " + urdf_);
+      if (it == link_index_.end()) {
+        known = false;
+        if (std::find(unknown_links.begin(), unknown_links.end(), value) == unknown_links.end())
+          unknown_links.emplace_back(value);
+        continue;
+      }
       link[k] = it->second;
+    }
+    if (!known) {
+      ++unknown_pairs;
+      continue;
     }
     if (link[0] == link[1]) {
       warnings_.push_back(LoadError::format(srdf, element, "names one link twice, ignored"));
@@ -307,6 +326,17 @@ std::vector<DisabledCollision> Loader::readSrdf(const std::string& srdf) {
     }
     const char* reason = e->Attribute("reason");
     pairs.push_back({link[0], link[1], reason ? reason : ""});
+  }
+  if (unknown_pairs > 0) {
+    constexpr std::size_t kNamesShown = 5;
+    std::string names;
+    for (std::size_t i = 0; i < std::min(unknown_links.size(), kNamesShown); ++i)
+      names += (i ? ", '" : "'") + unknown_links[i] + "'";
+    if (unknown_links.size() > kNamesShown) names += ", ...";
+    warnings_.push_back(LoadError::format(
+        srdf, "", std::to_string(unknown_pairs) + " <disable_collisions> pair" + (unknown_pairs > 1 ? "s" : "") +
+                      " skipped (as MoveIt does): " + std::to_string(unknown_links.size()) + " link name" +
+                      (unknown_links.size() > 1 ? "s" : "") + " not in " + urdf_ + ": " + names));
   }
   return pairs;
 }

@@ -1,5 +1,6 @@
 #include "load/urdf_outline.h"
 
+#include <clearway/load/input_limits.h>
 #include <clearway/load/load_error.h>
 
 #include <tinyxml2.h>
@@ -58,6 +59,9 @@ class Reader {
     numbers(e, name, 1, &x);
     return x;
   }
+  // Lengths in metres within the input limits: |x| ≤ kMaxInputLength, and x ≥ kMinInputLength when
+  // `positive` (else x = 0 or |x| ≥ kMinInputLength).
+  void checkLengths(const XMLElement* e, const char* name, const double* x, int n, bool positive) const;
   void checkOrigin(const XMLElement* owner, Pose* pose = nullptr) const;
   UrdfOutline::Collision readCollision(const XMLElement* c) const;
   void readLink(const XMLElement* e);
@@ -93,11 +97,24 @@ bool Reader::numbers(const XMLElement* e, const char* name, int n, double* out) 
   return true;
 }
 
+void Reader::checkLengths(const XMLElement* e, const char* name, const double* x, int n, bool positive) const {
+  for (int i = 0; i < n; ++i) {
+    const double a = std::abs(x[i]);
+    std::ostringstream value;
+    value << x[i];
+    const std::string quoted = std::string(name) + "=\"" + attribute(e, name) + "\"";
+    if (a > kMaxInputLength)
+      fail(e, quoted + ": " + value.str() + " m is beyond the largest length an input may give (1e6 m)");
+    if ((positive || a > 0.0) && a < kMinInputLength)
+      fail(e, quoted + ": " + value.str() + " m is below the smallest length an input may give (1e-9 m)");
+  }
+}
+
 void Reader::checkOrigin(const XMLElement* owner, Pose* pose) const {
   const XMLElement* o = owner->FirstChildElement("origin");
   if (o == nullptr) return;
   double xyz[3] = {0, 0, 0}, rpy[3] = {0, 0, 0};
-  numbers(o, "xyz", 3, xyz);
+  if (numbers(o, "xyz", 3, xyz)) checkLengths(o, "xyz", xyz, 3, false);
   numbers(o, "rpy", 3, rpy);
   if (pose) {
     pose->t = Vec3(xyz[0], xyz[1], xyz[2]);
@@ -118,10 +135,13 @@ UrdfOutline::Collision Reader::readCollision(const XMLElement* c) const {
   if (shape == "box") {
     if (!numbers(g, "size", 3, v)) fail(g, "box without size");
     if (v[0] < 0 || v[1] < 0 || v[2] < 0) fail(g, "box size must not be negative");
+    checkLengths(g, "size", v, 3, false);
   } else if (shape == "sphere" || shape == "cylinder" || shape == "capsule") {
     if (!numbers(g, "radius", 1, &v[0]) || !(v[0] > 0)) fail(g, shape + " needs a radius > 0");
+    checkLengths(g, "radius", &v[0], 1, true);
     if (shape != "sphere" && (!numbers(g, "length", 1, &v[1]) || v[1] < 0))
       fail(g, shape + " needs a length >= 0");
+    if (shape != "sphere") checkLengths(g, "length", &v[1], 1, false);
     if (shape == "capsule") {
       out.capsule = true;
       out.radius = v[0];
@@ -187,6 +207,8 @@ void Reader::readJoint(const XMLElement* e) {
     const double lower = number(limit, "lower", 0.0), upper = number(limit, "upper", 0.0);
     number(limit, "velocity", 0.0);
     number(limit, "effort", 0.0);
+    if (type == "prismatic" && !(std::abs(lower) <= kMaxInputLength && std::abs(upper) <= kMaxInputLength))
+      fail(limit, "a prismatic joint's limits must lie within ±1e6 m (the largest length an input may give)");
     if ((type == "revolute" || type == "prismatic") && lower > upper) {
       std::ostringstream s;
       s << "inverted limits: lower " << lower << " > upper " << upper;
@@ -271,7 +293,8 @@ UrdfOutline Reader::read() {
   }
   for (std::size_t j = 0; j < out_.joints.size(); ++j) {
     const XMLElement* mimic = joint_elements_[j]->FirstChildElement("mimic");
-    if (mimic != nullptr && joint_names.count(attribute(mimic, "joint")) == 0)
+    // A fixed joint's mimic is ignored (with a warning, by the loader), whatever it names.
+    if (mimic != nullptr && attribute(joint_elements_[j], "type") != "fixed" && joint_names.count(attribute(mimic, "joint")) == 0)
       fail(mimic, "mimics '" + attribute(mimic, "joint") + "', which is not a joint");
   }
   orderTree();

@@ -428,6 +428,7 @@ MotionChecker::MotionChecker(std::shared_ptr<const Scene> scene, MotionOptions o
   if (!(options_.distance_relative_error >= 0.0) || !std::isfinite(options_.distance_relative_error))
     throw std::invalid_argument("MotionChecker: distance_relative_error must be finite and >= 0");
   if (options_.max_queries < 1) throw std::invalid_argument("MotionChecker: max_queries must be >= 1");
+  if (options_.max_samples < 1) throw std::invalid_argument("MotionChecker: max_samples must be >= 1");
   for (const Obstacle& o : scene_->environment().obstacles()) obstacle_speed_ = std::max(obstacle_speed_, o.velocity.norm());
   // A floating joint's quaternion turns along the great arc (slerp), as OMPL's SO(3) interpolates.
   const RobotModel& model = scene_->robot();
@@ -642,7 +643,14 @@ MotionResult MotionChecker::sampled(const double* q0, double t0, const double* q
   for (int i = 0; i < sc.dimension(); ++i) len2 += (q1[i] - q0[i]) * (q1[i] - q0[i]);
   // As OMPL's DiscreteMotionValidator: the ends, then the states in between at the resolution.
   const double len = std::sqrt(len2);
-  const int n = std::isfinite(len) ? std::max(1, static_cast<int>(std::ceil(len / options_.resolution))) : 1;
+  // The step count in double first: len / resolution may exceed every int.
+  const double steps = std::isfinite(len) ? std::max(1.0, std::ceil(len / options_.resolution)) : 1.0;
+  if (!(steps <= options_.max_samples)) {
+    r.capped = true;
+    r.report.kind = CollisionReport::Kind::Invalid;
+    return r;  // first_contact = last_valid = 0: nothing is known free
+  }
+  const int n = static_cast<int>(steps);
   r.steps = 1;
   if (!sc.isFree(q0, ctx.scene, &r.report, t0)) return r;
   // The end first (each state is checked once); if it collides, the states in between say whether the

@@ -138,7 +138,8 @@ std::vector<PairAudit> auditSelfCollision(std::shared_ptr<const RobotGeometry> g
     mine.min_clearance.assign(result.size(), std::numeric_limits<double>::infinity());
     std::vector<Pose> ps(n_links);
     for (int s = t; s < options.samples; s += options.threads) {
-      computeLinkPoses(model, &configurations[static_cast<std::size_t>(s) * model.variableCount()], ps.data());
+      // data() + offset: a robot without joints has no configurations to index (&v[0] of an empty vector).
+      computeLinkPoses(model, configurations.data() + static_cast<std::size_t>(s) * model.variableCount(), ps.data());
       for (const int k : sampled_pairs) {
         const PairAudit& p = result[k];
         if (collides(p, ps)) {

@@ -18,12 +18,14 @@ std::atomic<std::uint64_t> g_next_serial{1};
 
 }  // namespace
 
-std::shared_ptr<const RobotGeometry> loadRobotGeometry(const SceneDescription& d) {
-  auto model = std::make_shared<const RobotModel>(loadRobot(d.urdf, d.srdf));
+std::shared_ptr<const RobotGeometry> loadRobotGeometry(const SceneDescription& d, const LoadOptions& options) {
+  LoadOptions load = options;
+  load.package_paths.insert(load.package_paths.end(), d.package_paths.begin(), d.package_paths.end());
+  auto model = std::make_shared<const RobotModel>(loadRobot(d.urdf, d.srdf, load));
   return std::make_shared<const RobotGeometry>(std::move(model));
 }
 
-std::shared_ptr<const Environment> loadEnvironment(const SceneDescription& d) {
+std::shared_ptr<const Environment> loadEnvironment(const SceneDescription& d, const LoadOptions& options) {
   std::vector<Obstacle> obstacles;
   for (std::size_t i = 0; i < d.obstacles.size(); ++i) {
     const SceneDescription::ObstacleSpec& s = d.obstacles[i];
@@ -34,7 +36,7 @@ std::shared_ptr<const Environment> loadEnvironment(const SceneDescription& d) {
     o.velocity = s.velocity;
     if (!s.mesh_file.empty()) {
       std::vector<std::string> warnings;
-      const TriangleMesh mesh = loadMesh(s.mesh_file, s.mesh_scale, &warnings);
+      const TriangleMesh mesh = loadMesh(s.mesh_file, s.mesh_scale, &warnings, options.mesh);
       try {
         o.mesh = std::make_shared<const LinkGeometry>(mesh);
       } catch (const std::exception& e) {
@@ -49,7 +51,8 @@ std::shared_ptr<const Environment> loadEnvironment(const SceneDescription& d) {
 }
 
 Scene::Scene(const SceneDescription& description, const SceneOptions& options)
-    : Scene(description, loadRobotGeometry(description), loadEnvironment(description), options) {}
+    : Scene(description, loadRobotGeometry(description, options.load), loadEnvironment(description, options.load),
+            options) {}
 
 Scene::Scene(const SceneDescription& description, std::shared_ptr<const RobotGeometry> robot,
              std::shared_ptr<const Environment> environment, const SceneOptions& options)

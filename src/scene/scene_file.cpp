@@ -1,10 +1,12 @@
 // The scene file (DESIGN.md, "Scene files"): YAML in, a SceneDescription out, every error naming the
 // file and the key. Strict: an unknown key is an error, because a misspelt `padding` silently ignored
 // is a collision silently missed.
+#include <clearway/load/input_limits.h>
 #include <clearway/scene/scene.h>
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <set>
@@ -27,12 +29,51 @@ class Parser {
     return m.line >= 0 ? " (line " + std::to_string(m.line + 1) + ")" : "";
   }
 
+  // The keys of mapping n (at key), in order: plain names, each once. yaml-cpp keeps a repeated key and
+  // lookups find the first, so a second `checks:` would be silently ignored. A key repeated with the
+  // same value is harmless and read once.
+  std::vector<std::string> keys(const YAML::Node& n, const std::string& key) const {
+    std::vector<std::string> out;
+    std::vector<YAML::Node> values;
+    for (const auto& kv : n) {
+      if (!kv.first.IsScalar())
+        fail(key, "a key must be a plain name, not a " + std::string(kv.first.IsSequence() ? "list" : "mapping") +
+                      where(kv.first));
+      const std::string k = kv.first.Scalar();
+      const auto seen = std::find(out.begin(), out.end(), k);
+      if (seen == out.end()) {
+        out.push_back(k);
+        values.push_back(kv.second);
+      } else if (YAML::Dump(values[seen - out.begin()]) != YAML::Dump(kv.second)) {
+        fail(key.empty() ? k : key + "." + k, "given twice with different values (lines " +
+                                                  std::to_string(values[seen - out.begin()].Mark().line + 1) + " and " +
+                                                  std::to_string(kv.first.Mark().line + 1) + ")");
+      }
+    }
+    return out;
+  }
+
   void requireMap(const YAML::Node& n, const std::string& key, const std::set<std::string>& allowed) const {
     if (!n.IsMap()) fail(key, "expected a mapping" + where(n));
-    for (const auto& kv : n) {
-      const std::string k = kv.first.as<std::string>();
-      if (!allowed.count(k)) fail(key.empty() ? k : key + "." + k, "unknown key" + where(kv.first));
-    }
+    for (const std::string& k : keys(n, key))
+      if (!allowed.count(k)) fail(key.empty() ? k : key + "." + k, "unknown key" + where(n[k]));
+  }
+
+  // A length in metres within the input limits: |x| ≤ kMaxInputLength, and, unless zero is allowed,
+  // |x| ≥ kMinInputLength (a radius of 1e-310 has no hull, a position of 1e308 no box centre).
+  double length(const YAML::Node& n, const std::string& key, bool zero_allowed) const {
+    const double v = number(n, key);
+    if (std::abs(v) > kMaxInputLength)
+      fail(key, "'" + n.Scalar() + "' m is beyond the largest length an input may give (1e6 m)" + where(n));
+    if (std::abs(v) < kMinInputLength && !(zero_allowed && v == 0.0))
+      fail(key, "'" + n.Scalar() + "' m is below the smallest length an input may give (1e-9 m)" + where(n));
+    return v;
+  }
+  Vec3 lengths(const YAML::Node& n, const std::string& key, bool zero_allowed) const {
+    if (!n.IsSequence() || n.size() != 3) vec3(n, key);  // the error for a wrong type or length
+    Vec3 v;
+    for (int i = 0; i < 3; ++i) v[i] = length(n[i], key + "[" + std::to_string(i) + "]", zero_allowed);
+    return v;
   }
 
   double number(const YAML::Node& n, const std::string& key) const {
@@ -67,18 +108,19 @@ class Parser {
     return v;
   }
   // A path relative to the scene file's folder.
-  std::string path(const YAML::Node& n, const std::string& key) const {
+  std::string path(const YAML::Node& n, const std::string& key, bool folder = false) const {
     const fs::path p = text(n, key);
     const fs::path full = p.is_absolute() ? p : fs::path(file_).parent_path() / p;
     std::error_code ec;
-    if (!fs::is_regular_file(full, ec)) fail(key, "file not found: " + full.string() + where(n));
+    if (folder && !fs::is_directory(full, ec)) fail(key, "folder not found: " + full.string() + where(n));
+    if (!folder && !fs::is_regular_file(full, ec)) fail(key, "file not found: " + full.string() + where(n));
     return full.lexically_normal().string();
   }
 
   Pose pose(const YAML::Node& n, const std::string& key) const {
     requireMap(n, key, {"position", "orientation"});
     Vec3 t = Vec3::Zero();
-    if (n["position"]) t = vec3(n["position"], key + ".position");
+    if (n["position"]) t = lengths(n["position"], key + ".position", true);
     if (!n["orientation"]) return Pose::translation(t);
     const std::vector<double> q = numbers(n["orientation"], key + ".orientation", 4);
     const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
@@ -98,13 +140,13 @@ class Parser {
         ++kinds;
         requireMap(b, key + ".box", {"size"});
         if (!b["size"]) fail(key + ".box.size", "missing");
-        o.shape = Box(0.5 * vec3(b["size"], key + ".box.size"));
+        o.shape = Box(0.5 * lengths(b["size"], key + ".box.size", true));
       }
       if (const YAML::Node s = n["sphere"]) {
         ++kinds;
         requireMap(s, key + ".sphere", {"radius"});
         if (!s["radius"]) fail(key + ".sphere.radius", "missing");
-        o.shape = Sphere(number(s["radius"], key + ".sphere.radius"));
+        o.shape = Sphere(length(s["radius"], key + ".sphere.radius", false));
       }
       for (const char* kind : {"cylinder", "capsule"}) {
         const YAML::Node c = n[kind];
@@ -114,7 +156,7 @@ class Parser {
         requireMap(c, k, {"radius", "length"});
         if (!c["radius"]) fail(k + ".radius", "missing");
         if (!c["length"]) fail(k + ".length", "missing");
-        const double r = number(c["radius"], k + ".radius"), h = 0.5 * number(c["length"], k + ".length");
+        const double r = length(c["radius"], k + ".radius", false), h = 0.5 * length(c["length"], k + ".length", true);
         if (std::string(kind) == "cylinder") o.shape = Cylinder(r, h);
         else o.shape = Capsule(r, h);
       }
@@ -133,7 +175,7 @@ class Parser {
     }
     if (kinds != 1) fail(key, "an obstacle needs exactly one of box, sphere, cylinder, capsule, mesh" + where(n));
     if (n["pose"]) o.pose = pose(n["pose"], key + ".pose");
-    if (n["velocity"]) o.velocity = vec3(n["velocity"], key + ".velocity");
+    if (n["velocity"]) o.velocity = lengths(n["velocity"], key + ".velocity", true);  // m/s
     d.obstacles.push_back(std::move(o));
   }
 
@@ -148,10 +190,16 @@ class Parser {
     }
     SceneDescription d;
     d.file = file_;
-    requireMap(root, "", {"format", "name", "source", "robot", "environment", "checks", "start", "goal"});
+    requireMap(root, "", {"format", "name", "source", "package_paths", "robot", "environment", "checks", "start", "goal"});
     if (!root["format"]) fail("format", "missing (this reader knows format 1)");
     if (number(root["format"], "format") != 1.0) fail("format", "unsupported format " + root["format"].Scalar() + " (this reader knows 1)");
     d.name = root["name"] ? text(root["name"], "name") : fs::path(file_).stem().string();
+
+    if (const YAML::Node p = root["package_paths"]; p && !p.IsNull()) {
+      if (!p.IsSequence()) fail("package_paths", "expected a list of folders" + where(p));
+      for (std::size_t i = 0; i < p.size(); ++i)
+        d.package_paths.push_back(path(p[i], "package_paths[" + std::to_string(i) + "]", /*folder=*/true));
+    }
 
     const YAML::Node robot = root["robot"];
     if (!robot) fail("robot", "missing");
@@ -164,17 +212,15 @@ class Parser {
     if (d.group.empty()) fail("robot.group", "an empty group has nothing to plan");
     if (const YAML::Node h = robot["hold"]; h && !h.IsNull()) {
       if (!h.IsMap()) fail("robot.hold", "expected a mapping of joint: value" + where(h));
-      for (const auto& kv : h) {
-        const std::string j = kv.first.as<std::string>();
-        d.hold.emplace_back(j, number(kv.second, "robot.hold." + j));
-      }
+      for (const std::string& j : keys(h, "robot.hold")) d.hold.emplace_back(j, number(h[j], "robot.hold." + j));
     }
     if (const YAML::Node b = robot["bounds"]; b && !b.IsNull()) {
       if (!b.IsMap()) fail("robot.bounds", "expected a mapping of variable: [lower, upper]" + where(b));
-      for (const auto& kv : b) {
-        const std::string v = kv.first.as<std::string>(), k = "robot.bounds." + v;
-        if (!kv.second.IsSequence() || kv.second.size() != 2) fail(k, "expected [lower, upper]" + where(kv.second));
-        d.bounds.emplace_back(v, std::make_pair(number(kv.second[0], k), number(kv.second[1], k)));
+      for (const std::string& v : keys(b, "robot.bounds")) {
+        const std::string k = "robot.bounds." + v;
+        const YAML::Node range = b[v];
+        if (!range.IsSequence() || range.size() != 2) fail(k, "expected [lower, upper]" + where(range));
+        d.bounds.emplace_back(v, std::make_pair(number(range[0], k), number(range[1], k)));
       }
     }
     if (const YAML::Node a = robot["allow"]; a && !a.IsNull()) {
@@ -216,6 +262,10 @@ class Parser {
       else if (c == "moving") d.effects.moving = true;
       else fail("checks", "unknown check '" + c + "' (self, environment, continuous, clearance, moving)");
     }
+    // Without self or environment nothing is ever checked, and every state would be called free.
+    if (!d.effects.self && !d.effects.environment)
+      fail("checks", std::string(root["checks"].size() == 0 ? "is empty" : "names no collision check") +
+                         ": every state would be free; list self, environment or both" + where(root["checks"]));
     bool any_moving = false;
     for (const auto& o : d.obstacles) any_moving = any_moving || o.velocity != Vec3::Zero();
     if (any_moving && !d.effects.moving)
@@ -234,7 +284,14 @@ class Parser {
 
 }  // namespace
 
-SceneDescription parseSceneFile(const std::string& path) { return Parser(path).parse(); }
+SceneDescription parseSceneFile(const std::string& path) {
+  try {
+    return Parser(path).parse();
+  } catch (const YAML::Exception& e) {
+    // Every read above checks its node first; this is the net for anything yaml-cpp still refuses.
+    throw LoadError(path, "", std::string("yaml-cpp: ") + e.what());
+  }
+}
 
 std::string Effects::toString() const {
   std::string s;

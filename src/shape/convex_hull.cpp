@@ -729,7 +729,8 @@ HullMesh computeHull(const std::vector<Vec3>& p, double eps) {
     mesh.triangles = first.triangles();
     bool all_kept = true;
     const std::vector<int> kept = keptVertices(p, mesh.triangles, 0.5 * eps, all_kept);
-    if (!all_kept) {
+    // Never none kept with finite points; if it happened, the first mesh is a hull of them all.
+    if (!all_kept && !kept.empty()) {
       // A point added early (ties in the farthest-point choice among coplanar points) can end up inside
       // a flat face, on an edge, or within eps of them. Rebuilding from the kept corners alone cannot
       // repeat this: each is then a corner, hence beyond the hull until added. This pass leaves out
@@ -771,11 +772,13 @@ ConvexHull::ConvexHull(const std::vector<Vec3>& points) {
   // Scale by a power of two (exact) so that every |coordinate| < 1, for the exact predicates.
   int exponent = 0;
   if (largest > 0.0) std::frexp(largest, &exponent);
-  const double scale = std::ldexp(1.0, -exponent);
+  // ldexp on each coordinate: for subnormal points (a radius of 1e-310) the factor 2^-exponent itself
+  // would overflow to infinity.
   std::vector<Vec3> scaled(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) scaled[i] = points[i] * scale;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    for (int k = 0; k < 3; ++k) scaled[i][k] = std::ldexp(points[i][k], -exponent);
 
-  const HullMesh mesh = computeHull(scaled, kHullEpsilon * largest * scale);
+  const HullMesh mesh = computeHull(scaled, kHullEpsilon * std::ldexp(largest, -exponent));
 
   std::vector<int> index(points.size(), -1);
   vertices_.reserve(mesh.vertices.size());

@@ -401,6 +401,18 @@ TEST(QueryFileErrors, EmptyVertexList) {
   EXPECT_MENTIONS(error(pair("distance", unit, body(R"({"type": "triangle", "vertices": []})"))), "b.shape.vertices");
 }
 
+TEST(QueryFileErrors, DeepNestingIsAnErrorNotAStackOverflow) {
+  // 100,000 levels as the id or as a radius once overflowed the stack (nlohmann's dump recurses).
+  const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+  EXPECT_MENTIONS(error(R"({"id": )" + deep + R"(, "query": "distance"})"), "nested deeper than 32 levels");
+  const std::string sphere = R"({"type": "sphere", "radius": )" + deep + "}";
+  EXPECT_MENTIONS(error(pair("distance", body(sphere), body(sphere))), "nested deeper than 32 levels");
+  // Brackets inside strings do not count, and 32 levels are still read (and refused for what they hold).
+  EXPECT_MENTIONS(error(R"({"id": ")" + std::string(100, '[') + R"(\"[", "query": "distance"})"), "a is missing");
+  const std::string deep32 = std::string(31, '[') + "1" + std::string(31, ']');
+  EXPECT_MENTIONS(error(R"({"id": )" + deep32 + "}"), "id must be a string or a number");
+}
+
 TEST(QueryFileErrors, BadRotations) {
   const std::string unit = body(R"({"type": "sphere", "radius": 1})");
   auto with_r = [&](const std::string& R) {

@@ -326,6 +326,37 @@ TEST(OctomapLoader, ForeignFiles) {
   EXPECT_NE(loadErrorOf(dir.file("binary.ot")).find("name it .bt"), std::string::npos);
 }
 
+TEST(OctomapLoader, HeadersThatLieAboutSizeOrResolution) {
+  TempDir dir;
+  octomap::OcTree tree(0.1);
+  tree.updateNode(octomap::point3d(0.05f, 0.05f, 0.05f), true);
+  tree.writeBinary(dir.file("one.bt"));
+  const std::string whole = readBytes(dir.file("one.bt"));
+  const auto edited = [&](const std::string& from, const std::string& to) {
+    std::string s = whole;
+    const std::size_t at = s.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return s.replace(at, from.size(), to);
+  };
+  const std::size_t size_at = whole.find("\nsize ") + 6;
+  const std::string size = whole.substr(size_at, whole.find('\n', size_at) - size_at);
+  // 'size 0' followed by nodes once loaded as an empty map: everything free.
+  writeBytes(dir.file("zero.bt"), edited("size " + size + "\n", "size 0\n"));
+  EXPECT_NE(loadErrorOf(dir.file("zero.bt")).find("zero.bt: corrupt file: the header declares 0 nodes, but"),
+            std::string::npos)
+      << loadErrorOf(dir.file("zero.bt"));
+  // A resolution so large that the map's cubes overflow, or too small to mean anything.
+  writeBytes(dir.file("huge.bt"), edited("res 0.1", "res 1e308"));
+  EXPECT_EQ(loadErrorOf(dir.file("huge.bt")),
+            dir.file("huge.bt") + ": resolution 1e+308 m: the map would span inf m, beyond the largest length an input may give (1e6 m)");
+  writeBytes(dir.file("big.bt"), edited("res 0.1", "res 100"));
+  EXPECT_NE(loadErrorOf(dir.file("big.bt")).find("the map would span 6.5536e+06 m"), std::string::npos);
+  writeBytes(dir.file("tiny.bt"), edited("res 0.1", "res 1e-12"));
+  EXPECT_NE(loadErrorOf(dir.file("tiny.bt")).find("below the smallest length"), std::string::npos);
+  writeBytes(dir.file("coarse.bt"), edited("res 0.1", "res 30"));  // within the limit: loads
+  EXPECT_EQ(loadErrorOf(dir.file("coarse.bt")), "");
+}
+
 TEST(OctomapLoader, TruncatedFilesAlwaysThrow) {
   TempDir dir;
   octomap::OcTree tree(0.05);

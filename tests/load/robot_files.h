@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -67,6 +68,35 @@ inline std::string tetrahedronStl(const std::string& extra_facets = "") {
   };
   return "solid tet\n" + facet("0 0 0", "0 1 0", "1 0 0") + facet("0 0 0", "1 0 0", "0 0 1") +
          facet("0 0 0", "0 0 1", "0 1 0") + facet("1 0 0", "0 1 0", "0 0 1") + extra_facets + "endsolid tet\n";
+}
+
+/// A COLLADA file holding one closed box [lo, hi] (outward triangles) in the file's coordinates, under a
+/// node with the given transform elements (e.g. "<translate>0 0 1</translate>"), with <unit meter> and
+/// <up_axis> (none when up_axis is empty).
+inline std::string colladaBox(const std::array<double, 3>& lo, const std::array<double, 3>& hi, const std::string& up_axis,
+                              double meter = 1.0, const std::string& node_transform = "") {
+  std::string positions;
+  for (int k = 0; k < 8; ++k) {
+    // Corner k: x from bit 0 (after the y flip below), y from bit 1, z from bit 2, in the order
+    // (x0,y0,z0) (x1,y0,z0) (x1,y1,z0) (x0,y1,z0), then the same at z1.
+    const int xbit = (k & 1) ^ ((k >> 1) & 1), ybit = (k >> 1) & 1, zbit = (k >> 2) & 1;
+    for (const double v : {xbit ? hi[0] : lo[0], ybit ? hi[1] : lo[1], zbit ? hi[2] : lo[2]})
+      positions += std::to_string(v) + " ";
+  }
+  return "<?xml version=\"1.0\"?>\n<COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">\n"
+         "<asset><unit meter=\"" + std::to_string(meter) + "\"/>" +
+         (up_axis.empty() ? "" : "<up_axis>" + up_axis + "</up_axis>") + "</asset>\n"
+         "<library_geometries><geometry id=\"g\"><mesh>\n"
+         "<source id=\"p\"><float_array id=\"pa\" count=\"24\">" + positions + "</float_array>\n"
+         "<technique_common><accessor source=\"#pa\" count=\"8\" stride=\"3\"><param name=\"X\" type=\"float\"/>"
+         "<param name=\"Y\" type=\"float\"/><param name=\"Z\" type=\"float\"/></accessor></technique_common></source>\n"
+         "<vertices id=\"v\"><input semantic=\"POSITION\" source=\"#p\"/></vertices>\n"
+         "<triangles count=\"12\"><input semantic=\"VERTEX\" source=\"#v\" offset=\"0\"/>\n"
+         "<p>0 3 2 0 2 1 4 5 6 4 6 7 0 1 5 0 5 4 2 3 7 2 7 6 1 2 6 1 6 5 3 0 4 3 4 7</p></triangles>\n"
+         "</mesh></geometry></library_geometries>\n"
+         "<library_visual_scenes><visual_scene id=\"s\"><node id=\"n\">" + node_transform +
+         "<instance_geometry url=\"#g\"/></node></visual_scene></library_visual_scenes>\n"
+         "<scene><instance_visual_scene url=\"#s\"/></scene>\n</COLLADA>\n";
 }
 
 /// Runs statement, which must throw LoadError whose file() is file, whose element() contains element

@@ -1,6 +1,7 @@
 // loadRobot on bad input: each problem a user can make in a URDF, an SRDF or a mesh is a LoadError that
 // names the file, the element (with its line) and the reason.
 #include <clearway/load/robot_loader.h>
+#include <clearway/load/triangle_mesh.h>
 
 #include "load/robot_files.h"
 
@@ -142,6 +143,31 @@ TEST_F(BadInput, Mimics) {
     <joint name="j2" type="continuous"><parent link="b"/><child link="c"/><mimic joint="j1"/></joint>
   </robot>)");
   EXPECT_LOAD_ERROR(loadRobot(fixed_leader), fixed_leader, "joint 'j2'", "a fixed joint (not one variable)");
+  const std::string planar = dir.write("mimic_planar.urdf", R"(<robot name="r">
+    <link name="a"/><link name="b"/><link name="c"/>
+    <joint name="j1" type="continuous"><parent link="a"/><child link="b"/></joint>
+    <joint name="j2" type="planar"><parent link="b"/><child link="c"/><mimic joint="j1"/></joint>
+  </robot>)");
+  EXPECT_LOAD_ERROR(loadRobot(planar), planar, "joint 'j2'", "a planar joint cannot mimic");
+}
+
+TEST_F(BadInput, AMimicOnAFixedJointIsIgnoredWithAWarning) {
+  // urdfdom accepts it and it does nothing (MoveIt too), whether the joint it names exists or not.
+  for (const std::string leader : {"j1", "ghost"}) {
+    const std::string urdf = dir.write("fixed_mimic_" + leader + ".urdf", R"(<robot name="r">
+    <link name="a"/><link name="b"/><link name="c"/>
+    <joint name="j1" type="continuous"><parent link="a"/><child link="b"/></joint>
+    <joint name="j2" type="fixed"><parent link="b"/><child link="c"/><mimic joint=")" + leader + R"(" multiplier="2"/></joint>
+  </robot>)");
+    const RobotModel m = loadRobot(urdf);
+    EXPECT_EQ(m.variableCount(), 1);
+    const Joint& j2 = m.joint(m.jointIndex("j2"));
+    EXPECT_EQ(j2.type, JointType::Fixed);
+    EXPECT_FALSE(j2.isMimic());
+    ASSERT_EQ(m.loadWarnings().size(), 1u);
+    EXPECT_EQ(m.loadWarnings()[0], urdf + ": joint 'j2' (line 4): a fixed joint cannot mimic: <mimic joint=\"" + leader +
+                                       "\"> ignored");
+  }
 }
 
 TEST_F(BadInput, UnsupportedGeometry) {
@@ -184,13 +210,31 @@ TEST_F(BadInput, BadMeshUris) {
   EXPECT_LOAD_ERROR(loadRobot(file), file, "link 'b' <collision>", "without an absolute path");
 }
 
-TEST_F(BadInput, SrdfNamingAMissingLink) {
+TEST_F(BadInput, SrdfPairsNamingMissingLinksAreSkippedWithOneWarning) {
+  // MoveIt skips such pairs; shipped SRDFs often name links of another variant of the robot.
   const std::string urdf = dir.write("r.urdf", twoLinks());
-  const std::string srdf = dir.write("r.srdf", "<robot name=\"r\">\n"
-                                               "  <disable_collisions link1=\"a\" link2=\"b\" reason=\"Adjacent\"/>\n"
-                                               "  <disable_collisions link1=\"a\" link2=\"ghost\" reason=\"Never\"/>\n"
-                                               "</robot>\n");
-  EXPECT_LOAD_ERROR(loadRobot(urdf, srdf), srdf, "<disable_collisions> (line 3)", "link2 'ghost' is not a link of");
+  std::string text = "<robot name=\"r\">\n  <disable_collisions link1=\"a\" link2=\"b\" reason=\"Adjacent\"/>\n";
+  for (int i = 0; i < 8; ++i)  // 8 pairs, 7 distinct missing names (ghost0 twice)
+    text += "  <disable_collisions link1=\"a\" link2=\"ghost" + std::to_string(i % 7) + "\" reason=\"Never\"/>\n";
+  text += "  <disable_collisions link1=\"ghost0\" link2=\"gone\" reason=\"Never\"/>\n</robot>\n";
+  const std::string srdf = dir.write("r.srdf", text);
+  const RobotModel m = loadRobot(urdf, srdf);
+  ASSERT_EQ(m.disabledCollisions().size(), 1u);
+  EXPECT_EQ(m.disabledCollisions()[0].reason, "Adjacent");
+  ASSERT_EQ(m.loadWarnings().size(), 1u) << m.loadWarnings()[0];
+  const std::string& w = m.loadWarnings()[0];
+  EXPECT_EQ(w.rfind(srdf + ": 9 <disable_collisions> pairs skipped (as MoveIt does): 8 link names not in " + urdf +
+                        ": 'ghost0', 'ghost1', 'ghost2', 'ghost3', 'ghost4', ...", 0),
+            0u)
+      << w;
+  EXPECT_EQ(w.find("ghost5"), std::string::npos) << "only the first few names: " << w;
+
+  const std::string one = dir.write("one.srdf", "<robot name=\"r\"><disable_collisions link1=\"ghost\" link2=\"b\"/></robot>");
+  const RobotModel m1 = loadRobot(urdf, one);
+  EXPECT_TRUE(m1.disabledCollisions().empty());
+  ASSERT_EQ(m1.loadWarnings().size(), 1u);
+  EXPECT_EQ(m1.loadWarnings()[0], one + ": 1 <disable_collisions> pair skipped (as MoveIt does): 1 link name not in " +
+                                      urdf + ": 'ghost'");
 }
 
 TEST_F(BadInput, BadSrdfFile) {
@@ -217,4 +261,131 @@ TEST_F(BadInput, SuspiciousMeshesAreWarnings) {
   EXPECT_NE(m.loadWarnings()[0].find("probably millimetres"), std::string::npos) << m.loadWarnings()[0];
   EXPECT_NE(m.loadWarnings()[1].find("open.obj: not closed (3 edges with one triangle"), std::string::npos)
       << m.loadWarnings()[1];
+}
+
+// ---- Inputs that once crashed, hung or exhausted memory (../shared/bad-inputs), written out here.
+
+TEST_F(BadInput, SizesAndCoordinatesBeyondTheInputLimits) {
+  // A sphere of radius 1e-310 crashed the hull builder; a coordinate of 1e308 the tree builder.
+  const std::string tiny = dir.write("tiny.urdf", twoLinks("revolute", "", "<collision><geometry><sphere radius=\"1e-310\"/></geometry></collision>"));
+  EXPECT_LOAD_ERROR(loadRobot(tiny), tiny, "link 'b' <collision> <geometry> <sphere> (line 3)",
+                    "radius=\"1e-310\": 1e-310 m is below the smallest length an input may give (1e-9 m)");
+  const std::string thin = dir.write("thin.urdf", twoLinks("revolute", "", "<collision><geometry><cylinder radius=\"0.1\" length=\"1e-320\"/></geometry></collision>"));
+  EXPECT_LOAD_ERROR(loadRobot(thin), thin, "<cylinder>", "length=\"1e-320\"");
+  const std::string flat = dir.write("flat.urdf", twoLinks("revolute", "", "<collision><geometry><box size=\"0.1 0 1e-12\"/></geometry></collision>"));
+  EXPECT_LOAD_ERROR(loadRobot(flat), flat, "<box>", "below the smallest length");
+  const std::string far = dir.write("far.urdf", twoLinks("revolute", "", "<collision><origin xyz=\"0 1e308 0\"/><geometry><sphere radius=\"1\"/></geometry></collision>"));
+  EXPECT_LOAD_ERROR(loadRobot(far), far, "<origin>", "beyond the largest length an input may give (1e6 m)");
+  const std::string slide = dir.write("slide.urdf", R"(<robot name="r"><link name="a"/><link name="b"/>
+    <joint name="j" type="prismatic"><parent link="a"/><child link="b"/><limit lower="0" upper="1e300" velocity="1" effort="1"/></joint></robot>)");
+  EXPECT_LOAD_ERROR(loadRobot(slide), slide, "joint 'j' <limit>", "within ±1e6 m");
+  // At the limits, and a flat box, still load.
+  const std::string edge = dir.write("edge.urdf", twoLinks("revolute", "<origin xyz=\"1e6 0 0\"/>\n", "<collision><geometry><sphere radius=\"1e-9\"/></geometry></collision><collision><geometry><box size=\"1 0 1\"/></geometry></collision>"));
+  EXPECT_EQ(loadRobot(edge).link(1).collisions.size(), 2u);
+
+  // A mesh scaled to 1e270 (finite, far beyond any robot), or to nothing.
+  dir.write("tet.stl", test::tetrahedronStl());
+  const std::string huge = dir.write("huge.urdf", twoLinks("revolute", "", "<collision><geometry><mesh filename=\"tet.stl\" scale=\"1e270 1 1\"/></geometry></collision>"));
+  EXPECT_LOAD_ERROR(loadRobot(huge), huge, "link 'b' <collision>", "1e+270 m from the origin after scale, beyond the largest length");
+  const std::string speck = dir.write("speck.urdf", twoLinks("revolute", "", "<collision><geometry><mesh filename=\"tet.stl\" scale=\"1e-12 1e-12 1e-12\"/></geometry></collision>"));
+  EXPECT_LOAD_ERROR(loadRobot(speck), speck, "link 'b' <collision>", "the mesh spans 1e-12 m after scale, below the smallest length");
+}
+
+TEST_F(BadInput, MeshFormatsAndPlyIndices) {
+  // A PLY face index past the vertex count was used unchecked (SIGSEGV).
+  const std::string header = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+                             "element face 4\nproperty list uchar int vertex_indices\nend_header\n"
+                             "0 0 0\n1 0 0\n0 1 0\n0 0 1\n";
+  const std::string ok = dir.write("tet.ply", header + "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
+  EXPECT_EQ(loadMesh(ok, Vec3::Ones()).triangles.size(), 4u);
+  const std::string bad = dir.write("bad.ply", header + "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 1000000000\n");
+  EXPECT_LOAD_ERROR(loadMesh(bad, Vec3::Ones()), bad, "", "uses vertex 1000000000, but the mesh has 4 vertices");
+  // Formats other than these four are refused, by the name the error gives them.
+  for (const std::string name : {"garbage.x", "model.3ds", "archive.zae", "scene.fbx"}) {
+    const std::string path = dir.write(name, "xof 0302txt 0064\ngarbage");
+    EXPECT_LOAD_ERROR(loadMesh(path, Vec3::Ones()), path, "", "(Clearway reads STL, OBJ, COLLADA (.dae) or PLY)");
+  }
+  // Assimp leaks on a facet with two vertices (suppressed for libassimp in sanitizer builds); a clear error.
+  const std::string two = dir.write("two_verts.stl", "solid x\n facet normal 0 0 1\n outer loop\n vertex 0 0 0\n vertex 1 0 0\n"
+                                                     " endloop\n endfacet\nendsolid x\n");
+  EXPECT_LOAD_ERROR(loadMesh(two, Vec3::Ones()), two, "", "assimp cannot read it");
+}
+
+namespace {
+
+// A COLLADA file around a library of nodes and a visual scene's content.
+std::string collada(const std::string& geometry_p, const std::string& nodes, const std::string& scene_nodes,
+                    const std::string& positions = "0 0 0 1 0 0 0 1 0 0 0 1", int vertices = 4,
+                    const std::string& accessor = "count=\"4\" stride=\"3\"") {
+  return "<?xml version=\"1.0\"?>\n<COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">\n"
+         "<asset><unit meter=\"1\"/><up_axis>Z_UP</up_axis></asset>\n"
+         "<library_geometries><geometry id=\"g\"><mesh>\n"
+         "<source id=\"p\"><float_array id=\"pa\" count=\"" + std::to_string(3 * vertices) + "\">" + positions + "</float_array>\n"
+         "<technique_common><accessor source=\"#pa\" " + accessor + "><param name=\"X\" type=\"float\"/>"
+         "<param name=\"Y\" type=\"float\"/><param name=\"Z\" type=\"float\"/></accessor></technique_common></source>\n"
+         "<vertices id=\"v\"><input semantic=\"POSITION\" source=\"#p\"/></vertices>\n"
+         "<triangles count=\"4\"><input semantic=\"VERTEX\" source=\"#v\" offset=\"0\"/>\n<p>" + geometry_p +
+         "</p></triangles>\n</mesh></geometry></library_geometries>\n"
+         "<library_nodes>" + nodes + "</library_nodes>\n"
+         "<library_visual_scenes><visual_scene id=\"s\">" + scene_nodes + "</visual_scene></library_visual_scenes>\n"
+         "<scene><instance_visual_scene url=\"#s\"/></scene>\n</COLLADA>\n";
+}
+
+const char* const kTetP = "0 2 1 0 1 3 0 3 2 1 2 3";
+const char* const kTetNode = "<node id=\"tet\"><instance_geometry url=\"#g\"/></node>";
+
+}  // namespace
+
+TEST_F(BadInput, ColladaThatAssimpCannotSurvive) {
+  // The reference: a tetrahedron through a library node loads.
+  const std::string good = dir.write("good.dae", collada(kTetP, kTetNode, "<node id=\"n\"><instance_node url=\"#tet\"/></node>"));
+  EXPECT_EQ(loadMesh(good, Vec3::Ones()).triangles.size(), 4u);
+
+  struct Case {
+    std::string name, text, element, reason;
+  };
+  std::string deep_chain;  // 300 library nodes, each instancing the next
+  for (int i = 0; i < 300; ++i)
+    deep_chain += "<node id=\"c" + std::to_string(i) + "\"><instance_node url=\"#c" + std::to_string(i + 1) + "\"/></node>";
+  deep_chain += "<node id=\"c300\"><instance_geometry url=\"#g\"/></node>";
+  std::string doubling;  // 2^30 nodes once expanded
+  for (int i = 0; i < 30; ++i)
+    doubling += "<node id=\"d" + std::to_string(i) + "\"><instance_node url=\"#d" + std::to_string(i + 1) +
+                "\"/><instance_node url=\"#d" + std::to_string(i + 1) + "\"/></node>";
+  doubling += "<node id=\"d30\"><instance_geometry url=\"#g\"/></node>";
+  std::string nested;  // 20,000 nested nodes: tinyxml2 stops at its depth limit
+  for (int i = 0; i < 20000; ++i) nested += "<node>";
+  for (int i = 0; i < 20000; ++i) nested += "</node>";
+  const Case cases[] = {
+      // A letter in an index list: assimp looped forever, allocating.
+      {"letter.dae", collada("0 2 1 0 1 3 0 3 2 1 2 3x", kTetNode, "<node id=\"n\"><instance_node url=\"#tet\"/></node>"),
+       "<p> (line 9)", "'3x' is not an integer"},
+      {"decimal.dae", collada("0 2 1 0 1 3 0 3 2 1 2 3.0", kTetNode, "<node id=\"n\"/>"), "<p>", "'3.0' is not an integer"},
+      {"float.dae", collada(kTetP, kTetNode, "<node id=\"n\"/>", "0 0 0 1 0 0 0 1 0 0 0 one"), "<float_array> (line 5)",
+       "'one' is not a number"},
+      // A node that instantiates itself: assimp recursed until the stack overflowed.
+      {"self.dae", collada(kTetP, "", "<node id=\"n\"><instance_geometry url=\"#g\"/><instance_node url=\"#n\"/></node>"),
+       "<node> (line 12)", "contains itself through <instance_node>"},
+      {"cycle.dae", collada(kTetP, "<node id=\"a\"><instance_node url=\"#b\"/></node><node id=\"b\"><node><instance_node url=\"#a\"/></node></node>",
+                            "<node id=\"n\"><instance_node url=\"#a\"/></node>"),
+       "<node>", "contains itself"},
+      {"deep.dae", collada(kTetP, deep_chain, "<node id=\"n\"><instance_node url=\"#c0\"/></node>"), "<node>",
+       "nested deeper than 256 levels"},
+      {"doubling.dae", collada(kTetP, doubling, "<node id=\"n\"><instance_node url=\"#d0\"/></node>"), "<node>",
+       "more than 100000 nodes"},
+      {"nested.dae", collada(kTetP, "", nested), "line", "malformed XML"},
+      // Counts and accessors beyond what the file holds: assimp reserved or read past the array.
+      {"count.dae", collada(kTetP, kTetNode, "<node id=\"n\"/>", "0 0 0 1 0 0 0 1 0 0 0 1", 4,
+                            "count=\"99999999999\" stride=\"3\""),
+       "<accessor> (line 6)", "count=\"99999999999\" exceeds the size of the file"},
+      {"accessor.dae", collada(kTetP, kTetNode, "<node id=\"n\"/>", "0 0 0 1 0 0 0 1 0 0 0 1", 4, "count=\"5\" stride=\"3\""),
+       "<accessor> (line 6)", "reaches value 15 of 'pa', which holds 12"},
+      {"stride.dae", collada(kTetP, kTetNode, "<node id=\"n\"/>", "0 0 0 1 0 0 0 1 0 0 0 1", 4, "count=\"4\" stride=\"-3\""),
+       "<accessor>", "stride=\"-3\" is not a whole number"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::string path = dir.write(c.name, c.text);
+    EXPECT_LOAD_ERROR(loadMesh(path, Vec3::Ones()), path, c.element, c.reason);
+  }
 }

@@ -85,15 +85,60 @@ TEST(MeshLoader, ObjQuadsAreTriangulated) {
   EXPECT_NEAR(signedVolume(m), 0.08 * 0.08 * 0.4, 1e-9);
 }
 
-TEST(MeshLoader, ColladaYUpInCentimetresBecomesZUpInMetres) {
-  // The file holds the forearm modelled y-up in centimetres; the link expects z-up metres.
+TEST(MeshLoader, ColladaUpAxisIsIgnoredAsRosDoesAndTheUnitKept) {
+  // The forearm is written in centimetres with the link's coordinates (z up) in a file declaring Y_UP:
+  // ROS ignores <up_axis> (geometric_shapes drops assimp's root transform), and so does the loader.
   std::vector<std::string> warnings;
   const TriangleMesh m = loadMesh(arm6Mesh("forearm.dae"), Vec3::Ones(), &warnings);
   EXPECT_EQ(m.triangles.size(), 12u);
   expectBounds(m, Vec3(-0.03, -0.03, 0.0), Vec3(0.03, 0.03, 0.35), 1e-7);
-  EXPECT_GT(signedVolume(m), 0.0);  // a rotation keeps the triangles outward
+  EXPECT_GT(signedVolume(m), 0.0);
   ASSERT_EQ(warnings.size(), 1u);
-  EXPECT_NE(warnings[0].find("<up_axis> is not Z_UP"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[0].find("COLLADA <up_axis> is Y_UP: ignored as ROS"), std::string::npos) << warnings[0];
+
+  // Honoured on request: the file's y becomes z, so the forearm lies along -y.
+  warnings.clear();
+  MeshOptions honour;
+  honour.honour_up_axis = true;
+  const TriangleMesh r = loadMesh(arm6Mesh("forearm.dae"), Vec3::Ones(), &warnings, honour);
+  expectBounds(r, Vec3(-0.03, -0.35, -0.03), Vec3(0.03, 0.0, 0.03), 1e-7);
+  EXPECT_GT(signedVolume(r), 0.0);  // a rotation keeps the triangles outward
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("COLLADA <up_axis> is Y_UP: rotated"), std::string::npos) << warnings[0];
+}
+
+TEST(MeshLoader, ColladaEveryUpAxisWithUnitAndNodeTransform) {
+  // A box x in [1, 2], y in [0, 0.5], z in [0, 3] (file units: cm), under a node translated by (0, 0, 1).
+  TempDir dir;
+  const Vec3 lo(0.01, 0.0, 0.01), hi(0.02, 0.005, 0.04);  // in metres, the translation included
+  struct Case {
+    std::string up_axis;
+    Vec3 honoured_lo, honoured_hi;  // the file's up axis turned to z
+    bool warned;
+  };
+  const Case cases[] = {
+      {"Z_UP", lo, hi, false},
+      {"Y_UP", Vec3(lo.x(), -hi.z(), lo.y()), Vec3(hi.x(), -lo.z(), hi.y()), true},  // (x, y, z) -> (x, -z, y)
+      {"", Vec3(lo.x(), -hi.z(), lo.y()), Vec3(hi.x(), -lo.z(), hi.y()), true},      // COLLADA's default is Y_UP
+      {"X_UP", Vec3(-hi.y(), -hi.z(), lo.x()), Vec3(-lo.y(), -lo.z(), hi.x()), true},  // (x, y, z) -> (-y, -z, x)
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE("up axis '" + c.up_axis + "'");
+    const std::string path = dir.write("box_" + c.up_axis + ".dae",
+                                       test::colladaBox({1, 0, 0}, {2, 0.5, 3}, c.up_axis, 0.01, "<translate>0 0 1</translate>"));
+    std::vector<std::string> warnings;
+    const TriangleMesh plain = loadMesh(path, Vec3::Ones(), &warnings);
+    expectBounds(plain, lo, hi, 1e-9);  // as written, in metres (assimp keeps floats), whatever the up axis
+    EXPECT_NEAR(signedVolume(plain), 0.01 * 0.005 * 0.03, 1e-12);
+    EXPECT_EQ(warnings.size(), c.warned ? 1u : 0u);
+    warnings.clear();
+    MeshOptions honour;
+    honour.honour_up_axis = true;
+    const TriangleMesh turned = loadMesh(path, Vec3::Ones(), &warnings, honour);
+    expectBounds(turned, c.honoured_lo, c.honoured_hi, 1e-9);
+    EXPECT_NEAR(signedVolume(turned), 0.01 * 0.005 * 0.03, 1e-12);
+    EXPECT_EQ(warnings.size(), c.warned ? 1u : 0u);
+  }
 }
 
 TEST(MeshLoader, ColladaZUpWithNodeTransform) {

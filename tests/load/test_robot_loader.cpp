@@ -109,10 +109,15 @@ TEST(RobotLoader, Arm6MeshesInEveryFormat) {
   EXPECT_EQ(collisionTriangles(m), 3 * 96u + 3 * 12u);
   for (const TriangleMesh& mesh : m.meshes()) EXPECT_TRUE(isClosed(mesh));
 
-  // The only warning: the forearm's COLLADA file is Y_UP.
+  // The only warning: the forearm's COLLADA file declares Y_UP, ignored as ROS ignores it.
   ASSERT_EQ(m.loadWarnings().size(), 1u);
   EXPECT_NE(m.loadWarnings()[0].find("link 'forearm_link' <collision>"), std::string::npos) << m.loadWarnings()[0];
-  EXPECT_NE(m.loadWarnings()[0].find("not Z_UP"), std::string::npos);
+  EXPECT_NE(m.loadWarnings()[0].find("<up_axis> is Y_UP: ignored"), std::string::npos) << m.loadWarnings()[0];
+  // The forearm stands along its link's z, as in RViz and MoveIt.
+  double forearm_top = 0.0;
+  for (const Vec3& v : m.meshes().at(m.link(m.linkIndex("forearm_link")).collisions.at(0).mesh).vertices)
+    forearm_top = std::max(forearm_top, v.z());
+  EXPECT_NEAR(forearm_top, 0.35, 1e-7);
 
   // The millimetre mesh is scaled by the URDF: the wrist is 0.1 m tall, radius 0.035.
   const Link& wrist1 = m.link(m.linkIndex("wrist_1_link"));
@@ -320,6 +325,32 @@ TEST(RobotLoader, OneMeshPerFileAndScale) {
   EXPECT_EQ(m.link(0).collisions[0].mesh, m.link(1).collisions[0].mesh);
   EXPECT_NE(m.link(1).collisions[0].mesh, m.link(1).collisions[1].mesh);
   EXPECT_DOUBLE_EQ(m.meshes()[m.link(1).collisions[1].mesh].vertices[1].norm(), 2.0);
+}
+
+TEST(RobotLoader, ColladaUpAxisWarningOncePerFileAndTheOptionReachesTheMeshes) {
+  TempDir dir;
+  dir.write("tall.dae", test::colladaBox({-0.05, -0.05, 0}, {0.05, 0.05, 1}, "Y_UP"));
+  const std::string urdf = dir.write("r.urdf", R"(<robot name="r">
+    <link name="a"><collision><geometry><mesh filename="tall.dae"/></geometry></collision></link>
+    <link name="b"><collision><geometry><mesh filename="tall.dae" scale="2 2 2"/></geometry></collision>
+                   <collision><geometry><mesh filename="./tall.dae"/></geometry></collision></link>
+    <joint name="j" type="fixed"><parent link="a"/><child link="b"/></joint>
+  </robot>)");
+  const RobotModel plain = loadRobot(urdf);
+  EXPECT_EQ(plain.meshes().size(), 2u);
+  ASSERT_EQ(plain.loadWarnings().size(), 1u);
+  EXPECT_NE(plain.loadWarnings()[0].find("tall.dae: COLLADA <up_axis> is Y_UP: ignored"), std::string::npos)
+      << plain.loadWarnings()[0];
+  EXPECT_NEAR(plain.meshes()[0].vertices[0].z(), 0.0, 1e-12);  // corner (-0.05, -0.05, 0) as written
+
+  LoadOptions options;
+  options.mesh.honour_up_axis = true;
+  const RobotModel turned = loadRobot(urdf, "", options);
+  ASSERT_EQ(turned.loadWarnings().size(), 1u);
+  EXPECT_NE(turned.loadWarnings()[0].find("rotated"), std::string::npos) << turned.loadWarnings()[0];
+  double lowest_y = 0.0;
+  for (const Vec3& v : turned.meshes()[0].vertices) lowest_y = std::min(lowest_y, v.y());
+  EXPECT_NEAR(lowest_y, -1.0, 1e-12);  // the file's y is up: its z (the box's length) lies along -y
 }
 
 TEST(RobotLoader, SrdfDetails) {

@@ -408,6 +408,7 @@ TEST(MotionCertified, BadInput) {
   for (auto edit : std::vector<void (*)(MotionOptions&)>{
            [](MotionOptions& o) { o.contact_distance = 0; }, [](MotionOptions& o) { o.contact_distance = NAN; },
            [](MotionOptions& o) { o.resolution = -1; }, [](MotionOptions& o) { o.max_queries = 0; },
+           [](MotionOptions& o) { o.max_samples = 0; },
            [](MotionOptions& o) { o.distance_relative_error = -0.1; }}) {
     MotionOptions o;
     edit(o);
@@ -423,6 +424,32 @@ TEST(MotionCertified, BadInput) {
   const MotionResult r = tight.check(from, far, tc);
   EXPECT_FALSE(r.free);
   EXPECT_TRUE(r.capped);
+
+  // Sampled: a resolution so fine that the step count passes every int (len / 1e-9 > 2^31) once wrapped
+  // to one step and called a colliding segment free; now more states than the cap is a collision.
+  MotionOptions fine;
+  fine.mode = MotionMode::Sampled;
+  for (const double resolution : {1e-9, 1e-12, 1e-320}) {
+    fine.resolution = resolution;
+    const MotionChecker sampled(scene, fine);
+    MotionContext sc = sampled.makeContext();
+    const MotionResult s = sampled.check(from, far, sc);
+    EXPECT_FALSE(s.free) << resolution;
+    EXPECT_TRUE(s.capped) << resolution;
+    EXPECT_EQ(s.last_valid, 0.0);
+  }
+  fine.resolution = 1e-3;  // about 1,400 states: within the cap, and the wall is seen
+  const int needed = static_cast<int>(std::ceil((far[0] - from[0]) / fine.resolution));
+  fine.max_samples = needed;
+  const MotionChecker within(scene, fine);
+  MotionContext wc = within.makeContext();
+  const MotionResult w = within.check(from, far, wc);
+  EXPECT_FALSE(w.free);
+  EXPECT_FALSE(w.capped);
+  fine.max_samples = needed - 1;
+  const MotionChecker beyond(scene, fine);
+  MotionContext bc = beyond.makeContext();
+  EXPECT_TRUE(beyond.check(from, far, bc).capped);
 }
 
 // ---- Cast mode: what only translates is measured by one shape cast ---------------------------------------

@@ -109,6 +109,24 @@ TEST(Audit, KnownFractionAndAlwaysThreshold) {
   EXPECT_EQ(static_cast<int>(again.disabledCollisions().size()), classified);
 }
 
+TEST(Audit, RobotsWithoutJoints) {
+  // A one-link robot has no joint values: the samples were indexed as &v[0] of an empty vector (UBSan:
+  // reference binding to null). Two links on a fixed joint have a pair but nothing to sample either.
+  TempDir dir;
+  for (const std::string& urdf :
+       {std::string(R"(<robot name="r"><link name="a"><collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link></robot>)"),
+        std::string(R"(<robot name="r"><link name="a"><collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>
+           <link name="b"><collision><origin xyz="1 0 0"/><geometry><sphere radius="0.1"/></geometry></collision></link>
+           <joint name="j" type="fixed"><parent link="a"/><child link="b"/></joint></robot>)")}) {
+    auto model = std::make_shared<const RobotModel>(loadRobot(dir.write("r.urdf", urdf)));
+    AuditOptions options;
+    options.samples = 3;
+    const std::vector<PairAudit> audit = auditSelfCollision(std::make_shared<const RobotGeometry>(model), options);
+    ASSERT_EQ(audit.size(), model->linkCount() == 1 ? 0u : 1u);
+    if (!audit.empty()) EXPECT_EQ(audit[0].reason, "Adjacent");
+  }
+}
+
 TEST(Audit, ClopperPearson) {
   EXPECT_EQ(clopperPearsonUpper(0, 0), 1.0);
   EXPECT_EQ(clopperPearsonUpper(5, 5), 1.0);

@@ -93,6 +93,28 @@ TEST(SceneFile, BadInputNamesFileAndKey) {
       {"format: 1\nrobot: [\n", "", "not valid YAML"},
       {replaced("environment:\n  obstacles:", "environment:\n  octomap: missing.bt\n  obstacles:"),
        "key 'environment.octomap'", "file not found"},
+      // A repeated key silently lost to the first (a colliding state was called free).
+      {replaced("checks:", "checks: [self]\nchecks:"), "key 'checks'", "given twice with different values (lines 9 and 10)"},
+      {replaced("  group:", "  padding: 0\n  padding: 0.1\n  group:"), "key 'robot.padding'", "given twice"},
+      {replaced("  group:", "  hold: {elbow: 0, elbow: 1}\n  group:"), "key 'robot.hold.elbow'", "given twice"},
+      {replaced("  group:", "  bounds: {elbow: [0, 1], elbow: [0, 2]}\n  group:"), "key 'robot.bounds.elbow'", "given twice"},
+      {replaced("{name: wall, box:", "{name: wall, name: post, box:"), "key 'environment.obstacles[0].name'", "given twice"},
+      // Complex keys: yaml-cpp's "bad conversion" named neither the file nor the key.
+      {replaced("  group:", "  hold: {? [a, b] : 1}\n  group:"), "key 'robot.hold'", "a key must be a plain name, not a list"},
+      {"? {a: 1}\n: 2\n" + good, "", "a key must be a plain name, not a mapping"},
+      // Checks that check nothing: every state was free without a word.
+      {replaced("[self, environment]", "[]"), "key 'checks'", "is empty: every state would be free"},
+      {replaced("[self, environment]", "[continuous, clearance]"), "key 'checks'", "names no collision check"},
+      // Lengths beyond the input limits: an infinite box centre crashed the tree builder, a subnormal
+      // radius the hull builder.
+      {replaced("position: [1.2, 0, 0]", "position: [1e308, 0, 0]"), "key 'environment.obstacles[0].pose.position[0]'",
+       "'1e308' m is beyond the largest length an input may give"},
+      {replaced("size: [0.1, 2, 1]", "size: [0.1, 2, 1e-310]"), "key 'environment.obstacles[0].box.size[2]'",
+       "below the smallest length"},
+      {replaced("box: {size: [0.1, 2, 1]}", "sphere: {radius: 1e-310}"), "key 'environment.obstacles[0].sphere.radius'",
+       "below the smallest length"},
+      {replaced("box: {size: [0.1, 2, 1]}", "capsule: {radius: 0.1, length: 2e6}"),
+       "key 'environment.obstacles[0].capsule.length'", "beyond the largest length"},
   };
   for (const Case& c : cases) {
     const std::string path = dir.write("bad.yaml", c.text);
@@ -100,6 +122,65 @@ TEST(SceneFile, BadInputNamesFileAndKey) {
   }
   const std::string missing = dir.path("absent.yaml");
   EXPECT_LOAD_ERROR(parseSceneFile(missing), missing, "", "not found");
+  // A key repeated with the same value says nothing new: read once.
+  const std::string same = dir.write("same.yaml", replaced("checks:", "checks: [self, environment]\nchecks:"));
+  EXPECT_TRUE(parseSceneFile(same).effects.environment);
+}
+
+TEST(SceneFile, PackagePathsAreFoldersRelativeToTheSceneFile) {
+  TempDir dir;
+  // Two packages named my_robot: a tetrahedron of size 1 in ws/, of size 2 in other/.
+  dir.write("ws/src/my_robot/package.xml", "<package><name>my_robot</name></package>");
+  dir.write("ws/src/my_robot/meshes/tet.stl", test::tetrahedronStl());
+  std::string big = test::tetrahedronStl();
+  for (std::size_t at = 0; (at = big.find("1", at)) != std::string::npos; ++at) big[at] = '2';
+  dir.write("other/my_robot/meshes/tet.stl", big);
+  const std::string urdf = dir.write("robot/r.urdf", R"(<robot name="r">
+    <link name="a"><collision><geometry><sphere radius="0.1"/></geometry></collision></link>
+    <link name="b"><collision><origin xyz="3 0 0"/><geometry><mesh filename="package://my_robot/meshes/tet.stl"/></geometry></collision></link>
+    <joint name="j" type="continuous"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/></joint>
+  </robot>)");
+  const std::string scene_text = "format: 1\npackage_paths: [../ws]\nrobot:\n  urdf: ../robot/r.urdf\n  group: [j]\n"
+                                 "checks: [self]\n";
+  const std::string path = dir.write("scenes/s.yaml", scene_text);
+
+  // Only the paths given here: ROS_PACKAGE_PATH and AMENT_PREFIX_PATH are out of the way.
+  const char* old_ros = std::getenv("ROS_PACKAGE_PATH");
+  const char* old_ament = std::getenv("AMENT_PREFIX_PATH");
+  const std::string saved_ros = old_ros ? old_ros : "", saved_ament = old_ament ? old_ament : "";
+  ::unsetenv("ROS_PACKAGE_PATH");
+  ::unsetenv("AMENT_PREFIX_PATH");
+
+  const SceneDescription d = parseSceneFile(path);
+  EXPECT_EQ(d.package_paths, std::vector<std::string>{dir.path("ws")});
+  auto meshSize = [](const Scene& scene) {
+    double size = 0.0;
+    for (const Vec3& v : scene.robot().meshes().at(0).vertices) size = std::max(size, v.maxCoeff());
+    return size;
+  };
+  EXPECT_DOUBLE_EQ(meshSize(*Scene::load(path)), 1.0);
+  // The caller's folders come first.
+  SceneOptions options;
+  options.load.package_paths = {dir.path("other")};
+  EXPECT_DOUBLE_EQ(meshSize(*Scene::load(path, options)), 2.0);
+
+  // Without the key the package is not found.
+  std::string without = scene_text;
+  without.erase(without.find("package_paths: [../ws]\n"), std::string("package_paths: [../ws]\n").size());
+  const std::string bare = dir.write("scenes/bare.yaml", without);
+  EXPECT_LOAD_ERROR(Scene::load(bare), urdf, "link 'b' <collision>", "unresolved package://my_robot");
+
+  std::string missing = scene_text;
+  missing.replace(missing.find("[../ws]"), 7, "[../ws, ../nowhere]");
+  const std::string bad = dir.write("scenes/bad.yaml", missing);
+  EXPECT_LOAD_ERROR(parseSceneFile(bad), bad, "key 'package_paths[1]'", "folder not found");
+  std::string scalar = scene_text;
+  scalar.replace(scalar.find("[../ws]"), 7, "../ws");
+  const std::string not_list = dir.write("scenes/scalar.yaml", scalar);
+  EXPECT_LOAD_ERROR(parseSceneFile(not_list), not_list, "key 'package_paths'", "expected a list of folders");
+
+  if (old_ros) ::setenv("ROS_PACKAGE_PATH", saved_ros.c_str(), 1);
+  if (old_ament) ::setenv("AMENT_PREFIX_PATH", saved_ament.c_str(), 1);
 }
 
 TEST(Scene, BadRobotReferencesNameTheKey) {

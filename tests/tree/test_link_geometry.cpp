@@ -249,6 +249,20 @@ TEST(LinkGeometry, HullCacheCarriesTheSeparatingAxis) {
 
 // ---- Construction -----------------------------------------------------------------------------------------
 
+TEST(LinkGeometry, SubnormalPrimitivesDoNotBreakTheHull) {
+  // A sphere of radius 1e-310 (as a URDF once gave; the loader now refuses it) made the hull builder
+  // read the first of no kept vertices. Whatever the hull is, it must be built and hold the shape.
+  for (const double r : {1e-310, 1e-320, 1e-300}) {
+    for (const Shape& shape : {Shape(Sphere(r)), Shape(Cylinder(r, r)), Shape(Capsule(r, r)), Shape(Box(Vec3::Constant(r)))}) {
+      std::vector<CollisionElement> elements(1);
+      elements[0].primitive = shape;
+      const LinkGeometry g(elements, {});
+      EXPECT_GE(g.hull().support(Vec3::UnitX()).x(), 0.0) << r;
+      EXPECT_LE(g.hull().support(-Vec3::UnitX()).x(), 0.0) << r;
+    }
+  }
+}
+
 TEST(LinkGeometry, BuildsFromCollisionElements) {
   const std::vector<TriangleMesh> meshes{tree_ref::uvSphere(0.1, 6, 8), tree_ref::gridBox(Vec3(0.1, 0.2, 0.3), 1)};
   std::vector<CollisionElement> elements(3);

@@ -16,13 +16,20 @@ struct TriangleMesh {
   std::vector<std::array<std::int32_t, 3>> triangles;
 };
 
+/// How mesh files are read.
+struct MeshOptions {
+  /// COLLADA: rotate the mesh so that the file's <up_axis> becomes z. Off by default, to load meshes as
+  /// ROS does (RViz, MoveIt): the coordinates as written, in the file's <unit>.
+  bool honour_up_axis = false;
+};
+
 /// Loads every mesh of a file through assimp (STL binary and ASCII, COLLADA, OBJ and any other format
 /// assimp reads) into one TriangleMesh:
 ///  - node transforms are applied and all meshes of the scene are merged; vertices at identical
 ///    positions are joined (within and across meshes), so shared edges are shared in the index list;
-///  - COLLADA (.dae, .zae): the <unit> is honoured, and the <up_axis> too: the result is z-up whatever
-///    the file declares (a Y_UP file is rotated so that its y becomes z). RViz and MoveIt ignore
-///    <up_axis>; a file that is not Z_UP gets a warning saying so;
+///  - COLLADA (.dae, .zae): the <unit> is honoured; the <up_axis> is ignored as ROS, RViz and MoveIt
+///    ignore it (the coordinates are the link's), unless options.honour_up_axis (then a Y_UP file is
+///    rotated so that its y becomes z); a file that is not Z_UP gets a warning saying which was done;
 ///  - then each vertex is multiplied componentwise by scale (the URDF <mesh scale>);
 ///  - zero-area triangles (two equal corners, or a height below 1e-12 of the longest edge) are dropped
 ///    with a warning; points and lines in the file are ignored with a warning;
@@ -30,7 +37,8 @@ struct TriangleMesh {
 ///    two triangles) and for a mesh whose largest extent exceeds 10 m (probably millimetres).
 /// Throws LoadError for a missing file, a format assimp cannot read, a mesh without triangles, a
 /// non-finite scale or a non-finite coordinate.
-TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<std::string>* warnings = nullptr);
+TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<std::string>* warnings = nullptr,
+                      const MeshOptions& options = {});
 
 /// True when every edge of the mesh is shared by exactly two triangles (a closed surface).
 bool isClosed(const TriangleMesh& mesh);

@@ -124,6 +124,9 @@ struct MotionOptions {
   int max_queries = 200000;
   /// Sampled: the largest step between checked states, in the state's Euclidean norm.
   double resolution = 0.01;
+  /// Sampled: cap on states per segment; a segment needing more is reported as a collision (capped),
+  /// never free (a resolution of 1e-9 once overflowed the step count and called a colliding segment free).
+  int max_samples = 1000000;
 };
 
 /// The verdict on a segment.

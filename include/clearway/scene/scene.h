@@ -6,6 +6,7 @@
 // thread (or through the convenience overloads, which keep one per thread themselves).
 #include <clearway/environment/environment.h>
 #include <clearway/kinematics/robot_model.h>
+#include <clearway/load/robot_loader.h>
 #include <clearway/scene/collision_filter.h>
 #include <clearway/scene/self_collision.h>
 
@@ -58,6 +59,9 @@ struct SceneDescription {
   std::string file;  ///< the scene file ("" for one built in code); errors name it
   std::string name;
   std::string urdf, srdf;
+  /// Folders searched for the robot's package:// meshes (the file's `package_paths:`, absolute), after
+  /// those the caller gives and before ROS_PACKAGE_PATH and AMENT_PREFIX_PATH.
+  std::vector<std::string> package_paths;
   std::vector<std::string> group;                          ///< planned joints, in state order
   std::vector<std::pair<std::string, double>> hold;        ///< other one-variable joints, fixed
   /// Narrower limits for group variables, by variable name ("base/x"): planar and floating joints have
@@ -85,15 +89,20 @@ struct SceneDescription {
 /// unknown check, or a file that is missing or not YAML.
 SceneDescription parseSceneFile(const std::string& path);
 
-/// The robot a description names (URDF, SRDF, meshes → trees and hulls). Throws LoadError.
-std::shared_ptr<const RobotGeometry> loadRobotGeometry(const SceneDescription& description);
-/// The environment a description names (obstacles, meshes, OctoMap). Throws LoadError.
-std::shared_ptr<const Environment> loadEnvironment(const SceneDescription& description);
+/// The robot a description names (URDF, SRDF, meshes → trees and hulls); options.package_paths are
+/// searched before the description's. Throws LoadError.
+std::shared_ptr<const RobotGeometry> loadRobotGeometry(const SceneDescription& description,
+                                                       const LoadOptions& options = {});
+/// The environment a description names (obstacles, meshes read with options.mesh, OctoMap). Throws LoadError.
+std::shared_ptr<const Environment> loadEnvironment(const SceneDescription& description, const LoadOptions& options = {});
 
 /// How a scene checks geometry (not part of the scene file: a choice of the caller).
 struct SceneOptions {
   GeometryMode mode = GeometryMode::Mesh;
   Tolerances tolerances;
+  /// How robot and mesh files are read (package:// folders searched before the scene file's own; the
+  /// COLLADA up axis).
+  LoadOptions load;
 };
 
 class Scene {

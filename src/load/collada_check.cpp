@@ -1,0 +1,203 @@
+#include "load/collada_check.h"
+
+#include <clearway/load/load_error.h>
+
+#include <tinyxml2.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <unordered_map>
+#include <vector>
+
+namespace clearway::detail {
+namespace {
+
+using tinyxml2::XMLElement;
+
+// The node hierarchy assimp builds, instances expanded: its recursion depth and its size.
+constexpr int kMaxNodeDepth = 256;
+constexpr std::int64_t kMaxExpandedNodes = 100000;
+
+std::string where(const XMLElement* e) { return "<" + std::string(e->Name()) + "> (line " + std::to_string(e->GetLineNum()) + ")"; }
+
+class Checker {
+ public:
+  Checker(std::string path, std::uint64_t file_size) : path_(std::move(path)), file_size_(file_size) {}
+
+  [[noreturn]] void fail(const XMLElement* e, const std::string& reason) const { throw LoadError(path_, where(e), reason); }
+
+  // Every element, depth first (tinyxml2 bounds the depth), with the checks that need one element.
+  void visit(const XMLElement* e) {
+    const std::string name = e->Name();
+    if (name == "p" || name == "vcount" || name == "v" || name == "h" || name == "int_array") tokens(e, true);
+    if (name == "float_array") tokens(e, false);
+    for (const char* attribute : {"count", "stride", "offset"}) wholeNumber(e, attribute);
+    if (const char* id = e->Attribute("id")) ids_.emplace(id, e);
+    if (name == "node") {
+      nodes_.push_back(e);
+      if (const char* n = e->Attribute("name")) names_.emplace(n, e);
+    }
+    if (name == "accessor") accessors_.push_back(e);
+    for (const XMLElement* c = e->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) visit(c);
+  }
+
+  // Accessors within their arrays: assimp reads offset + index·stride unchecked.
+  void checkAccessors() const {
+    for (const XMLElement* a : accessors_) {
+      const char* source = a->Attribute("source");
+      if (source == nullptr || source[0] != '#') fail(a, "an accessor needs source=\"#ARRAY\"");
+      const auto it = ids_.find(source + 1);
+      if (it == ids_.end()) fail(a, std::string("source '") + source + "' names no element");
+      const std::uint64_t count = wholeNumber(a, "count"), stride = std::max<std::uint64_t>(1, wholeNumber(a, "stride", 1)),
+                          offset = wholeNumber(a, "offset");
+      std::uint64_t params = 0;
+      for (const XMLElement* p = a->FirstChildElement("param"); p != nullptr; p = p->NextSiblingElement("param")) ++params;
+      const std::uint64_t length = countTokens(it->second);
+      // Each of these is at most the file size (wholeNumber), so the sum cannot overflow 64 bits.
+      const std::uint64_t needed = offset + (count - 1) * stride + params;
+      if (count > 0 && params > 0 && needed > length)
+        fail(a, "reaches value " + std::to_string(needed) + " of '" + (source + 1) + "', which holds " +
+                    std::to_string(length));
+    }
+  }
+
+  // No cycle through <instance_node>, and a bounded hierarchy once instances are expanded.
+  void checkNodes() {
+    for (const XMLElement* n : nodes_) expand(n, 1);
+  }
+
+ private:
+  struct Expanded {
+    int state = 0;  // 0 unseen, 1 on the current path, 2 done
+    int depth = 0;
+    std::int64_t size = 0;
+  };
+
+  // The node a url="#X" names: the one with id X, else the one named X (assimp's own fallback); null
+  // when none (assimp skips it).
+  const XMLElement* target(const XMLElement* instance) const {
+    const char* url = instance->Attribute("url");
+    if (url == nullptr || url[0] != '#') return nullptr;
+    const auto by_id = ids_.find(url + 1);
+    if (by_id != ids_.end() && std::strcmp(by_id->second->Name(), "node") == 0) return by_id->second;
+    const auto by_name = names_.find(url + 1);
+    return by_name != names_.end() ? by_name->second : nullptr;
+  }
+
+  const Expanded& expand(const XMLElement* node, int level) {
+    Expanded& x = expanded_[node];
+    if (x.state == 2) return x;
+    if (x.state == 1) fail(node, "the node contains itself through <instance_node>: its hierarchy never ends");
+    if (level > kMaxNodeDepth)
+      fail(node, "nodes nested deeper than " + std::to_string(kMaxNodeDepth) + " levels (instances expanded)");
+    x.state = 1;
+    int depth = 0;
+    std::int64_t size = 1;
+    for (const XMLElement* c = node->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) {
+      const XMLElement* child = std::strcmp(c->Name(), "node") == 0            ? c
+                                : std::strcmp(c->Name(), "instance_node") == 0 ? target(c)
+                                                                               : nullptr;
+      if (child == nullptr) continue;
+      const Expanded& e = expand(child, level + 1);
+      depth = std::max(depth, e.depth);
+      size = std::min(kMaxExpandedNodes + 1, size + e.size);
+    }
+    Expanded& done = expanded_[node];  // the map may have grown
+    done = {2, depth + 1, size};
+    if (size > kMaxExpandedNodes)
+      fail(node, "more than " + std::to_string(kMaxExpandedNodes) + " nodes once <instance_node> is expanded");
+    if (done.depth + level - 1 > kMaxNodeDepth)
+      fail(node, "nodes nested deeper than " + std::to_string(kMaxNodeDepth) + " levels (instances expanded)");
+    return done;
+  }
+
+  // A count-like attribute: absent → fallback; else a whole number no larger than the file.
+  std::uint64_t wholeNumber(const XMLElement* e, const char* attribute, std::uint64_t fallback = 0) const {
+    const char* text = e->Attribute(attribute);
+    if (text == nullptr) return fallback;
+    const char* p = text;
+    while (std::isspace(static_cast<unsigned char>(*p))) ++p;
+    if (!std::isdigit(static_cast<unsigned char>(*p)))
+      fail(e, std::string(attribute) + "=\"" + text + "\" is not a whole number");
+    errno = 0;
+    char* end = nullptr;
+    const unsigned long long v = std::strtoull(p, &end, 10);
+    while (std::isspace(static_cast<unsigned char>(*end))) ++end;
+    if (*end != '\0') fail(e, std::string(attribute) + "=\"" + text + "\" is not a whole number");
+    if (errno == ERANGE || v > file_size_)
+      fail(e, std::string(attribute) + "=\"" + text + "\" exceeds the size of the file (" + std::to_string(file_size_) +
+                  " bytes)");
+    return v;
+  }
+
+  // Whitespace-separated integers (integers = true) or numbers in the element's text.
+  void tokens(const XMLElement* e, bool integers) const {
+    const char* p = e->GetText();
+    if (p == nullptr) return;
+    while (*p != '\0') {
+      while (std::isspace(static_cast<unsigned char>(*p))) ++p;
+      if (*p == '\0') break;
+      const char* start = p;
+      while (*p != '\0' && !std::isspace(static_cast<unsigned char>(*p))) ++p;
+      const std::string token(start, p);
+      bool ok = false;
+      if (integers) {
+        std::size_t i = token[0] == '-' || token[0] == '+' ? 1 : 0;
+        ok = i < token.size() && std::all_of(token.begin() + static_cast<std::ptrdiff_t>(i), token.end(),
+                                             [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
+      } else {
+        char* end = nullptr;
+        std::strtod(token.c_str(), &end);
+        ok = end != token.c_str() && *end == '\0';
+      }
+      if (!ok)
+        fail(e, "'" + token.substr(0, 40) + "' is not " + (integers ? "an integer" : "a number") +
+                    " (assimp would never finish reading this list)");
+    }
+  }
+
+  std::uint64_t countTokens(const XMLElement* e) const {
+    const char* p = e->GetText();
+    std::uint64_t n = 0;
+    for (bool in_token = false; p != nullptr && *p != '\0'; ++p) {
+      const bool space = std::isspace(static_cast<unsigned char>(*p));
+      if (!space && !in_token) ++n;
+      in_token = !space;
+    }
+    return n;
+  }
+
+  std::string path_;
+  std::uint64_t file_size_;
+  std::unordered_map<std::string, const XMLElement*> ids_, names_;
+  std::vector<const XMLElement*> nodes_, accessors_;
+  std::unordered_map<const XMLElement*, Expanded> expanded_;
+};
+
+}  // namespace
+
+void checkCollada(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw LoadError(path, "", "cannot open the file");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const std::string text = buffer.str();
+  tinyxml2::XMLDocument doc;
+  if (doc.Parse(text.c_str(), text.size()) != tinyxml2::XML_SUCCESS)
+    throw LoadError(path, "line " + std::to_string(doc.ErrorLineNum()), std::string("malformed XML: ") + doc.ErrorStr());
+  const XMLElement* root = doc.RootElement();
+  if (root == nullptr || std::strcmp(root->Name(), "COLLADA") != 0)
+    throw LoadError(path, "", "not a COLLADA file: the root element is not <COLLADA>");
+  Checker checker(path, text.size());
+  checker.visit(root);
+  checker.checkAccessors();
+  checker.checkNodes();
+}
+
+}  // namespace clearway::detail
