@@ -18,8 +18,8 @@
 // Usage: bench_tree [--quick] [--shared DIR]     (DIR defaults to CLEARWAY_SHARED_DIR, ../shared)
 #include <clearway/kinematics/forward_kinematics.h>
 #include <clearway/load/robot_loader.h>
-#include <clearway/load/triangle_mesh.h>
-#include <clearway/shape/link_geometry.h>
+#include <clearway/load/mesh_loader.h>
+#include <clearway/body/link_geometry.h>
 
 #include <algorithm>
 #include <cstdio>

@@ -9,7 +9,7 @@
 #include "scene_commands.h"
 
 #ifdef CLEARWAY_HAVE_BENCH_SUITES
-#include "../../benchmarks/suites.h"
+#include "suites.h"  // (the clearway_bench_suites library)
 #endif
 
 #include <algorithm>

@@ -4,7 +4,7 @@
 // choices beyond triangulation.
 #include <clearway/load/input_limits.h>
 #include <clearway/load/load_error.h>
-#include <clearway/load/triangle_mesh.h>
+#include <clearway/load/mesh_loader.h>
 
 #include "load/collada_check.h"
 
@@ -301,7 +301,7 @@ TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<st
   countBadEdges(mesh, &open, &non_manifold);
   if (open > 0 || non_manifold > 0)
     warn("not closed (" + std::to_string(open) + " edges with one triangle, " + std::to_string(non_manifold) +
-         " with more than two): its inside is not well defined");
+         " with more than two): a piece with an edge of one triangle is a surface, not a solid (a body wholly inside it does not collide)");
 
   Vec3 lo = mesh.vertices[0], hi = mesh.vertices[0];
   for (const Vec3& v : mesh.vertices) {

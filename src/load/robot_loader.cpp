@@ -4,7 +4,7 @@
 // file and the element.
 #include <clearway/load/robot_loader.h>
 
-#include <clearway/load/triangle_mesh.h>
+#include <clearway/load/mesh_loader.h>
 
 #include "load/mesh_uri.h"
 #include "load/urdf_outline.h"

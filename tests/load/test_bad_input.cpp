@@ -1,7 +1,7 @@
 // loadRobot on bad input: each problem a user can make in a URDF, an SRDF or a mesh is a LoadError that
 // names the file, the element (with its line) and the reason.
 #include <clearway/load/robot_loader.h>
-#include <clearway/load/triangle_mesh.h>
+#include <clearway/load/mesh_loader.h>
 
 #include "load/robot_files.h"
 

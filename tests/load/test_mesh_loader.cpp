@@ -1,7 +1,7 @@
 // loadMesh: every format robots use (STL ASCII and binary, OBJ, COLLADA with unit and up axis), the
 // node hierarchy, scale, welding, the warnings (zero-area, not closed, millimetres, up axis) and the
 // errors (missing, unsupported, empty, non-finite).
-#include <clearway/load/triangle_mesh.h>
+#include <clearway/load/mesh_loader.h>
 
 #include "load/robot_files.h"
 

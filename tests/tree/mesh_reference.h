@@ -10,7 +10,7 @@
 //                distances to the plane and the crossing point's distances to the triangle's edges).
 // Pairs of meshes are classified robustly colliding, robustly free, or within the band (ambiguous).
 // Also: generators of closed test meshes (UV spheres, tori, subdivided boxes and thin plates).
-#include <clearway/load/triangle_mesh.h>
+#include <clearway/shape/triangle_mesh.h>
 #include <clearway/math.h>
 #include <clearway/tree/aabb.h>
 

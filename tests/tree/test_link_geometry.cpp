@@ -1,8 +1,8 @@
 // LinkGeometry: Mesh mode against brute force over all triangle pairs (tests/tree/mesh_reference.h, no
 // tree, SAT or GJK in it) on random poses of generated meshes and of the Panda's link meshes; Hull mode
 // never "free" where Mesh says "collision"; padding; touching; primitives; distances.
-#include <clearway/load/triangle_mesh.h>
-#include <clearway/shape/link_geometry.h>
+#include <clearway/load/mesh_loader.h>
+#include <clearway/body/link_geometry.h>
 
 #include <gtest/gtest.h>
 

@@ -4,10 +4,10 @@
 // occupied, by choice). Everything sits in AABB trees in the world frame, so a link is tested only
 // against the obstacles and voxels its bounds can touch, then exactly (shape/link_geometry.h).
 #include <clearway/load/load_error.h>
-#include <clearway/load/triangle_mesh.h>
+#include <clearway/shape/triangle_mesh.h>
 #include <clearway/math.h>
 #include <clearway/narrowphase/gjk.h>
-#include <clearway/shape/link_geometry.h>
+#include <clearway/body/link_geometry.h>
 #include <clearway/shape/shape.h>
 #include <clearway/tolerances.h>
 #include <clearway/tree/aabb_tree.h>

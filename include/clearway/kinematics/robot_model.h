@@ -3,7 +3,7 @@
 // topological order (root first), the joints between them, each link's collision elements, and the
 // link pairs a user has declared never to check. Built once by loadRobot (or by hand in tests), then
 // shared read-only by every query and thread.
-#include <clearway/load/triangle_mesh.h>
+#include <clearway/shape/triangle_mesh.h>
 #include <clearway/math.h>
 #include <clearway/shape/shape.h>
 

@@ -4,7 +4,7 @@
 // RobotModel::loadWarnings() in the same form for the caller to print.
 #include <clearway/kinematics/robot_model.h>
 #include <clearway/load/load_error.h>
-#include <clearway/load/triangle_mesh.h>
+#include <clearway/load/mesh_loader.h>
 
 #include <string>
 #include <vector>

@@ -1,37 +1,17 @@
 #pragma once
 // Self-collision of a robot: every checked link pair (scene/collision_filter.h) tested with the link
-// geometries of shape/link_geometry.h at the link poses of one configuration. The checker is
+// geometries of body/robot_geometry.h at the link poses of one configuration. The checker is
 // immutable and shared by all threads; what changes from query to query (the separating axis of each
 // pair's hulls, the pair that collided last) lives in a SelfCollisionContext, one per thread.
 #include <clearway/kinematics/robot_model.h>
 #include <clearway/scene/collision_filter.h>
-#include <clearway/shape/link_geometry.h>
+#include <clearway/body/robot_geometry.h>
 #include <clearway/tolerances.h>
 
 #include <memory>
 #include <vector>
 
 namespace clearway {
-
-/// The collision geometry of every link of a robot (null for links without geometry). Immutable.
-class RobotGeometry {
- public:
-  /// Builds each link's trees and hull from the model's collision elements. Throws ShapeError naming
-  /// the link when its geometry is unusable.
-  explicit RobotGeometry(std::shared_ptr<const RobotModel> model, const TreeBuildOptions& options = {});
-
-  const RobotModel& model() const noexcept { return *model_; }
-  const std::shared_ptr<const RobotModel>& modelPtr() const noexcept { return model_; }
-  /// Link i's geometry, or null when the link has no collision element.
-  const LinkGeometry* link(int i) const noexcept { return links_[i].get(); }
-  /// Links that have geometry, in link order.
-  const std::vector<int>& geometricLinks() const noexcept { return geometric_; }
-
- private:
-  std::shared_ptr<const RobotModel> model_;
-  std::vector<std::unique_ptr<const LinkGeometry>> links_;
-  std::vector<int> geometric_;
-};
 
 /// Two links of one robot, a < b.
 struct LinkPair {

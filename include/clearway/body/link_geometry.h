@@ -14,7 +14,7 @@
 //
 // Every query answers in the frames of the poses given; a LinkGeometry itself is in the link frame.
 #include <clearway/kinematics/robot_model.h>
-#include <clearway/load/triangle_mesh.h>
+#include <clearway/shape/triangle_mesh.h>
 #include <clearway/narrowphase/gjk.h>
 #include <clearway/shape/convex_hull.h>
 #include <clearway/shape/shape.h>

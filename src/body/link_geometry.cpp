@@ -7,7 +7,7 @@
 // scale bounding every coordinate of the pair in A's frame. Box tests and the triangle SAT only
 // discard pairs certainly farther apart than slack (the band dwarfs their rounding); what they keep,
 // GJK decides within its own band, which is at most this one.
-#include <clearway/shape/link_geometry.h>
+#include <clearway/body/link_geometry.h>
 
 #include <algorithm>
 #include <array>

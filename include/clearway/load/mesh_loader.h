@@ -1,7 +1,7 @@
 #pragma once
 // Triangle meshes as the rest of Clearway sees them: one indexed triangle list per file, in metres,
 // in the frame the URDF expects (z up), whatever format, unit and node hierarchy the file used.
-#include <clearway/math.h>
+#include <clearway/shape/triangle_mesh.h>
 
 #include <array>
 #include <cstdint>
@@ -9,12 +9,6 @@
 #include <vector>
 
 namespace clearway {
-
-/// An indexed triangle mesh: vertices (no duplicates) and triangles indexing them.
-struct TriangleMesh {
-  std::vector<Vec3> vertices;
-  std::vector<std::array<std::int32_t, 3>> triangles;
-};
 
 /// How mesh files are read.
 struct MeshOptions {

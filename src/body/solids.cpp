@@ -5,7 +5,7 @@
 // passes within rounding of an edge, a vertex or a triangle's plane could count a crossing twice or not at
 // all: such a ray is dropped and the next of a fixed set of directions is tried; when all are dropped, the
 // point counts as inside (never "outside" by accident).
-#include <clearway/shape/link_geometry.h>
+#include <clearway/body/link_geometry.h>
 
 #include <algorithm>
 #include <cmath>

@@ -1,0 +1,31 @@
+#pragma once
+// A robot's bodies: the collision geometry of each of its links, built once from its model.
+#include <clearway/body/link_geometry.h>
+#include <clearway/kinematics/robot_model.h>
+
+#include <memory>
+#include <vector>
+
+namespace clearway {
+
+/// The collision geometry of every link of a robot (null for links without geometry). Immutable.
+class RobotGeometry {
+ public:
+  /// Builds each link's trees and hull from the model's collision elements. Throws ShapeError naming
+  /// the link when its geometry is unusable.
+  explicit RobotGeometry(std::shared_ptr<const RobotModel> model, const TreeBuildOptions& options = {});
+
+  const RobotModel& model() const noexcept { return *model_; }
+  const std::shared_ptr<const RobotModel>& modelPtr() const noexcept { return model_; }
+  /// Link i's geometry, or null when the link has no collision element.
+  const LinkGeometry* link(int i) const noexcept { return links_[i].get(); }
+  /// Links that have geometry, in link order.
+  const std::vector<int>& geometricLinks() const noexcept { return geometric_; }
+
+ private:
+  std::shared_ptr<const RobotModel> model_;
+  std::vector<std::unique_ptr<const LinkGeometry>> links_;
+  std::vector<int> geometric_;
+};
+
+}  // namespace clearway

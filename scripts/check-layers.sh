@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# The layering check: every folder of include/clearway/ and src/ is a pipeline stage, and a stage may
+# include only itself and the stages before it. Reads every `#include <clearway/STAGE/...>` (and the
+# plugin's and tool's) and fails, naming file, line and both stages, when one points up the pipeline or
+# names a stage not listed here. Headers at include/clearway/ itself (math.h, tolerances.h) and detail/
+# are below every stage.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+# The pipeline, from the bottom up: the one place its order is written.
+stages=(detail shape narrowphase tree kinematics load body environment scene motion ompl cli)
+
+rank() {
+  local i
+  for i in "${!stages[@]}"; do
+    if [ "${stages[$i]}" = "$1" ]; then echo "$i"; return; fi
+  done
+  echo -1
+}
+
+# The stage a file belongs to, from its path.
+stageOf() {
+  case "$1" in
+    include/clearway/*/*) local rest=${1#include/clearway/}; echo "${rest%%/*}" ;;
+    include/clearway/*) echo "-" ;;
+    src/*/*) local rest=${1#src/}; echo "${rest%%/*}" ;;
+    plugins/ompl/*) echo ompl ;;
+    *) echo "?" ;;
+  esac
+}
+
+status=0
+checked=0
+while IFS= read -r file; do
+  from=$(stageOf "$file")
+  [ "$from" = "-" ] && from_rank=-1 || from_rank=$(rank "$from")
+  if [ "$from" != "-" ] && [ "$from_rank" -lt 0 ]; then
+    echo "check-layers: $file: its folder '$from' is not a stage (add it to the list in $0)"
+    status=1
+    continue
+  fi
+  while IFS=: read -r line target; do
+    to=${target#*clearway/}
+    case "$to" in */*) to=${to%%/*} ;; *) continue ;; esac  # (math.h, tolerances.h: below every stage)
+    to_rank=$(rank "$to")
+    checked=$((checked + 1))
+    if [ "$to_rank" -lt 0 ]; then
+      echo "check-layers: $file:$line: includes stage '$to', which is not in the list"
+      status=1
+    elif [ "$to_rank" -gt "$from_rank" ]; then
+      echo "check-layers: $file:$line: stage '$from' includes '$to', which comes after it in the pipeline"
+      status=1
+    fi
+  done < <(grep -noE '^[[:space:]]*#[[:space:]]*include[[:space:]]*[<"]clearway/[^>"]+' "$file" | sed -E 's/:[^<"]*[<"]/:/')
+  # Relative includes that leave the file's own stage (../) bypass the check: refuse them.
+  if grep -nE '^[[:space:]]*#[[:space:]]*include[[:space:]]*"\.\./' "$file" >/dev/null; then
+    echo "check-layers: $file: a relative include leaves its stage: $(grep -nE '#[[:space:]]*include[[:space:]]*"\.\./' "$file" | head -n 1)"
+    status=1
+  fi
+done < <(find include/clearway src plugins/ompl -type f \( -name '*.h' -o -name '*.cpp' \) | sort)
+
+if [ $status -eq 0 ]; then
+  echo "check-layers: $checked includes, all down the pipeline (${stages[*]})"
+fi
+exit $status

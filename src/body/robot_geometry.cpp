@@ -1,0 +1,24 @@
+#include <clearway/body/robot_geometry.h>
+
+#include <stdexcept>
+#include <utility>
+
+namespace clearway {
+
+RobotGeometry::RobotGeometry(std::shared_ptr<const RobotModel> model, const TreeBuildOptions& options)
+    : model_(std::move(model)) {
+  if (!model_) throw std::invalid_argument("RobotGeometry: null robot model");
+  links_.resize(model_->linkCount());
+  for (int i = 0; i < model_->linkCount(); ++i) {
+    const Link& link = model_->link(i);
+    if (link.collisions.empty()) continue;
+    try {
+      links_[i] = std::make_unique<const LinkGeometry>(link.collisions, model_->meshes(), options);
+    } catch (const std::exception& e) {
+      throw ShapeError("robot '" + model_->name() + "': link '" + link.name + "': " + e.what());
+    }
+    geometric_.push_back(i);
+  }
+}
+
+}  // namespace clearway
