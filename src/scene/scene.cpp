@@ -14,7 +14,6 @@ namespace clearway {
 
 namespace {
 
-std::atomic<std::uint64_t> g_next_serial{1};
 
 }  // namespace
 
@@ -61,8 +60,7 @@ Scene::Scene(const SceneDescription& description, std::shared_ptr<const RobotGeo
       geometry_(std::move(robot)),
       environment_(environment ? std::move(environment) : std::make_shared<const Environment>()),
       filter_(geometry_->model()),
-      self_(geometry_, filter_),
-      serial_(g_next_serial++) {
+      self_(geometry_, filter_) {
   init();
 }
 
@@ -340,7 +338,7 @@ bool Scene::isFree(const std::vector<double>& state, CollisionReport* report, do
 
 SceneContext& Scene::threadContext() const {
   // Keyed by serial, not address: a new scene at a freed scene's address must not inherit its caches.
-  return detail::perThread<SceneContext>(serial_, [this] { return makeContext(); });
+  return detail::perThread<SceneContext>(scratch_owner_, [this] { return makeContext(); });
 }
 
 double Scene::clearance(const double* state, SceneContext& ctx, double* lower_bound, double t) const noexcept {

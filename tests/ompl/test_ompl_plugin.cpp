@@ -195,6 +195,11 @@ void planAndCertify(const std::function<ob::PlannerPtr(const ob::SpaceInformatio
     EXPECT_TRUE(sampled.check(q0.data(), q1.data(), sc).free) << "segment " << i;
   }
   EXPECT_GT(c.motion->counters().motions.load(), 0u);
+  // OMPL's own counters, as DiscreteMotionValidator keeps them (Planner Arena's "valid segment fraction").
+  EXPECT_GT(c.motion->getValidMotionCount(), 0u);
+  EXPECT_GT(c.motion->getInvalidMotionCount(), 0u);
+  EXPECT_GT(c.motion->getValidMotionFraction(), 0.0);
+  EXPECT_LT(c.motion->getValidMotionFraction(), 1.0);
 }
 
 std::string ourScene(const std::string& name) { return std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/" + name; }

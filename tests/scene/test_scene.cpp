@@ -330,6 +330,22 @@ TEST(Scene, UndeclaredEffectsCostNothing) {
   }
 }
 
+TEST(Scene, ContextsOfDroppedScenesAreReleased) {
+  // A thread that loads, queries and drops one scene after another keeps contexts for the live ones
+  // only (a planner service must not grow without bound).
+  TempDir dir;
+  const std::string file = dir.write("s.yaml", planarScene("[self, environment]"));
+  const auto live = Scene::load(file);
+  live->isFree({M_PI / 2, 0.0});
+  for (int i = 0; i < 1000; ++i) {
+    const auto scene = Scene::load(file);
+    scene->isFree({M_PI / 2, 0.0});
+  }
+  live->isFree({M_PI / 2, 0.0});
+  EXPECT_LE(detail::threadScratch<SceneContext>().size(), 2u);
+  EXPECT_GE(detail::threadScratch<SceneContext>().size(), 1u);
+}
+
 TEST(Scene, ThreadsShareOneScene) {
   TempDir dir;
   const auto scene = Scene::load(dir.write("s.yaml", planarScene()));

@@ -4,6 +4,7 @@
 // `environment` no obstacle or voxel is looked at, without `clearance` no distance is computed, without
 // `moving` there is no time. Immutable once built; queries are thread-safe given one SceneContext per
 // thread (or through the convenience overloads, which keep one per thread themselves).
+#include <clearway/detail/per_thread.h>
 #include <clearway/environment/environment.h>
 #include <clearway/kinematics/robot_model.h>
 #include <clearway/load/robot_loader.h>
@@ -197,7 +198,7 @@ class Scene {
   CollisionReport static_collision_;  // a collision no state can undo (static links), found at construction
   double static_clearance_ = std::numeric_limits<double>::infinity();  // static links to static obstacles
   double static_clearance_lower_ = std::numeric_limits<double>::infinity();
-  std::uint64_t serial_ = 0;  // identifies this scene's per-thread contexts
+  detail::ScratchOwner scratch_owner_;  // identifies this scene's per-thread contexts
 };
 
 }  // namespace clearway

@@ -17,7 +17,6 @@ namespace ob = ompl::base;
 
 namespace {
 
-std::atomic<std::uint64_t> g_next_serial{1};
 
 using detail::perThread;
 
@@ -205,7 +204,7 @@ void StateMap::unwrap(const double* from, double* to) const noexcept {
 // ---- ValidityChecker ----------------------------------------------------------------------------------
 
 ValidityChecker::ValidityChecker(const ob::SpaceInformationPtr& si, std::shared_ptr<const Scene> scene)
-    : ob::StateValidityChecker(si), scene_(std::move(scene)), map_(*scene_), serial_(g_next_serial++) {
+    : ob::StateValidityChecker(si), scene_(std::move(scene)), map_(*scene_) {
   // Honest specs: clearance is an exact distance only when the scene computes it.
   specs_.clearanceComputationType = scene_->effects().clearance ? ob::StateValidityCheckerSpecs::EXACT
                                                                 : ob::StateValidityCheckerSpecs::NONE;
@@ -215,7 +214,7 @@ ValidityChecker::ValidityChecker(const ob::SpaceInformationPtr& si, std::shared_
 bool ValidityChecker::isValid(const ob::State* state) const {
   const Timer timer(counters_.nanoseconds);
   ++counters_.states;
-  ValidityScratch& s = perThread<ValidityScratch>(serial_, [&] {
+  ValidityScratch& s = perThread<ValidityScratch>(scratch_owner_, [&] {
     return ValidityScratch{scene_->makeContext(), std::vector<double>(scene_->dimension())};
   });
   map_.toVector(state, s.q.data());
@@ -224,7 +223,7 @@ bool ValidityChecker::isValid(const ob::State* state) const {
 
 double ValidityChecker::clearance(const ob::State* state) const {
   if (!scene_->effects().clearance) return ob::StateValidityChecker::clearance(state);
-  ValidityScratch& s = perThread<ValidityScratch>(serial_, [&] {
+  ValidityScratch& s = perThread<ValidityScratch>(scratch_owner_, [&] {
     return ValidityScratch{scene_->makeContext(), std::vector<double>(scene_->dimension())};
   });
   map_.toVector(state, s.q.data());
@@ -249,12 +248,12 @@ std::shared_ptr<const Scene> timeless(std::shared_ptr<const Scene> scene) {
 
 ContinuousMotionValidator::ContinuousMotionValidator(const ob::SpaceInformationPtr& si,
                                                      std::shared_ptr<const Scene> scene, MotionOptions options)
-    : ob::MotionValidator(si), checker_(timeless(scene), options), map_(*scene), serial_(g_next_serial++) {}
+    : ob::MotionValidator(si), checker_(timeless(scene), options), map_(*scene) {}
 
 MotionResult ContinuousMotionValidator::check(const ob::State* s1, const ob::State* s2, bool locate_contact) const {
   const Timer timer(counters_.nanoseconds);
   ++counters_.motions;
-  MotionScratch& s = perThread<MotionScratch>(serial_, [&] {
+  MotionScratch& s = perThread<MotionScratch>(scratch_owner_, [&] {
     const int n = checker_.scene().dimension();
     return MotionScratch{checker_.makeContext(), std::vector<double>(n), std::vector<double>(n)};
   });
@@ -264,15 +263,21 @@ MotionResult ContinuousMotionValidator::check(const ob::State* s1, const ob::Sta
   return checker_.check(s.q0.data(), s.q1.data(), s.ctx, locate_contact);
 }
 
+void ContinuousMotionValidator::count(bool free) const {
+  const std::lock_guard<std::mutex> lock(ompl_counters_);
+  ++(free ? valid_ : invalid_);
+}
+
 bool ContinuousMotionValidator::checkMotion(const ob::State* s1, const ob::State* s2) const {
   const bool free = check(s1, s2, /*locate_contact=*/false).free;
-  // OMPL's own counters are plain integers; they are kept for its tools, but ours are the reliable ones.
+  count(free);
   return free;
 }
 
 bool ContinuousMotionValidator::checkMotion(const ob::State* s1, const ob::State* s2,
                                             std::pair<ob::State*, double>& lastValid) const {
   const MotionResult r = check(s1, s2);
+  count(r.free);
   if (r.free) return true;
   lastValid.second = r.last_valid;
   // The state space interpolates exactly as the checker did (linear; SO(2) the short way), so the

@@ -15,6 +15,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 
 namespace clearway {
 
@@ -66,7 +67,7 @@ class ValidityChecker : public ompl::base::StateValidityChecker {
  private:
   std::shared_ptr<const Scene> scene_;
   StateMap map_;
-  std::uint64_t serial_;
+  detail::ScratchOwner scratch_owner_;  // identifies its per-thread scratch
   mutable CheckerCounters counters_;
 };
 
@@ -88,8 +89,12 @@ class ContinuousMotionValidator : public ompl::base::MotionValidator {
  private:
   MotionChecker checker_;
   StateMap map_;
-  std::uint64_t serial_;
+  detail::ScratchOwner scratch_owner_;  // identifies its per-thread scratch
   mutable CheckerCounters counters_;
+  // OMPL's valid_ and invalid_ are plain integers that its benchmark tools read once planning is done;
+  // parallel planners call checkMotion from several threads, so each update takes this lock.
+  mutable std::mutex ompl_counters_;
+  void count(bool free) const;
 };
 
 /// Installs a ValidityChecker and a ContinuousMotionValidator on si (whose space must be
