@@ -71,7 +71,7 @@ class MotionBound {
   double linkCoefficient(int link, int v) const noexcept { return link_coef_[link * dim_ + v]; }
 
  private:
-  struct DynamicBound;  // motion.cpp
+  struct DynamicBound;  // motion_bound.cpp
   // Adds to f the joints of link's chain from index `from` on.
   void addDynamic(int link, std::size_t from, const double* dq, const Pose* poses, DynamicBound& f) const noexcept;
 
@@ -144,7 +144,7 @@ struct MotionResult {
   bool capped = false;      ///< the query cap was reached (reported as a collision)
 };
 
-/// Scratch for checkSegment, one per thread (allocates once), made by the checking MotionChecker's makeContext().
+/// Scratch for MotionChecker::check, one per thread (allocates once), made by the checking MotionChecker's makeContext().
 struct MotionContext {
   SceneContext scene;
   std::vector<double> q, dq;
@@ -250,7 +250,7 @@ class MotionChecker {
   void buildItems();
   // The item's motion bound for the step dq.
   double itemBound(const Item& item, const double* dq, double obstacle_motion) const noexcept;
-  struct Sweep;  // motion.cpp
+  struct Sweep;  // certified.cpp
 
   std::shared_ptr<const Scene> scene_;
   MotionOptions options_;

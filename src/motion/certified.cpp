@@ -1,0 +1,567 @@
+// Certified mode: conservative advancement of every item over the segment (see motion.h), with Cast
+// mode's shape casts ahead of it.
+#include <clearway/motion/motion.h>
+
+#include <clearway/kinematics/forward_kinematics.h>
+#include <clearway/narrowphase/gjk.h>
+#include <clearway/narrowphase/ray_cast.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "motion_detail.h"
+
+namespace clearway {
+
+using motion_detail::alignedUnit;
+
+void MotionChecker::castAhead(const double* q0, const double* q1, double t0, int n_items, MotionContext& ctx,
+                              MotionResult& r) const noexcept {
+  const Scene& sc = *scene_;
+  const Tolerances& tol = sc.options().tolerances;
+  const double contact = options_.contact_distance;
+  bool posed = false;
+  for (int k = 0; k < n_items; ++k) {
+    const Item& it = items_[k];
+    if (it.group >= 0) continue;  // its group's coverage decides where it starts
+    const bool self = it.b >= 0;
+    if (!self && ctx.obstacle_motion > 0.0) continue;  // (the cast holds obstacles still, where they are at t0)
+    if (self ? !bound_.translates(it.a, it.b, ctx.dq.data()) : !bound_.translates(it.a, ctx.dq.data())) continue;
+    if (!posed) {  // both ends' poses, once: the end's kept aside, the start's left in the scene context
+      sc.computePoses(q1, ctx.scene);
+      ctx.end_poses = ctx.scene.poses;
+      sc.computePoses(q0, ctx.scene);
+      posed = true;
+    }
+    const std::vector<Pose>& start = ctx.scene.poses;
+    const std::vector<Pose>& end = ctx.end_poses;
+    ++r.distance_queries;
+    double first;  // certified: the grown hulls do not touch before it
+    if (self) {
+      // In b's frame a translates (the rotations on the path do not change): one cast of a's grown hull.
+      const Pose from = relativePose(start[it.frame_b], start[it.frame_a]);
+      const Vec3 shift = relativePose(end[it.frame_b], end[it.frame_a]).t - from.t;
+      const CastResult c = gjkShapeCast(Margin<ConvexHull>{it.ga->hull(), it.padding + contact}, from, shift,
+                                        it.gb->hull(), Pose::identity(), 1.0, tol);
+      first = c.hit ? std::max(0.0, c.t) : 2.0;
+    } else {
+      first = sc.environment().linkCast(*it.ga, start[it.frame_a], end[it.frame_a].t - start[it.frame_a].t,
+                                        it.padding + contact, tol, 1.0, t0, &ctx.scene.counters.environment);
+    }
+    ctx.safe_until[k] = std::min(first, 2.0);
+  }
+}
+
+// One certified check in progress. Each item covers [0, limit] on its own with balls: a clearance d
+// measured at s clears s ± d / B (B the item's motion bound; or the larger reach its axes allow). An
+// interval is measured at its middle, and what the ball leaves uncovered on either side is an interval
+// again, left first; a measurement within contact_distance makes the item step from the interval's left
+// end by conservative advancement to its first contact, which becomes the limit: nothing after it
+// matters to any item. So a free segment costs about one measurement per ball of twice the radius that
+// advancement alone would use, and the first contact is exact all the same.
+struct MotionChecker::Sweep {
+  // A clearance proven beyond the contact distance (the search said "not within it"), in contact distances.
+  static constexpr double kBeyond = 1.0 + 1e-9;
+  // Once the convex bounds are within contact, how far (in contact distances) the exact geometry is
+  // measured: near fine meshes, a search farther out visits a great many triangles.
+  static constexpr double kNear = 8.0;
+
+  const MotionChecker& mc;
+  MotionContext& ctx;
+  MotionResult& r;
+  const double* q0;
+  const double* q1;
+  double t0 = 0.0, t1 = 0.0;  // the times at q0 and q1 (moving obstacles)
+  double limit = 1.0;         // the first contact found so far, or the segment's end
+  bool hit = false;           // a contact at `limit`
+  double clear_before = 0.0;  // a parameter before `limit` the contacting item is certified clear at
+  bool capped = false;
+  int contacts = 0;           // how often the limit was lowered
+  // Only the verdict is asked: the first measurement within contact settles it (it is a contact, if not
+  // the first one), and nothing else is measured.
+  bool verdict_only = false;
+  bool stop() const noexcept { return capped || (verdict_only && hit); }
+  double at_s = -1.0;         // the parameter ctx.scene.q holds
+  // The last measurement's self item whose hulls' GJK axis separates them (splitClearances), −1: none.
+  static constexpr std::size_t kSplit = 8;
+  int split_item = -1;
+  double clear_a[kSplit], clear_b[kSplit];
+
+  Sweep(const MotionChecker& checker, MotionContext& c, MotionResult& result, const double* from, const double* to)
+      : mc(checker), ctx(c), r(result), q0(from), q1(to) {
+    ctx.scene.poses[0] = Pose::identity();
+  }
+
+  // The time at parameter s.
+  double time(double s) const noexcept { return t0 + s * (t1 - t0); }
+
+  // The link's pose (and its ancestors') at parameter s.
+  const Pose& pose(double s, int link) {
+    if (s != at_s) {
+      mc.interpolate(q0, q1, s, ctx.q.data());
+      const std::vector<int>& group = mc.scene_->groupVariables();
+      for (std::size_t i = 0; i < group.size(); ++i) ctx.scene.q[group[i]] = ctx.q[i];
+      ++ctx.step_stamp;
+      ++r.steps;
+      at_s = s;
+    }
+    const RobotModel& model = mc.scene_->robot();
+    Pose* poses = ctx.scene.poses.data();
+    for (int l = link; l > 0 && ctx.pose_stamp[l] != ctx.step_stamp; l = model.parentLink(l)) ctx.pose_path.push_back(l);
+    for (; !ctx.pose_path.empty(); ctx.pose_path.pop_back()) {
+      computeLinkPose(model, ctx.scene.q.data(), poses, ctx.pose_path.back());
+      ctx.pose_stamp[ctx.pose_path.back()] = ctx.step_stamp;
+    }
+    return poses[link];
+  }
+
+  // One item's warm starts, the block of n at `slot` in `all` (none for −1), emptied when this segment
+  // first uses them: a verdict depends on nothing but its segment.
+  SimplexCache* warmStarts(std::vector<SimplexCache>& all, int slot, std::uint64_t& stamp, std::size_t n) {
+    if (slot < 0) return nullptr;
+    SimplexCache* block = all.data() + slot;
+    if (stamp != ctx.segment) {
+      std::fill(block, block + n, SimplexCache{});
+      stamp = ctx.segment;
+    }
+    return block;
+  }
+
+  // Item k's contact distance on this segment.
+  double contactOf(int k) const noexcept {
+    return ctx.contact_stamp[k] == ctx.segment ? ctx.contact[k] : mc.options_.contact_distance;
+  }
+
+  // measure(), and when item k first comes within contact on this segment, its ends' clearances: where the
+  // nearer end is closer than twice the contact distance, the item's contact distance becomes half that
+  // end's clearance (never 0: an end that touches keeps it), and s is measured again. A state the
+  // validity checker accepts can then be left; the loops still end, each ball being at least that wide.
+  double measureItem(int k, double s, double need, CollisionReport& report) {
+    const double d = measure(k, s, need, report);
+    if (!(d <= contactOf(k)) || ctx.contact_stamp[k] == ctx.segment) return d;
+    ctx.contact_stamp[k] = ctx.segment;
+    ctx.contact[k] = mc.options_.contact_distance;
+    const Item& it = mc.items_[k];
+    if (it.last > it.first) return d;  // a group's members decide, each with its own ends
+    const double e0 = endClearance(k, 0.0);
+    const double e = e0 > 0.0 ? std::min(e0, endClearance(k, 1.0)) : 0.0;
+    if (!(e > 0.0) || !(0.5 * e < ctx.contact[k])) return d;
+    ctx.contact[k] = 0.5 * e;
+    return measure(k, s, need, report);
+  }
+
+  // A certified lower bound on item k's clearance at s (padding removed) where it is below the contact
+  // distance; at least the contact distance otherwise. As the scene's geometry mode sees it.
+  double endClearance(int k, double s) {
+    const Scene& sc = *mc.scene_;
+    const Tolerances& tol = sc.options().tolerances;
+    const double relative = mc.options_.distance_relative_error;
+    const Item& it = mc.items_[k];
+    const double cutoff = it.padding + mc.options_.contact_distance;
+    const bool exact = sc.options().mode != GeometryMode::Hull;
+    ++r.distance_queries;
+    if (r.distance_queries >= mc.options_.max_queries) capped = true;
+    const Pose pa = pose(s, it.frame_a);
+    double d;
+    if (it.b >= 0) {
+      const Pose& pb = pose(s, it.frame_b);
+      if (exact) {
+        const DistanceResult m = meshDistance(*it.ga, pa, *it.gb, pb, tol, relative, cutoff);
+        d = isFailure(m.status) ? 0.0 : m.lower_bound;
+      } else {
+        SimplexCache cold;
+        d = gjkLowerBound(it.ga->hull(), pa, it.gb->hull(), pb, tol, cold, cutoff, relative);
+      }
+    } else {
+      EnvironmentCounters* counters = &ctx.scene.counters.environment;
+      if (exact) {
+        const DistanceResult m = sc.environment().linkDistance(*it.ga, pa, tol, cutoff, time(s), relative, counters);
+        d = isFailure(m.status) ? 0.0 : m.lower_bound;
+      } else {
+        d = sc.environment().hullLowerBound(*it.ga, pa, tol, cutoff, relative, time(s), counters);
+      }
+    }
+    return d - it.padding;
+  }
+
+  // A certified lower bound on item k's clearance at s (padding removed), computed only as far as `need`
+  // (beyond it, the answer only has to say so). A contact fills `report`.
+  double measure(int k, double s, double need, CollisionReport& report) {
+    const Scene& sc = *mc.scene_;
+    const Tolerances& tol = sc.options().tolerances;
+    const double contact = contactOf(k), relative = mc.options_.distance_relative_error;
+    // Below the scene's contact distance (an end of the segment is that near), only distances decide: an
+    // intersection test within it would count the narrow phase's band as contact.
+    const bool lowered = contact < mc.options_.contact_distance;
+    const bool exact = sc.options().mode != GeometryMode::Hull;
+    const Item& it = mc.items_[k];
+    const bool head = it.last > it.first;  // a group stops at the merged hulls: its members decide the rest
+    ++r.distance_queries;
+    split_item = -1;
+    need = std::max(need, 2.0 * contact);  // a clearance must exceed the contact distance to count
+    const Pose pa = pose(s, it.frame_a);
+    double d;
+    if (it.b >= 0) {
+      const Pose& pb = pose(s, it.frame_b);
+      const LinkGeometry& a = *it.ga;
+      const LinkGeometry& b = *it.gb;
+      // Ever tighter and dearer lower bounds, each only when the one before falls short of `enough`: the
+      // bounding balls, the hulls (warm-started GJK), the convex parts, and last the triangles.
+      const double enough = need + it.padding;
+      double lower = (pa * a.sphereCenter() - pb * b.sphereCenter()).norm() - a.sphereRadius() - b.sphereRadius();
+      if (!(lower >= enough))  // (the GJK bound first in max(): it is a number even if the balls' is not)
+        lower = std::max(gjkLowerBound(a.hull(), pa, b.hull(), pb, tol, ctx.hull_cache[k], enough, relative), lower);
+      d = lower - it.padding;
+      if (d > contact) split_item = k;  // (the hulls' last GJK axis: this measurement's, or an earlier one's)
+      if (d <= contact && exact && !head) {
+        SimplexCache* caches =
+            warmStarts(ctx.part_cache, ctx.part_slot[k], ctx.part_stamp[k], a.parts().size() * b.parts().size());
+        d = std::max(d, partsLowerBound(a, pa, b, pb, tol, enough, relative, caches) - it.padding);  // (d first: NaN)
+      }
+      if (d <= contact && exact && !head) {
+        // The convex pieces are within contact, so the triangles are near (and a fine mesh has many near):
+        // whether they are within contact is a search that stops at the first pair; only if not, how far
+        // they are, measured no farther than a few contact distances.
+        if (!lowered && meshesIntersect(a, pa, b, pb, tol, GeometryMode::Mesh, it.padding + contact)) {
+          d = 0.0;
+        } else {
+          const DistanceResult m = meshDistance(a, pa, b, pb, tol, relative, std::min(enough, it.padding + kNear * contact));
+          d = isFailure(m.status) ? 0.0 : std::max(m.lower_bound - it.padding, lowered ? 0.0 : kBeyond * contact);
+        }
+      }
+      if (d <= contact && !head) {
+        report = CollisionReport{};
+        report.kind = CollisionReport::Kind::Self;
+        report.link = it.a;
+        report.other_link = it.b;
+      }
+    } else {
+      const double cutoff = need + it.padding + contact;
+      const double t = time(s);  // where moving obstacles are
+      // As for pairs: the hull's bound first, the exact geometry only when the hull comes close.
+      const int e = k - mc.env_begin_;
+      SimplexCache* warm = warmStarts(ctx.env_cache, ctx.env_slot[e], ctx.env_stamp[e], sc.environment().staticCount());
+      const double h =
+          sc.environment().hullLowerBound(*it.ga, pa, tol, cutoff, relative, t, &ctx.scene.counters.environment, warm);
+      d = h - it.padding;
+      EnvironmentHit hit;
+      bool found = false;  // `hit` names what is within contact
+      EnvironmentCounters* counters = &ctx.scene.counters.environment;
+      if (d <= contact && exact && !head)  // the convex parts, then (as for pairs) within contact, then how far
+        d = std::max(d, sc.environment().hullLowerBound(*it.ga, pa, tol, cutoff, relative, t, counters, nullptr, true) -
+                            it.padding);  // (d first: NaN)
+      if (d <= contact && exact && !head) {
+        if (!lowered &&
+            sc.environment().linkIntersects(*it.ga, pa, tol, GeometryMode::Mesh, it.padding + contact, t, &hit, counters)) {
+          d = 0.0;
+          found = true;
+        } else {
+          const DistanceResult e =
+              sc.environment().linkDistance(*it.ga, pa, tol, std::min(cutoff, it.padding + kNear * contact), t, relative, counters);
+          d = isFailure(e.status) ? 0.0 : std::max(e.lower_bound - it.padding, lowered ? 0.0 : kBeyond * contact);
+        }
+      }
+      if (d <= contact && !head) {
+        report = CollisionReport{};
+        report.kind = CollisionReport::Kind::Environment;
+        report.link = it.a;
+        // Which obstacle or voxel (for the report only): one within the contact distance, widened by the
+        // relative error the distance's lower bound was allowed.
+        if (!found)
+          sc.environment().linkIntersects(*it.ga, pa, tol, sc.options().mode,
+                                          it.padding + (contact + 1e-9) * (1.0 + relative), t, &hit);
+        report.hit = hit;
+      }
+    }
+    if (r.distance_queries >= mc.options_.max_queries) capped = true;
+    return d;
+  }
+
+  // Self item k's parts' clearances from the other link, from the hulls' separating plane: any unit u gives,
+  // for a part of A whose points reach at most P_i along u and a B whose points start at Q, a clearance of
+  // at least Q − P_i (the last GJK axis makes it tight for the nearest part); never below d, the hulls'.
+  // False when there is no axis or too many parts.
+  bool splitClearances(int k, double d) {
+    const Item& it = mc.items_[k];
+    const SimplexCache& cache = ctx.hull_cache[k];
+    const std::vector<LinkGeometry::Part>& parts_a = it.ga->parts();
+    const std::vector<LinkGeometry::Part>& parts_b = it.gb->parts();
+    if (!cache.valid || parts_a.size() > kSplit || parts_b.size() > kSplit) return false;
+    const Pose& pa = ctx.scene.poses[it.frame_a];  // (as measured)
+    const Pose& pb = ctx.scene.poses[it.frame_b];
+    const Vec3 u_a = -cache.axis.normalized();  // A towards B, in A's frame
+    const Vec3 u = pa.R * u_a, u_b = pb.R.transpose() * u;
+    if (!u.allFinite()) return false;
+    std::int32_t hint_a = cache.hint_a, hint_b = cache.hint_b;
+    const double p = u.dot(pa.t) + u_a.dot(it.ga->hull().support(u_a, hint_a));
+    const double q = u.dot(pb.t) + u_b.dot(it.gb->hull().support(-u_b, hint_b));
+    // Rounding: each term is a dot product of coordinates of a few metres at most.
+    const double slack = it.padding + 1e-12 * (1.0 + std::abs(p) + std::abs(q));
+    for (std::size_t i = 0; i < parts_a.size(); ++i)  // (d first in max(): a NaN plane leaves d)
+      clear_a[i] = std::max(d, q - std::min(p, u.dot(pa * parts_a[i].center) + parts_a[i].radius) - slack);
+    for (std::size_t j = 0; j < parts_b.size(); ++j)
+      clear_b[j] = std::max(d, std::max(q, u.dot(pb * parts_b[j].center) - parts_b[j].radius) - p - slack);
+    return true;
+  }
+
+  // Self item k's parts' motion bounds against the other link, for this segment: a's parts, then b's.
+  const double* splitBounds(int k) {
+    const Item& it = mc.items_[k];
+    double* bound = ctx.split_bound.data() + ctx.split_slot[k];
+    if (ctx.split_stamp[k] != ctx.segment) {
+      const std::vector<int>& begin = mc.bodies_.parts_begin;
+      const int na = static_cast<int>(it.ga->parts().size()), nb = static_cast<int>(it.gb->parts().size());
+      for (int i = 0; i < na; ++i) bound[i] = mc.bound_.pair(begin[it.a] + i, it.b, ctx.dq.data());
+      for (int j = 0; j < nb; ++j) bound[na + j] = mc.bound_.pair(it.a, begin[it.b] + j, ctx.dq.data());
+      ctx.split_stamp[k] = ctx.segment;
+    }
+    return bound;
+  }
+
+  // How far from s a clearance d of item k reaches, either way. Beyond `want` nothing is asked; only short
+  // of it does a self item look at its links' parts: where the near part lies close to the axes that turn
+  // it, the far parts' larger clearances make up for their larger motion.
+  double reach(int k, double d, double want) {
+    const Item& it = mc.items_[k];
+    const double* dq = ctx.dq.data();
+    const Pose* poses = ctx.scene.poses.data();  // (at the parameter d was measured at)
+    // The static bound first: where it reaches as far as asked, the reaches from the axes now are not needed.
+    double h = d / ctx.bound[k];  // (∞ when the item does not move)
+    if (!(h < want)) return h;
+    if (it.b < 0) return std::max(h, mc.bound_.linkStep(it.a, dq, poses, d, ctx.obstacle_motion));
+    h = std::max(h, mc.bound_.pairStep(it.a, it.b, dq, poses, d));
+    if (h < want && split_item == k && splitClearances(k, d)) {
+      const double* bound = splitBounds(k);
+      const std::size_t na = it.ga->parts().size(), nb = it.gb->parts().size();
+      double ha = INFINITY, hb = INFINITY;  // (a part that does not move relative to the other: ∞)
+      for (std::size_t i = 0; i < na; ++i) ha = std::min(ha, clear_a[i] / bound[i]);
+      for (std::size_t j = 0; j < nb; ++j) hb = std::min(hb, clear_b[j] / bound[na + j]);
+      h = std::max(h, std::max(ha, hb));
+    }
+    return h;
+  }
+
+  // How far either way from s item k is clear, measured for the interval s ± half; −1 within contact.
+  double first(int k, double s, double half) {
+    CollisionReport report;
+    const double d = measureItem(k, s, ctx.bound[k] * half, report);
+    if (d > contactOf(k)) return reach(k, d, half);
+    if (verdict_only && mc.items_[k].last <= mc.items_[k].first) found(s, report);
+    return -1.0;
+  }
+
+  // A contact at s settles a verdict-only check (no parameter before it is known to be free).
+  void found(double s, const CollisionReport& report) {
+    hit = true;
+    limit = s;
+    ++contacts;
+    clear_before = 0.0;
+    r.report = report;
+  }
+
+  // Covers [a, b] ∩ [0, limit] for item k (all of [0, a) is covered already).
+  void cover(int k, double a, double b, double witness) {
+    const Item& it = mc.items_[k];
+    const std::size_t base = ctx.intervals.size();
+    ctx.intervals.push_back({a, b, witness});
+    CollisionReport report;
+    while (ctx.intervals.size() > base && !stop()) {
+      const MotionContext::Interval iv = ctx.intervals.back();
+      ctx.intervals.pop_back();
+      const double hi = std::min(iv.b, limit);
+      if (iv.a > hi || (hit && iv.a >= hi)) continue;
+      const double m = 0.5 * (iv.a + hi);
+      const double d = measureItem(k, m, ctx.bound[k] * 0.5 * (hi - iv.a), report);
+      if (d <= contactOf(k)) {
+        if (it.last > it.first) {  // a group within contact: its members take over here, exactly
+          for (int member = it.first; member < it.last && !stop(); ++member) {
+            ctx.bound[member] = mc.itemBound(mc.items_[member], ctx.dq.data(), ctx.obstacle_motion);
+            cover(member, iv.a, hi, iv.witness);
+          }
+          continue;
+        }
+        if (verdict_only) {
+          found(m, report);
+          ctx.intervals.resize(base);
+          return;
+        }
+        if (advance(k, iv.a, iv.witness, hi)) {
+          ctx.intervals.resize(base);  // all to the right of the contact
+          return;
+        }
+        continue;
+      }
+      const double rad = reach(k, d, std::max(m - iv.a, hi - m));
+      if (m + rad < hi) ctx.intervals.push_back({m + rad, hi, m});
+      if (m - rad > iv.a) ctx.intervals.push_back({iv.a, m - rad, iv.witness});
+    }
+    ctx.intervals.resize(base);
+  }
+
+  // Conservative advancement of item k from a (clear at `witness`) towards `until`: true when it meets a
+  // contact there (which becomes the limit); false when [a, until] is clear.
+  bool advance(int k, double a, double witness, double until) {
+    CollisionReport report;
+    double s = a, prev = std::max(witness, 0.0), prev_d = 0.0;  // the clearance measured at prev (0: none)
+    while (!capped) {
+      const double d = measureItem(k, s, ctx.bound[k] * (until - s), report);
+      const double contact = contactOf(k);
+      if (d <= contact) {
+        if (!hit || s < limit) {
+          limit = s;
+          hit = true;
+          ++contacts;
+          // The last parameter known free: past prev, as long as the step's bound still leaves half the
+          // contact distance. (Both reaches come from bounds convex in the step and 0 at 0: the motion
+          // over a fraction λ of the step is at most λ·prev_d.)
+          clear_before = prev_d > contact ? prev + (s - prev) * (1.0 - 0.5 * contact / prev_d) : prev;
+          r.report = report;
+        }
+        return true;
+      }
+      prev = s;
+      prev_d = d;
+      s += reach(k, d, until - s);  // at least contactOf(k) / B > 0: the loop ends
+      if (!(s < until)) return false;
+    }
+    return false;
+  }
+};
+
+double MotionChecker::itemBound(const Item& it, const double* dq, double obstacle_motion) const noexcept {
+  return it.b >= 0 ? bound_.pair(it.a, it.b, dq) : bound_.link(it.a, dq) + obstacle_motion;
+}
+
+MotionResult MotionChecker::certified(const double* q0, double t0, const double* q1, double t1, MotionContext& ctx,
+                                      bool locate_contact) const noexcept {
+  MotionResult r;
+  const Scene& sc = *scene_;
+  // q0's collisions are found by the items' coverage of the segment, except those no state changes.
+  // (first_contact = last_valid = 0)
+  if (!sc.validState(q0)) {
+    r.report.kind = CollisionReport::Kind::Invalid;
+    return r;
+  }
+  if (sc.staticCollision().kind != CollisionReport::Kind::None || rigid_collision_.kind != CollisionReport::Kind::None) {
+    r.report = sc.staticCollision().kind != CollisionReport::Kind::None ? sc.staticCollision() : rigid_collision_;
+    return r;
+  }
+  for (int i = 0; i < sc.dimension(); ++i) ctx.dq[i] = q1[i] - q0[i];
+  for (const int k : quaternions_) {  // the change of the unit quaternions slerp runs between
+    Eigen::Vector4d a, b;
+    alignedUnit(q0 + k, q1 + k, a, b);
+    for (int c = 0; c < 4; ++c) ctx.dq[k + c] = b[c] - a[c];
+  }
+  for (int i = 0; i < sc.dimension(); ++i)
+    if (!std::isfinite(ctx.dq[i])) {
+      r.report.kind = CollisionReport::Kind::Invalid;
+      return r;
+    }
+  // The segment stays within bounds when both ends do (boxes are convex): an invalid end is reported
+  // after the advancement has looked for an earlier contact.
+  const bool end_invalid = !sc.validState(q1);
+
+  const bool check_env = sc.effects().environment && !sc.environment().empty();
+  const int n_items = check_env ? static_cast<int>(items_.size()) : env_begin_;
+  // No warm start from other segments: a segment's verdict then depends on nothing but its ends (a planner's
+  // threads, and a later re-check of its path, must agree even on pairs within the contact distance).
+  for (SimplexCache& c : ctx.hull_cache) c = SimplexCache{};
+  ++ctx.segment;  // (the part pairs' and obstacles' warm starts are emptied as their items first need them)
+  // How far moving obstacles travel over the segment (per unit of s): it adds to every environment item's
+  // motion; none unless the scene declares them.
+  const bool timed = sc.effects().moving && sc.environment().hasMovingObstacles();
+  if (!timed) t0 = t1 = 0.0;
+  ctx.obstacle_motion = timed ? obstacle_speed_ * std::abs(t1 - t0) : 0.0;
+  if (!std::isfinite(ctx.obstacle_motion) || !std::isfinite(t0)) {
+    r.report.kind = CollisionReport::Kind::Invalid;
+    return r;
+  }
+  // Members wait until their group comes within contact.
+  for (int k = 0; k < n_items; ++k) {
+    if (items_[k].group >= 0) continue;
+    ctx.bound[k] = itemBound(items_[k], ctx.dq.data(), ctx.obstacle_motion);  // (0 when nothing moves: measured once)
+    ctx.safe_until[k] = 0.0;
+  }
+
+  if (options_.mode == MotionMode::Cast) castAhead(q0, q1, t0, n_items, ctx, r);
+  Sweep sweep{*this, ctx, r, q0, q1};
+  sweep.t0 = t0, sweep.t1 = t1;
+  sweep.verdict_only = !locate_contact;
+  // The item that met the last contact goes first: a planner's next segment often meets it again, and a
+  // contact found early bounds every other item's work.
+  const int lead = ctx.lead >= 0 && ctx.lead < n_items && items_[ctx.lead].group < 0 ? ctx.lead : -1;
+  const auto cover = [&](int k, double a, double b, double witness) {
+    const int before = sweep.contacts;
+    sweep.cover(k, a, b, witness);
+    if (sweep.contacts > before) ctx.lead = k;
+  };
+  if (lead >= 0 && ctx.safe_until[lead] <= 1.0)
+    cover(lead, ctx.safe_until[lead], 1.0, ctx.safe_until[lead] > 0.0 ? ctx.safe_until[lead] : -1.0);
+  // Every other item is first measured in the middle of what is left, where one set of poses serves all.
+  const double mid = 0.5 * sweep.limit;
+  for (int k = 0; k < n_items && !sweep.stop(); ++k)
+    if (k != lead && items_[k].group < 0 && ctx.safe_until[k] == 0.0) {
+      const int before = sweep.contacts;
+      ctx.first_reach[k] = sweep.first(k, mid, mid);
+      if (sweep.contacts > before) ctx.lead = k;
+    }
+  for (int k = 0; k < n_items && !sweep.stop(); ++k) {
+    if (k == lead || items_[k].group >= 0) continue;
+    const double start = ctx.safe_until[k];  // 0, or where a shape cast says the item is clear until
+    if (start > 1.0) continue;
+    if (start > 0.0) {
+      cover(k, start, 1.0, start);
+    } else if (ctx.first_reach[k] < 0.0) {
+      cover(k, 0.0, 1.0, -1.0);  // within contact in the middle: from the start, exactly
+    } else {  // what the ball in the middle leaves, left first
+      const double rad = ctx.first_reach[k];
+      if (mid - rad > 0.0) cover(k, 0.0, mid - rad, -1.0);
+      if (mid + rad < sweep.limit) cover(k, mid + rad, 1.0, mid);
+    }
+  }
+  if (sweep.capped) {
+    r.capped = true;
+    r.first_contact = r.last_valid = 0.0;
+    r.report = CollisionReport{};
+    r.report.kind = CollisionReport::Kind::Invalid;
+    return r;
+  }
+  // An end out of bounds: the segment is valid up to where it leaves them (q0 is within: boxes are convex).
+  double exit = 1.0;
+  if (end_invalid) {
+    for (int i = 0; i < sc.dimension(); ++i) {
+      const double lo = sc.lower(i) - kJointLimitTolerance, hi = sc.upper(i) + kJointLimitTolerance;
+      if (q1[i] > hi && ctx.dq[i] > 0.0) exit = std::min(exit, (hi - q0[i]) / ctx.dq[i]);
+      if (q1[i] < lo && ctx.dq[i] < 0.0) exit = std::min(exit, (lo - q0[i]) / ctx.dq[i]);
+    }
+    exit = std::clamp(exit, 0.0, 1.0);
+  }
+  if (sweep.hit && !(end_invalid && exit < sweep.limit)) {
+    r.free = false;
+    r.first_contact = sweep.limit;
+    // The state at the contact is within contact_distance of touching: if it is still free, it is the last
+    // valid one; otherwise the last parameter the contacting item is certified clear at. (Deciding costs a
+    // full check of a state next to a contact, where the exact meshes decide: about a tenth of a UR5's
+    // motion checks, so only for callers that want it.)
+    r.last_valid = sweep.clear_before;
+    if (locate_contact) {
+      interpolate(q0, q1, sweep.limit, ctx.q.data());
+      if (sc.isFree(ctx.q.data(), ctx.scene, nullptr, sweep.time(sweep.limit))) r.last_valid = sweep.limit;
+    }
+    return r;
+  }
+  if (end_invalid) {  // clear until the segment leaves its bounds
+    r.first_contact = r.last_valid = exit;
+    r.report = CollisionReport{};
+    r.report.kind = CollisionReport::Kind::Invalid;
+    return r;
+  }
+  r.free = true;
+  r.report = CollisionReport{};
+  return r;
+}
+
+
+}  // namespace clearway

@@ -1,0 +1,343 @@
+// MotionBound: the per-link and per-pair coefficients of the motion bound, static and from the axes now.
+#include <clearway/motion/motion.h>
+
+#include <clearway/kinematics/forward_kinematics.h>
+#include <clearway/narrowphase/gjk.h>
+#include <clearway/narrowphase/ray_cast.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "motion_detail.h"
+
+namespace clearway {
+
+using motion_detail::referenceState;
+using motion_detail::rigidAnchors;
+
+// ---- MotionBound --------------------------------------------------------------------------------------
+
+MotionBound::MotionBound(const Scene& scene, const std::vector<Body>& bodies)
+    : dim_(scene.dimension()), links_(scene.robot().linkCount() + static_cast<int>(bodies.size())) {
+  const RobotModel& model = scene.robot();
+  const int model_links = model.linkCount();
+  // A body is one more link: its merged geometry in the frame of its anchor link.
+  frame_.resize(links_);
+  for (int i = 0; i < links_; ++i) frame_[i] = i < model_links ? i : bodies[i - model_links].anchor;
+  // Each link's (or body's) points: their hull, and a ball containing them.
+  std::vector<Body> shape(links_);
+  for (int i = 0; i < links_; ++i) {
+    if (i >= model_links) {
+      shape[i] = bodies[i - model_links];
+    } else if (const LinkGeometry* g = scene.geometry().link(i)) {
+      shape[i] = Body{i, &g->hull(), g->sphereCenter(), g->sphereRadius()};
+    }
+  }
+  // The farthest hull vertex from the frame's origin.
+  radius_.assign(links_, 0.0);
+  for (int i = 0; i < links_; ++i)
+    if (shape[i].hull)
+      for (const Vec3& v : shape[i].hull->vertices()) radius_[i] = std::max(radius_[i], v.norm());
+  // Which state entry drives each joint variable (through a mimic too).
+  std::vector<int> var_to_state(model.variableCount(), -1);
+  for (int i = 0; i < dim_; ++i) var_to_state[scene.groupVariables()[i]] = i;
+  // The farthest a slide driven by state entry v (or, without one, a variable held still) goes.
+  const auto travel = [&](int v, const JointVariable& var) {
+    const double lo = v >= 0 ? scene.lower(v) : var.lower, hi = v >= 0 ? scene.upper(v) : var.upper;
+    return std::max(std::abs(lo), std::abs(hi));
+  };
+  // Elements: one per joint of one variable; a planar joint is two slides and a turn about its axis; a
+  // floating joint is three slides and a spin about its origin, one element per quaternion entry (the
+  // angle turned is at most kSpin times the quaternions' distance).
+  const int joints = model.jointCount();
+  std::vector<std::vector<int>> elements_of(joints);
+  for (int j = 0; j < joints; ++j) {
+    const Joint& joint = model.joint(j);
+    const Joint& owner = joint.isMimic() ? model.joint(joint.mimic.joint) : joint;
+    const auto add = [&](int k, Kind kind, double step) {
+      const int var = owner.first_variable >= 0 ? owner.first_variable + k : -1;
+      const int v = var >= 0 ? var_to_state[var] : -1;
+      elements_of[j].push_back(static_cast<int>(joint_var_.size()));
+      joint_of_.push_back(j);
+      joint_var_.push_back(v);
+      kind_.push_back(static_cast<char>(kind));
+      joint_mult_.push_back(kind == Kind::Spin ? kSpin : joint.isMimic() ? std::abs(joint.mimic.multiplier) : 1.0);
+      step_.push_back(step);
+      axis_.push_back(joint.axis.normalized());
+      child_.push_back(joint.child_link);
+    };
+    const double origin = joint.origin.t.norm();
+    const std::vector<JointVariable>& vars = model.variables();
+    const auto slide = [&](int k) {
+      const int var = owner.first_variable >= 0 ? owner.first_variable + k : -1;
+      return var >= 0 ? travel(var_to_state[var], vars[var]) : 0.0;
+    };
+    switch (joint.type) {
+      case JointType::Fixed: add(-1, Kind::Revolute, origin); break;  // (no variable: never moves)
+      case JointType::Revolute:
+      case JointType::Continuous: add(0, Kind::Revolute, origin); break;
+      case JointType::Prismatic:
+        add(0, Kind::Prismatic,
+            origin + (joint.isMimic() ? std::abs(joint.mimic.multiplier) * slide(0) + std::abs(joint.mimic.offset) : slide(0)));
+        break;
+      case JointType::Planar:
+        add(0, Kind::Prismatic, origin + slide(0));
+        add(1, Kind::Prismatic, slide(1));
+        add(2, Kind::Revolute, 0.0);
+        break;
+      case JointType::Floating:
+        for (int k = 0; k < 3; ++k) add(k, Kind::Prismatic, (k ? 0.0 : origin) + slide(k));
+        for (int k = 3; k < 7; ++k) add(k, Kind::Spin, 0.0);
+        break;
+    }
+  }
+  const int elements = static_cast<int>(joint_var_.size());
+  // A revolute joint's axis is fixed in the links rigidly attached to either side of it (through joints
+  // the group does not move): their distances from it are exact, so a link turning about a nearby axis
+  // (a base about its own turntable, a gripper about the wrist) barely counts. The rigid transforms
+  // come from the poses at one reference state, which also give a still joint's exact offset.
+  exact_.assign(static_cast<std::size_t>(links_) * elements, std::numeric_limits<double>::infinity());
+  // The farthest hull vertex of a link from a line (point o, unit direction u) in the link's frame.
+  const auto axisReach = [&](int link, const Vec3& o, const Vec3& u) {
+    const ConvexHull* hull = shape[link].hull;
+    double r = 0.0;
+    if (hull)
+      for (const Vec3& v : hull->vertices()) {
+        const Vec3 w = v - o;
+        r = std::max(r, (w - w.dot(u) * u).norm());
+      }
+    return r * (1.0 + 1e-12) + 1e-12 * (hull ? radius_[link] + o.norm() : 0.0);  // rounding
+  };
+  {
+    SceneContext ctx = scene.makeContext();
+    scene.computePoses(referenceState(scene).data(), ctx);
+    // Links joined through joints without a state entry form rigid bodies.
+    const auto still = [&](int j) {
+      for (const int e : elements_of[j])
+        if (joint_var_[e] >= 0) return false;
+      return true;
+    };
+    const std::vector<int> anchor = rigidAnchors(scene);  // (the same rigid bodies MotionChecker merges)
+    for (int j = 0; j < joints; ++j) {
+      const Joint& joint = model.joint(j);
+      if (!still(j) || joint.parent_link < 0 || joint.child_link < 0) continue;
+      // Held where the reference state has it (a held planar or floating joint has no limits to bound it).
+      const double offset = relativePose(ctx.poses[joint.parent_link], ctx.poses[joint.child_link]).t.norm();
+      for (const int e : elements_of[j]) step_[e] = e == elements_of[j].front() ? offset * (1.0 + 1e-12) : 0.0;
+    }
+    for (int e = 0; e < elements; ++e) {
+      const Joint& joint = model.joint(joint_of_[e]);
+      if (joint_var_[e] < 0 || kind_[e] != static_cast<char>(Kind::Revolute) || joint.child_link < 0 || joint.parent_link < 0)
+        continue;
+      const Pose& child = ctx.poses[joint.child_link];  // the joint frame, turned by q about the axis
+      const Vec3 point = child.t, dir = child.R * axis_[e];
+      for (int l = 0; l < links_; ++l) {
+        const int root = anchor[frame_[l]];
+        if (root != anchor[joint.child_link] && root != anchor[joint.parent_link]) continue;
+        const Pose& pose = ctx.poses[frame_[l]];
+        exact_[static_cast<std::size_t>(l) * elements + e] =
+            axisReach(l, pose.R.transpose() * (point - pose.t), pose.R.transpose() * dir);
+      }
+    }
+  }
+  chain_.resize(links_);
+  prefix_.resize(links_);
+  joint_reach_.resize(links_);
+  sphere_center_.assign(links_, Vec3::Zero());
+  sphere_radius_.assign(links_, 0.0);
+  link_coef_.assign(static_cast<std::size_t>(links_) * dim_, 0.0);
+  for (int i = 0; i < links_; ++i) {
+    for (int l = frame_[i]; model.link(l).parent_joint >= 0; l = model.parentLink(l)) {
+      const std::vector<int>& e = elements_of[model.link(l).parent_joint];
+      chain_[i].insert(chain_[i].end(), e.rbegin(), e.rend());
+    }
+    std::reverse(chain_[i].begin(), chain_[i].end());
+    sphere_center_[i] = shape[i].center, sphere_radius_[i] = shape[i].radius;
+    const std::size_t n = chain_[i].size();
+    prefix_[i].assign(n, 0.0);
+    for (std::size_t k = 0; k < n; ++k) prefix_[i][k] = (k ? prefix_[i][k - 1] : 0.0) + step_[chain_[i][k]];
+    // A chain joint's reach to the link: the offsets of the joints after it, plus the link's radius (the
+    // lengths do not change under rotation); the link's own joint knows it exactly.
+    joint_reach_[i].assign(n, 0.0);
+    for (std::size_t k = 0; k < n; ++k) {
+      joint_reach_[i][k] = radius_[i] + (prefix_[i][n - 1] - prefix_[i][k]);
+      joint_reach_[i][k] = std::min(joint_reach_[i][k], exactReach(i, chain_[i][k]));
+    }
+    for (std::size_t k = 0; k < n; ++k) {
+      const int j = chain_[i][k];
+      if (joint_var_[j] < 0) continue;
+      const double w = isSlide(j) ? 1.0 : joint_reach_[i][k];
+      link_coef_[static_cast<std::size_t>(i) * dim_ + joint_var_[j]] += joint_mult_[j] * w;
+    }
+  }
+}
+
+bool MotionBound::translates(int a, int b, const double* dq) const noexcept {
+  // Joints above the fork move both links alike; only the path between them matters.
+  std::size_t fork = 0;
+  while (fork < chain_[a].size() && fork < chain_[b].size() && chain_[a][fork] == chain_[b][fork]) ++fork;
+  for (const int l : {a, b})
+    for (std::size_t k = fork; k < chain_[l].size(); ++k) {
+      const int j = chain_[l][k], v = joint_var_[j];
+      if (v >= 0 && dq[v] != 0.0 && !isSlide(j)) return false;
+    }
+  return true;
+}
+
+bool MotionBound::translates(int link, const double* dq) const noexcept {
+  for (const int j : chain_[link])
+    if (joint_var_[j] >= 0 && dq[joint_var_[j]] != 0.0 && !isSlide(j)) return false;
+  return true;
+}
+
+double MotionBound::link(int link, const double* dq) const noexcept {
+  double b = 0.0;
+  const double* c = &link_coef_[static_cast<std::size_t>(link) * dim_];
+  for (int v = 0; v < dim_; ++v)
+    if (dq[v] != 0.0) b += c[v] * std::abs(dq[v]);
+  return b;
+}
+
+// A bound on how far points of links move for a step h·dq, measured from where the joint axes are now:
+// joint k turns a link by h·w_k about its axis; the link's points are within r_k (now, from its bounding
+// ball) of the axis, plus how far the joints after k can move them relative to it, h·γ_k, and never
+// beyond the static reach R_k. So they move at most f(h) = h·Σ w_k·min(R_k, r_k + h·γ_k): convex and
+// piecewise quadratic, a piece starting where a joint's dynamic reach meets its static one.
+struct MotionBound::DynamicBound {
+  static constexpr int kMax = 64;
+  double a = 0.0, c = 0.0;   // f(h) = h·(a + c·h) on the first piece
+  double fixed = 0.0;        // Σ w·R: the static bound for h = 1
+  double cap[kMax], gain[kMax], excess[kMax];  // per piece start: where, w·γ and w·(R − r) there
+  int n = 0;
+
+  // h ↦ the largest step with f(h) ≤ d, never below the static d / fixed.
+  double solve(double d) {
+    for (int i = 1; i < n; ++i)
+      for (int k = i; k > 0 && cap[k] < cap[k - 1]; --k) {
+        std::swap(cap[k], cap[k - 1]);
+        std::swap(gain[k], gain[k - 1]);
+        std::swap(excess[k], excess[k - 1]);
+      }
+    double h = INFINITY;
+    for (int i = 0; i <= n; ++i) {
+      const double end = i < n ? cap[i] : INFINITY;
+      const double root = c > 0.0 ? 2.0 * d / (a + std::sqrt(a * a + 4.0 * c * d)) : a > 0.0 ? d / a : INFINITY;
+      if (root <= end) {
+        h = root;
+        break;
+      }
+      // Past its cap, joint i moves the link by its static reach: c·h gives way to w·(R − r).
+      a += excess[i];
+      c = std::max(0.0, c - gain[i]);
+    }
+    h = std::max(fixed > 0.0 ? d / fixed : INFINITY, h);
+    return std::isnan(h) ? 0.0 : h;
+  }
+};
+
+void MotionBound::addDynamic(int link, std::size_t from, const double* dq, const Pose* poses, DynamicBound& f) const noexcept {
+  const std::vector<int>& chain = chain_[link];
+  const Vec3 center = poses[frame_[link]] * sphere_center_[link];
+  double after = 0.0;  // Σ w·R over the joints below k: γ_k
+  for (std::size_t k = chain.size(); k-- > from;) {
+    const int j = chain[k], v = joint_var_[j];
+    if (v < 0 || dq[v] == 0.0) continue;
+    const double w = joint_mult_[j] * std::abs(dq[v]);
+    const double reach = isSlide(j) ? 1.0 : joint_reach_[link][k];
+    if (kind_[j] != static_cast<char>(Kind::Revolute) || f.n == DynamicBound::kMax) {  // slides, spins: static
+      f.a += w * reach;
+    } else {
+      const Pose& frame = poses[child_[j]];
+      const Vec3 u = frame.R * axis_[j], r = center - frame.t;
+      const double now = std::min(reach, (r - r.dot(u) * u).norm() + sphere_radius_[link]);
+      f.a += w * now;
+      if (now < reach && after > 0.0) {
+        f.c += w * after;
+        f.cap[f.n] = (reach - now) / after, f.gain[f.n] = w * after, f.excess[f.n] = w * (reach - now);
+        ++f.n;
+      }
+    }
+    after += w * reach;
+  }
+  f.fixed += after;
+}
+
+double MotionBound::linkStep(int link, const double* dq, const Pose* poses, double d, double extra) const noexcept {
+  DynamicBound f;
+  addDynamic(link, 0, dq, poses, f);
+  f.a += extra, f.fixed += extra;  // (linear in h)
+  return f.solve(d);
+}
+
+double MotionBound::pairStep(int a, int b, const double* dq, const Pose* poses, double d) const noexcept {
+  // Watched from the fork: each link moves by the joints below it, from where their axes are now.
+  std::size_t fork = 0;
+  while (fork < chain_[a].size() && fork < chain_[b].size() && chain_[a][fork] == chain_[b][fork]) ++fork;
+  DynamicBound f;
+  addDynamic(a, fork, dq, poses, f);
+  addDynamic(b, fork, dq, poses, f);
+  return f.solve(d);
+}
+
+double MotionBound::pair(int a, int b, const double* dq) const noexcept {
+  // Joints shared by both chains move the pair rigidly. The others lie on the path a → fork → b, and
+  // the pair may be watched from any link X on that path: the joints between a and X move a, the rest
+  // move b. Each joint costs |Δq| times its reach to the link it moves (for a link above the joint, the
+  // offsets up to the fork and down to that link); the bound is the cheapest X, found in one sweep.
+  const std::vector<int>& ca = chain_[a];
+  const std::vector<int>& cb = chain_[b];
+  const std::size_t na = ca.size(), nb = cb.size();
+  std::size_t fork = 0;
+  while (fork < na && fork < nb && ca[fork] == cb[fork]) ++fork;
+  const double above = fork ? prefix_[a][fork - 1] : 0.0;  // equal for b: the shared joints
+  const double side_a = na > fork ? prefix_[a][na - 1] - above : 0.0;
+  const double side_b = nb > fork ? prefix_[b][nb - 1] - above : 0.0;
+  // Path order: a's joints upwards, then b's downwards. cost_a[k]: the joint moving a; cost_b[k]: moving b.
+  constexpr std::size_t kMaxPath = 128;
+  double cost_a[kMaxPath], cost_b[kMaxPath];
+  std::size_t n = 0;
+  const auto add = [&](int j, double reach_a, double reach_b) {
+    const int v = joint_var_[j];
+    if (v < 0 || dq[v] == 0.0) return;
+    const double w = joint_mult_[j] * std::abs(dq[v]);
+    cost_a[n] = (isSlide(j) ? 1.0 : reach_a) * w;
+    cost_b[n] = (isSlide(j) ? 1.0 : reach_b) * w;
+    ++n;
+  };
+  if (na - fork + nb - fork > kMaxPath) {  // beyond any real robot: watched from the fork
+    double bound = 0.0;
+    for (int side = 0; side < 2; ++side) {
+      const int l = side ? b : a;
+      for (std::size_t k = fork; k < chain_[l].size(); ++k) {
+        const int j = chain_[l][k], v = joint_var_[j];
+        if (v >= 0 && dq[v] != 0.0) bound += joint_mult_[j] * std::abs(dq[v]) * (isSlide(j) ? 1.0 : joint_reach_[l][k]);
+      }
+    }
+    return bound;
+  }
+  for (std::size_t k = na; k-- > fork;) {
+    // From this joint up to the fork, then down to b.
+    const double reach_b = radius_[b] + (prefix_[a][k] - above) + side_b;
+    add(ca[k], joint_reach_[a][k], std::min(reach_b, exactReach(b, ca[k])));
+  }
+  for (std::size_t k = fork; k < nb; ++k) {
+    const double reach_a = radius_[a] + (prefix_[b][k] - above) + side_a;
+    add(cb[k], std::min(reach_a, exactReach(a, cb[k])), joint_reach_[b][k]);
+  }
+  // Split after i joints: Σ_{k<i} cost_a + Σ_{k≥i} cost_b, smallest over i, by a suffix sweep.
+  double suffix_b = 0.0;
+  double best = INFINITY;
+  double prefix_a[kMaxPath + 1];
+  prefix_a[0] = 0.0;
+  for (std::size_t k = 0; k < n; ++k) prefix_a[k + 1] = prefix_a[k] + cost_a[k];
+  for (std::size_t i = n + 1; i-- > 0;) {
+    best = std::min(best, prefix_a[i] + suffix_b);
+    if (i > 0) suffix_b += cost_b[i - 1];
+  }
+  return best;
+}
+
+
+}  // namespace clearway

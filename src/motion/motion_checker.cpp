@@ -1,0 +1,273 @@
+// MotionChecker: rigid bodies merged, the items certified mode measures, contexts, interpolation, and the
+// choice of mode.
+#include <clearway/motion/motion.h>
+
+#include <clearway/kinematics/forward_kinematics.h>
+#include <clearway/narrowphase/gjk.h>
+#include <clearway/narrowphase/ray_cast.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "motion_detail.h"
+
+namespace clearway {
+
+using motion_detail::alignedUnit;
+using motion_detail::referenceState;
+using motion_detail::rigidAnchors;
+
+namespace {
+
+// Environment items keep a GJK warm start per static obstacle up to this many obstacles (2.5 KiB a link).
+constexpr std::size_t kWarmObstacles = 64;
+
+}  // namespace
+
+// ---- MotionChecker ------------------------------------------------------------------------------------
+
+MotionChecker::Bodies MotionChecker::mergeBodies(const Scene& scene) {
+  const RobotModel& model = scene.robot();
+  Bodies out;
+  out.anchor = rigidAnchors(scene);
+  out.index.assign(model.linkCount(), -1);
+  std::vector<std::vector<int>> members(model.linkCount());
+  for (const int l : scene.geometry().geometricLinks()) members[out.anchor[l]].push_back(l);
+  SceneContext ctx = scene.makeContext();
+  scene.computePoses(referenceState(scene).data(), ctx);
+  out.reference = ctx.poses;
+  for (int anchor = 0; anchor < model.linkCount(); ++anchor) {
+    if (members[anchor].size() < 2) continue;
+    // Every member's elements, placed in the anchor's frame (fixed: the joints in between do not move).
+    std::vector<CollisionElement> elements;
+    for (const int l : members[anchor]) {
+      const Pose in_anchor = relativePose(out.reference[anchor], out.reference[l]);
+      for (CollisionElement e : model.link(l).collisions) {
+        e.origin = in_anchor * e.origin;
+        elements.push_back(std::move(e));
+      }
+    }
+    for (const int l : members[anchor]) out.index[l] = static_cast<int>(out.list.size());
+    out.geometry.push_back(std::make_unique<const LinkGeometry>(elements, model.meshes()));
+    const LinkGeometry& g = *out.geometry.back();
+    out.list.push_back({anchor, &g.hull(), g.sphereCenter(), g.sphereRadius()});
+  }
+  // Then each link's and merged body's convex pieces, as links of the bound of their own.
+  const int merged = static_cast<int>(out.list.size());
+  out.parts_begin.assign(model.linkCount() + merged, -1);
+  for (int l = 0; l < model.linkCount() + merged; ++l) {
+    const LinkGeometry* g = l < model.linkCount() ? scene.geometry().link(l) : out.geometry[l - model.linkCount()].get();
+    if (!g) continue;
+    out.parts_begin[l] = model.linkCount() + static_cast<int>(out.list.size());
+    const int frame = l < model.linkCount() ? l : out.list[l - model.linkCount()].anchor;
+    for (const LinkGeometry::Part& part : g->parts()) out.list.push_back({frame, &part.hull, part.center, part.radius});
+  }
+  return out;
+}
+
+MotionChecker::MotionChecker(std::shared_ptr<const Scene> scene, MotionOptions options)
+    : scene_(std::move(scene)), options_(options), bodies_(mergeBodies(*scene_)), bound_(*scene_, bodies_.list) {
+  if (!(options_.contact_distance > 0.0) || !std::isfinite(options_.contact_distance))
+    throw std::invalid_argument("MotionChecker: contact_distance must be finite and > 0");
+  if (!(options_.resolution > 0.0) || !std::isfinite(options_.resolution))
+    throw std::invalid_argument("MotionChecker: resolution must be finite and > 0");
+  if (!(options_.distance_relative_error >= 0.0) || !std::isfinite(options_.distance_relative_error))
+    throw std::invalid_argument("MotionChecker: distance_relative_error must be finite and >= 0");
+  if (options_.max_queries < 1) throw std::invalid_argument("MotionChecker: max_queries must be >= 1");
+  if (options_.max_samples < 1) throw std::invalid_argument("MotionChecker: max_samples must be >= 1");
+  for (const Obstacle& o : scene_->environment().obstacles()) obstacle_speed_ = std::max(obstacle_speed_, o.velocity.norm());
+  // A floating joint's quaternion turns along the great arc (slerp), as OMPL's SO(3) interpolates.
+  const RobotModel& model = scene_->robot();
+  for (int i = 0; i < scene_->dimension(); ++i) {
+    const int v = scene_->groupVariables()[i];
+    const Joint& joint = model.joint(model.variables()[v].joint);
+    if (joint.type == JointType::Floating && v == joint.first_variable + 3) quaternions_.push_back(i);
+  }
+  buildItems();
+}
+
+void MotionChecker::buildItems() {
+  const Scene& sc = *scene_;
+  const RobotModel& model = sc.robot();
+  const int n_links = model.linkCount();
+  const std::vector<int>& anchor = bodies_.anchor;
+  std::vector<int> geometric(n_links, 0);  // per anchor: its links with geometry
+  for (const int l : sc.geometry().geometricLinks()) ++geometric[anchor[l]];
+  // A link's body as one link of the bound: merged, or the link itself when it is the body's only one.
+  const auto whole = [&](int link, Item& item, bool second) {
+    const int body = bodies_.index[link];
+    const int index = body >= 0 ? n_links + body : link;
+    const int frame = body >= 0 ? bodies_.list[body].anchor : link;
+    const LinkGeometry* g = body >= 0 ? bodies_.geometry[body].get() : sc.geometry().link(link);
+    (second ? item.b : item.a) = index;
+    (second ? item.frame_b : item.frame_a) = frame;
+    (second ? item.gb : item.ga) = g;
+  };
+  // Groups of members (indices into `single`): the members follow their group, in order.
+  const auto emit = [&](const std::vector<Item>& single, const std::vector<std::vector<int>>& groups,
+                        const std::vector<Item>& heads) {
+    std::vector<char> taken(single.size(), 0);
+    std::vector<Item> tail;
+    for (std::size_t g = 0; g < groups.size(); ++g) items_.push_back(heads[g]);
+    const std::size_t first_group = items_.size() - groups.size();
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      Item& head = items_[first_group + g];
+      head.first = static_cast<int>(items_.size() + tail.size());
+      for (const int m : groups[g]) {
+        Item member = single[m];
+        member.group = static_cast<int>(first_group + g);
+        tail.push_back(member);
+        taken[m] = 1;
+      }
+      head.last = static_cast<int>(items_.size() + tail.size());
+    }
+    items_.insert(items_.end(), tail.begin(), tail.end());
+    for (std::size_t m = 0; m < single.size(); ++m)
+      if (!taken[m]) items_.push_back(single[m]);
+  };
+
+  // Self pairs. Two bodies whose every link pair is checked are one item: the least distance over those
+  // pairs is the distance of the merged geometries (padding: the largest of the pairs').
+  std::vector<Item> single, heads;
+  std::vector<std::vector<int>> groups;
+  if (sc.effects().self) {
+    const SelfCollision& self = sc.selfCollision();
+    std::vector<std::pair<std::pair<int, int>, int>> keyed;  // (anchors, index in single)
+    const std::vector<Pose>& at = bodies_.reference;
+    for (int k = 0; k < static_cast<int>(self.pairs().size()); ++k) {
+      const LinkPair& p = self.pairs()[k];
+      if (anchor[p.a] == anchor[p.b]) {  // one rigid body: as at every state
+        if (rigid_collision_.kind == CollisionReport::Kind::None &&
+            meshesIntersect(*sc.geometry().link(p.a), at[p.a], *sc.geometry().link(p.b), at[p.b],
+                            sc.options().tolerances, sc.options().mode, self.pairPadding(k))) {
+          rigid_collision_.kind = CollisionReport::Kind::Self;
+          rigid_collision_.link = p.a;
+          rigid_collision_.other_link = p.b;
+        }
+        continue;
+      }
+      Item item;
+      item.a = item.frame_a = p.a;
+      item.b = item.frame_b = p.b;
+      item.ga = sc.geometry().link(p.a);
+      item.gb = sc.geometry().link(p.b);
+      item.padding = self.pairPadding(k);
+      keyed.push_back({std::minmax(anchor[p.a], anchor[p.b]), static_cast<int>(single.size())});
+      single.push_back(item);
+    }
+    std::sort(keyed.begin(), keyed.end());
+    for (std::size_t i = 0, j; i < keyed.size(); i = j) {
+      for (j = i; j < keyed.size() && keyed[j].first == keyed[i].first; ++j) {}
+      const auto [x, y] = keyed[i].first;
+      const std::size_t n = j - i;
+      if (x == y || n < 2 || n != static_cast<std::size_t>(geometric[x]) * geometric[y]) continue;
+      Item head;
+      whole(single[keyed[i].second].a, head, false);
+      whole(single[keyed[i].second].b, head, true);
+      groups.emplace_back();
+      for (std::size_t m = i; m < j; ++m) {
+        groups.back().push_back(keyed[m].second);
+        head.padding = std::max(head.padding, single[keyed[m].second].padding);
+      }
+      heads.push_back(head);
+    }
+  }
+  emit(single, groups, heads);
+  env_begin_ = static_cast<int>(items_.size());
+
+  // Environment links. A body whose every geometric link is checked is one item.
+  single.clear(), heads.clear(), groups.clear();
+  const std::vector<int>& env_links = sc.environmentLinks();
+  std::vector<int> checked(n_links, 0);
+  for (const int l : env_links) ++checked[anchor[l]];
+  std::vector<int> group_of(n_links, -1);
+  for (std::size_t k = 0; k < env_links.size(); ++k) {
+    const int l = env_links[k];
+    Item item;
+    item.a = item.frame_a = l;
+    item.ga = sc.geometry().link(l);
+    item.padding = sc.linkPadding(l);
+    single.push_back(item);
+    const int x = anchor[l];
+    if (checked[x] < 2 || checked[x] != geometric[x]) continue;
+    if (group_of[x] < 0) {
+      group_of[x] = static_cast<int>(groups.size());
+      groups.emplace_back();
+      Item head;
+      whole(l, head, false);
+      heads.push_back(head);
+    }
+    groups[group_of[x]].push_back(static_cast<int>(k));
+    heads[group_of[x]].padding = std::max(heads[group_of[x]].padding, item.padding);
+  }
+  emit(single, groups, heads);
+}
+
+MotionContext MotionChecker::makeContext() const {
+  MotionContext c;
+  c.scene = scene_->makeContext();
+  c.q.resize(scene_->dimension());
+  c.dq.resize(scene_->dimension());
+  c.safe_until.resize(items_.size());
+  c.bound.resize(items_.size());
+  c.first_reach.resize(items_.size());
+  c.contact.assign(items_.size(), options_.contact_distance);
+  c.contact_stamp.assign(items_.size(), 0);
+  c.hull_cache.resize(env_begin_);
+  c.part_slot.assign(env_begin_, -1);
+  c.part_stamp.assign(env_begin_, 0);
+  c.split_slot.assign(env_begin_, 0);
+  c.split_stamp.assign(env_begin_, 0);
+  for (int k = 0; k < env_begin_; ++k) {
+    const Item& it = items_[k];
+    c.split_slot[k] = static_cast<int>(c.split_bound.size());
+    c.split_bound.resize(c.split_bound.size() + it.ga->parts().size() + it.gb->parts().size());
+    if (it.last > it.first) continue;  // a head stops at its hulls
+    c.part_slot[k] = static_cast<int>(c.part_cache.size());
+    c.part_cache.resize(c.part_cache.size() + it.ga->parts().size() * it.gb->parts().size());
+  }
+  // (Warm starts per static obstacle while there are few: with many, the tree visits only a few per query.)
+  const std::size_t obstacles = scene_->environment().staticCount();
+  const int env_items = static_cast<int>(items_.size()) - env_begin_;
+  c.env_slot.assign(env_items, -1);
+  c.env_stamp.assign(env_items, 0);
+  if (obstacles > 0 && obstacles <= kWarmObstacles) {
+    for (int k = 0; k < env_items; ++k) c.env_slot[k] = static_cast<int>(k * obstacles);
+    c.env_cache.resize(env_items * obstacles);
+  }
+  c.pose_stamp.assign(scene_->robot().linkCount(), 0);
+  c.pose_path.reserve(scene_->robot().linkCount());
+  c.intervals.reserve(256);
+  if (options_.mode == MotionMode::Cast) c.end_poses.resize(scene_->robot().linkCount());
+  return c;
+}
+
+
+void MotionChecker::interpolate(const double* q0, const double* q1, double s, double* out) const noexcept {
+  for (int i = 0; i < scene_->dimension(); ++i) out[i] = q0[i] + s * (q1[i] - q0[i]);
+  for (const int k : quaternions_) {
+    Eigen::Vector4d a, b;
+    alignedUnit(q0 + k, q1 + k, a, b);
+    const double angle = std::acos(std::clamp(a.dot(b), -1.0, 1.0));
+    // Slerp; nearly equal ends interpolate linearly (then renormalized), where sin(angle) loses digits.
+    Eigen::Vector4d q = angle > 1e-9 ? Eigen::Vector4d((std::sin((1 - s) * angle) * a + std::sin(s * angle) * b) / std::sin(angle))
+                                     : Eigen::Vector4d(a + s * (b - a));
+    q.normalize();
+    for (int c = 0; c < 4; ++c) out[k + c] = q[c];
+  }
+}
+
+MotionResult MotionChecker::check(const double* q0, const double* q1, MotionContext& ctx,
+                                  bool locate_contact) const noexcept {
+  return check(q0, 0.0, q1, 0.0, ctx, locate_contact);
+}
+
+MotionResult MotionChecker::check(const double* q0, double t0, const double* q1, double t1, MotionContext& ctx,
+                                  bool locate_contact) const noexcept {
+  return options_.mode == MotionMode::Sampled ? sampled(q0, t0, q1, t1, ctx)
+                                              : certified(q0, t0, q1, t1, ctx, locate_contact);
+}
+
+}  // namespace clearway
