@@ -892,9 +892,8 @@ TEST(MotionCertified, MovingObstaclesNeverMissWhatDenseSamplingFinds) {
 // pair(part, other) says; and a part next to the axes that turn it gets a bound well below its link's
 // (the UR5's upper arm turns about the shoulder, where its near end sits beside the base).
 TEST(MotionBound, HoldsForConvexParts) {
-  const std::string root = std::string(CLEARWAY_SHARED_DIR) + "/scenes";
-  if (!std::filesystem::is_directory(root) || test::sharedRobot("panda/panda.urdf").empty())
-    GTEST_SKIP() << "shared scenes not found at " << root << " (see DATA.md)";
+  CLEARWAY_REQUIRE_SHARED("robots/panda/panda.urdf");
+  CLEARWAY_SHARED_OR_SKIP(root, "scenes");
   std::mt19937 rng(5);
   for (const char* name : {"box_panda/box_panda_0001.yaml", "box_ur5/box_ur5_0001.yaml"}) {
     const auto scene = std::make_shared<const Scene>(parseSceneFile(root + "/" + name));
@@ -945,9 +944,8 @@ TEST(MotionBound, HoldsForConvexParts) {
 // reporting a contact that sampling does not see is allowed only where the robot is truly within
 // contact_distance (clearance measured at the contact parameter).
 TEST(MotionCertified, SharedProblemsAgreeWithDenseSampling) {
-  const std::string root = std::string(CLEARWAY_SHARED_DIR) + "/scenes";
-  if (!std::filesystem::is_directory(root) || test::sharedRobot("panda/panda.urdf").empty())
-    GTEST_SKIP() << "shared scenes not found at " << root << " (see DATA.md)";
+  CLEARWAY_REQUIRE_SHARED("robots/panda/panda.urdf");
+  CLEARWAY_SHARED_OR_SKIP(root, "scenes");
   int segments = 0, both_free = 0, both_hit = 0, certified_only = 0;
   std::mt19937 rng(3);
   for (const char* name : {"bookshelf_small_panda/bookshelf_small_panda_0001.yaml", "box_ur5/box_ur5_0002.yaml",

@@ -270,9 +270,8 @@ TEST(OmplPlugin, PlansOnTheBundledScene) {
 // A Panda start 0.5 mm below a ceiling: within the certified check's contact distance (1 mm), but free,
 // so it must be leavable and the problem planned (it once used up the whole time limit).
 TEST(OmplPlugin, PlansFromAStartJustBelowACeiling) {
-  const std::string file = std::string(CLEARWAY_SHARED_DIR) + "/scenes/box_panda/box_panda_0001.yaml";
-  if (test::sharedRobot("panda/panda.urdf").empty() || !std::ifstream(file))
-    GTEST_SKIP() << "shared scene not found: " << file;
+  CLEARWAY_REQUIRE_SHARED("robots/panda/panda.urdf");
+  CLEARWAY_SHARED_OR_SKIP(file, "scenes/box_panda/box_panda_0001.yaml");
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
   ompl::RNG::setSeed(5);
   SceneDescription d = parseSceneFile(file);

@@ -19,11 +19,11 @@ namespace {
 
 using test::TempDir;
 
-std::string sharedScenes() { return std::string(CLEARWAY_SHARED_DIR) + "/scenes"; }
+std::string sharedScenes() { return test::sharedDir() + "/scenes"; }
 
-#define CLEARWAY_SHARED_SCENES_OR_SKIP()                                                             \
-  if (!std::filesystem::is_directory(sharedScenes()) || test::sharedRobot("panda/panda.urdf").empty()) \
-  GTEST_SKIP() << "shared scenes not found at " << sharedScenes() << " (see DATA.md)"
+#define CLEARWAY_SHARED_SCENES_OR_SKIP()           \
+  CLEARWAY_REQUIRE_SHARED("scenes");                 \
+  CLEARWAY_REQUIRE_SHARED("robots/panda/panda.urdf")
 
 // A scene of the planar arm (robots/planar_arm) with a box obstacle; `extra` replaces parts.
 std::string planarScene(const std::string& checks = "[self, environment]", const std::string& obstacles =
