@@ -347,6 +347,78 @@ TEST(MotionCertified, RandomSegmentsNeverMissWhatDenseSamplingFinds) {
   EXPECT_GT(free, 20);
 }
 
+TEST(MotionCertified, EveryCapEndsInACollision) {
+  // The planar arm among two posts, with each cap forced: the certified loop's query cap, the sampled
+  // check's state cap, and the narrow phase's iteration caps (GJK, EPA, casts at 0) under the scene's
+  // states and every motion mode. A capped answer is a collision, never free; no capped checker is freer
+  // than the uncapped one; and each cap is reached at least once, or this proves nothing.
+  TempDir dir;
+  const std::string obstacles =
+      "    - {name: post, cylinder: {radius: 0.03, length: 1}, pose: {position: [0, 1.2, 0]}}\n"
+      "    - {name: rod, box: {size: [0.02, 0.02, 1]}, pose: {position: [-0.9, -0.9, 0]}}\n";
+  const auto scene = planarScene(dir, obstacles);
+  SceneOptions no_iterations;
+  no_iterations.tolerances.gjk_max_iterations = 0;
+  no_iterations.tolerances.epa_max_iterations = 0;
+  no_iterations.tolerances.cast_max_iterations = 0;
+  const auto uncertain = Scene::load(dir.path("planar.yaml"), no_iterations);
+  MotionOptions one_query, one_state = sampled(1e-3), cast;
+  one_query.max_queries = 1;
+  one_state.max_samples = 1;
+  cast.mode = MotionMode::Cast;
+  const MotionChecker exact(scene), query_capped(scene, one_query), state_capped(scene, one_state);
+  const MotionChecker gjk_capped(uncertain), cast_capped(uncertain, cast), sampled_capped(uncertain, sampled(0.05));
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> s1(-3.1, 3.1), s2(-2.5, 2.5);
+  int query_caps = 0, state_caps = 0, refused_states = 0, segments = 0;
+  int narrow_collisions[3] = {0, 0, 0}, exact_collisions = 0;
+  for (int trial = 0; trial < 150; ++trial) {
+    const std::vector<double> q0{s1(rng), s2(rng)}, q1{s1(rng), s2(rng)};
+    // States: the scene without iterations may refuse free states, never accept colliding ones.
+    for (const auto& q : {q0, q1}) {
+      const bool free = scene->isFree(q), capped_free = uncertain->isFree(q);
+      if (capped_free) EXPECT_TRUE(free) << "trial " << trial;
+      refused_states += free && !capped_free;
+    }
+    if (!scene->isFree(q0) || !scene->isFree(q1)) continue;
+    ++segments;
+    MotionContext c = exact.makeContext();
+    const MotionResult reference = exact.check(q0.data(), q1.data(), c);
+    MotionContext cq = query_capped.makeContext();
+    const MotionResult q = query_capped.check(q0.data(), q1.data(), cq);
+    if (q.capped) {
+      ++query_caps;
+      EXPECT_FALSE(q.free) << "trial " << trial;
+    }
+    MotionContext cs = state_capped.makeContext();
+    const MotionResult st = state_capped.check(q0.data(), q1.data(), cs);
+    if (st.capped) {
+      ++state_caps;
+      EXPECT_FALSE(st.free) << "trial " << trial;
+    }
+    int k = 0;
+    for (const MotionChecker* m : {&gjk_capped, &cast_capped, &sampled_capped}) {
+      MotionContext cm = m->makeContext();
+      const MotionResult r = m->check(q0.data(), q1.data(), cm);
+      if (!reference.free) EXPECT_FALSE(r.free) << "trial " << trial << " checker " << k;
+      narrow_collisions[k++] += !r.free;
+    }
+    exact_collisions += !reference.free;
+    for (const MotionResult* r : {&q, &st})
+      if (!reference.free) EXPECT_FALSE(r->free) << "trial " << trial;
+  }
+  EXPECT_GT(segments, 20);
+  EXPECT_GT(query_caps, segments / 2);
+  EXPECT_EQ(state_caps, segments);  // a 1 mm resolution needs more than one state on any segment drawn
+  EXPECT_GT(refused_states, 0);
+  // With no iterations nothing near an obstacle can be certified: motions that pass near one end there.
+  // The certified and cast loops decide most items by bounds that need no GJK iterations (boxes, spheres,
+  // the parts' lower bounds give 0 and fall through to contact), so they may refuse no more than the
+  // exact scene; sampling over the capped scene refuses more.
+  EXPECT_GT(narrow_collisions[2], exact_collisions);
+  for (int k = 0; k < 2; ++k) EXPECT_GE(narrow_collisions[k], exact_collisions) << "checker " << k;
+}
+
 TEST(MotionCertified, BadInput) {
   TempDir dir;
   const auto scene =
