@@ -799,13 +799,9 @@ void randomStep(const Scene& scene, std::mt19937& rng, std::vector<double>& q0, 
 // The bounds on the shared robots, where the reaches come from real meshes, rigid grippers and chains
 // that fork: over random steps, no hull vertex of a link moves farther than link() says, and no distance
 // between hull vertices of a checked pair changes by more than pair() says.
-TEST(MotionBound, HoldsOnTheSharedRobots) {
-  const std::string root = std::string(CLEARWAY_SHARED_DIR) + "/scenes";
-  if (!std::filesystem::is_directory(root) || test::sharedRobot("panda/panda.urdf").empty())
-    GTEST_SKIP() << "shared scenes not found at " << root << " (see DATA.md)";
-  std::mt19937 rng(11);
-  for (const char* name : {"box_panda/box_panda_0001.yaml", "box_ur5/box_ur5_0001.yaml"}) {
-    const auto scene = std::make_shared<const Scene>(parseSceneFile(root + "/" + name));
+void expectBoundsHold(const std::shared_ptr<const Scene>& scene, std::mt19937& rng) {
+  const std::string name = scene->name();
+  {
     const MotionBound bound(*scene);
     const int n = scene->dimension();
     SceneContext c0 = scene->makeContext(), c1 = scene->makeContext();
@@ -866,6 +862,86 @@ TEST(MotionBound, HoldsOnTheSharedRobots) {
     }
     EXPECT_GT(checked, 1000) << name;
   }
+}
+
+TEST(MotionBound, HoldsOnTheSharedRobots) {
+  CLEARWAY_REQUIRE_SHARED("robots/panda/panda.urdf");
+  CLEARWAY_SHARED_OR_SKIP(root, "scenes");
+  std::mt19937 rng(11);
+  for (const char* name : {"box_panda/box_panda_0001.yaml", "box_ur5/box_ur5_0001.yaml"})
+    expectBoundsHold(std::make_shared<const Scene>(parseSceneFile(root + "/" + name)), rng);
+}
+
+// The two-armed robot (robots/twin_arm): its tree forks at the torso, so pairs with one link on each arm
+// take the bound's code for links on two branches (their motions relative to each other add up from the
+// fork, not along one chain). The shared robots are serial chains, and so are our others.
+std::shared_ptr<const Scene> twinArmScene() {
+  return Scene::load(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/twin_arm_table.yaml");
+}
+
+TEST(MotionBound, HoldsForLinksOnTwoBranchesOfAFork) {
+  const auto scene = twinArmScene();
+  int across = 0;
+  for (const LinkPair& p : scene->selfCollision().pairs()) {
+    const std::string a = scene->robot().link(p.a).name, b = scene->robot().link(p.b).name;
+    across += (a.rfind("left_", 0) == 0 && b.rfind("right_", 0) == 0) || (a.rfind("right_", 0) == 0 && b.rfind("left_", 0) == 0);
+  }
+  EXPECT_EQ(across, 16);  // every link of one arm against every link of the other
+  std::mt19937 rng(13);
+  for (int round = 0; round < 3; ++round) expectBoundsHold(scene, rng);
+}
+
+TEST(MotionCertified, BranchingPaddedRobotNeverMissesWhatDenseSamplingFinds) {
+  // The two arms over a table, by a thin post and under a thin bar, with 1 cm of padding: random steps
+  // between free states, checked by the certified loop and by dense sampling (2 mm in the joint vector).
+  // A collision sampling finds must be found no later; the arms meet each other often enough that
+  // self-collisions across the fork are among them.
+  const auto scene = twinArmScene();
+  ASSERT_GT(scene->description().padding, 0.0);
+  const MotionChecker certified(scene);
+  MotionContext ctx = certified.makeContext();
+  const MotionChecker fine(scene, sampled(2e-3));
+  MotionContext fc = fine.makeContext();
+  std::mt19937 rng(14);
+  const int n = scene->dimension();
+  int collide = 0, free = 0, misses = 0, across = 0;
+  for (int trial = 0; trial < 6000; ++trial) {
+    // Half the segments between random states, half short steps (free more often).
+    std::vector<double> q0 = randomState(*scene, rng), q1 = randomState(*scene, rng), dq(n);
+    if (trial % 2) randomStep(*scene, rng, q0, q1, dq);
+    if (!scene->isFree(q0) || !scene->isFree(q1)) continue;
+    const MotionResult c = certified.check(q0.data(), q1.data(), ctx);
+    const MotionResult d = fine.check(q0.data(), q1.data(), fc);
+    EXPECT_FALSE(c.capped);
+    (c.free ? free : collide)++;
+    if (!d.free) {
+      misses += c.free;
+      EXPECT_FALSE(c.free) << "trial " << trial << ": certified missed a collision sampling found";
+      EXPECT_LE(c.first_contact, d.first_contact + 1e-9) << "trial " << trial;
+      if (d.report.kind != CollisionReport::Kind::Self) continue;
+      const std::string a = scene->robot().link(d.report.link).name, b = scene->robot().link(d.report.other_link).name;
+      across += (a.rfind("left_", 0) == 0 && b.rfind("right_", 0) == 0) || (a.rfind("right_", 0) == 0 && b.rfind("left_", 0) == 0);
+    }
+  }
+  std::printf("twin_arm: %d segments free, %d collide (%d first between the arms), %d missed\n", free, collide, across,
+              misses);
+  EXPECT_EQ(misses, 0);
+  EXPECT_GT(collide, 30);
+  EXPECT_GT(free, 30);
+  // Random segments meet the torso, table and bar first; one that folds the left forearm across the right
+  // arm meets the other branch: both checks find it, the certified one no later.
+  std::vector<double> q0(n, 0.0), q1(n, 0.0);
+  q1[3] = -2.5;  // left_elbow
+  ASSERT_TRUE(scene->isFree(q0));
+  const MotionResult c = certified.check(q0.data(), q1.data(), ctx);
+  const MotionResult d = fine.check(q0.data(), q1.data(), fc);
+  ASSERT_FALSE(d.free);
+  ASSERT_EQ(d.report.kind, CollisionReport::Kind::Self) << scene->describe(d.report);
+  const std::string a = scene->robot().link(d.report.link).name, b = scene->robot().link(d.report.other_link).name;
+  EXPECT_TRUE((a.rfind("left_", 0) == 0 && b.rfind("right_", 0) == 0) || (a.rfind("right_", 0) == 0 && b.rfind("left_", 0) == 0))
+      << scene->describe(d.report);
+  EXPECT_FALSE(c.free);
+  EXPECT_LE(c.first_contact, d.first_contact + 1e-9);
 }
 
 // The slider with a 1 mm wall that starts at x = x0 and moves along +x at 1 m/s (checks: moving).
