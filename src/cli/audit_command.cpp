@@ -30,7 +30,9 @@ const char* const kAuditUsage =
     "Default (colliding at the default configuration), Always (colliding in >= 95% of N random\n"
     "configurations), Never (never seen colliding), or checked; with the evidence (samples, colliding count,\n"
     "95% Clopper-Pearson upper bound on the collision probability, smallest clearance seen; 'near' marks\n"
-    "a Never pair that came within 1 mm). Prints a summary, and with --srdf the pairs where the given SRDF\n"
+    "a Never pair that came within 1 mm). Default pairs are sampled too. Prints first the pairs whose\n"
+    "verdict may mislead: disabled (Default, or by the --srdf given) yet colliding in more than 1% of the\n"
+    "samples, or checked yet colliding in most; then a summary, and with --srdf the pairs where the given SRDF\n"
     "and the audit disagree. --srdf-out writes disable_collisions for every classified pair; --report a\n"
     "Markdown table of all pairs and, beside it (REPORT with .png), a heat map of the link-pair matrix\n"
     "(drawn by gnuplot when installed). A progress bar goes to stderr on a terminal.\n"
@@ -50,6 +52,17 @@ std::string clearanceText(double c) {
   std::snprintf(buf, sizeof buf, "%.4g", c);
   return buf;
 }
+
+// The measured evidence of a pair, or "" for a pair that was not sampled (Adjacent).
+std::string evidenceText(const PairAudit& p) {
+  if (p.samples == 0) return "";
+  std::ostringstream out;
+  out << " (" << p.colliding << "/" << p.samples << " colliding, p <= " << p.p_upper << ", min clearance "
+      << clearanceText(p.min_clearance) << ")";
+  return out.str();
+}
+
+double collidingFraction(const PairAudit& p) { return p.samples > 0 ? static_cast<double>(p.colliding) / p.samples : 0.0; }
 
 // A bar on stderr, redrawn in place: only on a terminal (logs and pipes get the summary lines alone).
 void progressBar(int done, int total) {
@@ -199,6 +212,30 @@ int auditCommand(const std::vector<std::string>& args) {
   if (isatty(STDERR_FILENO)) options.progress = progressBar;
   const std::vector<PairAudit> audit = auditSelfCollision(geometry, options);
 
+  // The pairs whose verdict may mislead come first, the most often colliding first: the audit's own
+  // (Default pairs that collide elsewhere, checked pairs that collide in most samples), and pairs the
+  // given SRDF disables that the samples show colliding.
+  std::vector<std::pair<const PairAudit*, std::string>> warnings;
+  for (const PairAudit& p : audit) {
+    if (!p.warning.empty()) {
+      warnings.emplace_back(&p, p.warning);
+      continue;
+    }
+    const auto it = shipped.find({p.a, p.b});
+    if (it == shipped.end() || p.samples == 0 || p.reason == "Always") continue;
+    const double fraction = collidingFraction(p);
+    if (fraction > options.warn_fraction) {
+      std::ostringstream why;
+      why << srdf << " disables it (" << it->second << ") but it collides in " << p.colliding << " of " << p.samples
+          << " samples (" << 100.0 * fraction << "%)";
+      warnings.emplace_back(&p, why.str());
+    }
+  }
+  std::stable_sort(warnings.begin(), warnings.end(),
+                   [](const auto& x, const auto& y) { return collidingFraction(*x.first) > collidingFraction(*y.first); });
+  for (const auto& [p, why] : warnings)
+    std::cout << "warning: " << model->link(p->a).name << " " << model->link(p->b).name << ": " << why << "\n";
+
   std::map<std::string, int> counts;
   int near = 0;
   for (const PairAudit& p : audit) {
@@ -217,8 +254,7 @@ int auditCommand(const std::vector<std::string>& args) {
       ++differ;
       std::cout << "differs: " << model->link(p.a).name << " " << model->link(p.b).name << ": SRDF "
                 << (theirs.empty() ? "checked" : theirs) << ", audit " << (p.reason.empty() ? "checked" : p.reason)
-                << " (" << p.colliding << "/" << p.samples << " colliding, p <= " << p.p_upper << ", min clearance "
-                << clearanceText(p.min_clearance) << ")\n";
+                << evidenceText(p) << "\n";
     }
     std::cout << differ << " pairs differ from " << srdf << "\n";
   }
@@ -242,10 +278,22 @@ int auditCommand(const std::vector<std::string>& args) {
     if (drawn) out << "![link-pair matrix](" << png.filename().string() << ")\n\n";
     out << "| link 1 | link 2 | verdict | colliding | samples | p (95% upper) | min clearance (m) |\n"
         << "|---|---|---|---|---|---|---|\n";
+    // Warned pairs first (in the order printed), then the rest; unmeasured cells are "-".
+    std::vector<const PairAudit*> rows;
+    for (const auto& w : warnings) rows.push_back(w.first);
     for (const PairAudit& p : audit)
-      out << "| " << model->link(p.a).name << " | " << model->link(p.b).name << " | "
-          << (p.reason.empty() ? "checked" : p.reason) << (p.near_miss ? " (near)" : "") << " | " << p.colliding
-          << " | " << p.samples << " | " << p.p_upper << " | " << clearanceText(p.min_clearance) << " |\n";
+      if (std::find(rows.begin(), rows.end(), &p) == rows.end()) rows.push_back(&p);
+    for (const PairAudit* p : rows) {
+      const bool measured = p->samples > 0;
+      std::ostringstream pu;
+      pu << p->p_upper;
+      out << "| " << model->link(p->a).name << " | " << model->link(p->b).name << " | "
+          << (p->reason.empty() ? "checked" : p->reason) << (p->near_miss ? " (near)" : "")
+          << (std::find_if(warnings.begin(), warnings.end(), [&](const auto& w) { return w.first == p; }) != warnings.end()
+                  ? " (warning)" : "")
+          << " | " << (measured ? std::to_string(p->colliding) : "-") << " | " << (measured ? std::to_string(p->samples) : "-")
+          << " | " << (measured ? pu.str() : "-") << " | " << clearanceText(p->min_clearance) << " |\n";
+    }
     if (!out) {
       std::cerr << "clearway audit: cannot write " << report << "\n";
       return kExitUsage;

@@ -20,9 +20,15 @@ cleanup() {
 }
 trap cleanup EXIT
 
+# The shared data as the C++ tests find it (tests/shared_data.h): $CLEARWAY_SHARED, else ../shared; with
+# CI=true it must be there.
+shared=${CLEARWAY_SHARED:-$source_dir/../shared}
 args=(narrowphase --count 10 --seed 5)
-if [ -d "$source_dir/../shared/scenes" ]; then
-  args=(narrowphase states --count 8 --subjects hull16,box-capsule,cylinder-cone,box_panda --seed 5)
+if [ -d "$shared/scenes" ]; then
+  args=(narrowphase states --count 8 --subjects hull16,box-capsule,cylinder-cone,box_panda --seed 5 --shared "$shared")
+elif [ "${CI:-}" = true ]; then
+  echo "shared data not found: $shared/scenes (required because CI=true)" >&2
+  exit 1
 fi
 "$clearway" bench "${args[@]}" --out "$work/all" >/dev/null 2>"$work/all.err" || { cat "$work/all.err"; exit 1; }
 

@@ -3,6 +3,7 @@
 // (a shard out of range, a missing or repeated shard, a truncated file, mixed configurations) is a
 // clear error.
 #include "cli/tool_run.h"
+#include "shared_data.h"
 
 #include <gtest/gtest.h>
 
@@ -21,7 +22,9 @@ namespace {
 
 #define EXPECT_MENTIONS(text, key) EXPECT_NE((text).find(key), std::string::npos) << "\"" << (text) << "\" should name " << (key)
 
-bool haveSharedScenes() { return fs::is_directory(std::string(CLEARWAY_SHARED_DIR) + "/scenes"); }
+// The shared scenes when present; when CI=true they must be (the tests that use them fail otherwise).
+bool haveSharedScenes() { return fs::is_directory(clearway::test::sharedDir() + "/scenes") || clearway::test::sharedDataRequired(); }
+std::string sharedArg() { return " --shared '" + clearway::test::sharedDir() + "'"; }
 
 std::string tempDir(const std::string& name) {
   const std::string dir = testing::TempDir() + "clearway_bench_" + name + "_" + std::to_string(::getpid());
@@ -60,14 +63,14 @@ std::vector<std::string> rowsWithoutTime(const std::string& file) {
 
 // The bench arguments of the shard tests: the shape families always, two shared problems when present.
 std::string shardArgs() {
-  return haveSharedScenes() ? "narrowphase states --count 12 --subjects hull16,box-capsule,box_panda,cage_ur5 --seed 7"
+  return haveSharedScenes() ? "narrowphase states --count 12 --subjects hull16,box-capsule,box_panda,cage_ur5 --seed 7" + sharedArg()
                             : "narrowphase --count 12 --seed 7";
 }
 
 }  // namespace
 
 TEST(BenchTool, ShardsMergeIntoTheUnshardedRun) {
-  if (!haveSharedScenes()) std::cerr << "[ note ] no shared scenes at " CLEARWAY_SHARED_DIR ": narrowphase only\n";
+  if (!haveSharedScenes()) std::cerr << "[ note ] " << clearway::test::sharedMissing("scenes") << ": narrowphase only\n";
   const std::string dir = tempDir("shards");
   ToolRun r = runTool("bench " + shardArgs() + " --out '" + dir + "/all'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -125,9 +128,9 @@ TEST(BenchTool, ResultsParseBackAndAccuracyFollowsTheTolerance) {
 }
 
 TEST(BenchTool, PlanningWritesOmplBenchmarkLogs) {
-  if (!haveSharedScenes()) GTEST_SKIP() << "no shared scenes at " CLEARWAY_SHARED_DIR;
+  CLEARWAY_REQUIRE_SHARED("scenes");
   const std::string dir = tempDir("plan");
-  const ToolRun r = runTool("bench plan --subjects box_panda --plan-runs 2 --plan-time 20 --out '" + dir + "'");
+  const ToolRun r = runTool("bench plan --subjects box_panda --plan-runs 2 --plan-time 20" + sharedArg() + " --out '" + dir + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   int logs = 0;
   for (const auto& entry : fs::directory_iterator(dir + "/plan")) {

@@ -6,6 +6,8 @@
 #include <octomap/ColorOcTree.h>
 #include <octomap/OcTree.h>
 
+#include "shared_data.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -244,8 +246,7 @@ TEST(OctomapLoader, FullFormatRoundTripMatchesBinary) {
 }
 
 TEST(OctomapLoader, RealMapMatchesOctomapLeafIteration) {
-  const std::string path = std::string(CLEARWAY_SHARED_DIR) + "/scenes/box_panda/box_panda_0001.bt";
-  if (!fs::exists(path)) GTEST_SKIP() << "shared scenes not found: " << path;
+  CLEARWAY_SHARED_OR_SKIP(path, "scenes/box_panda/box_panda_0001.bt");
   const OccupancyMap map = loadOctomap(path);
   EXPECT_DOUBLE_EQ(map.resolution, 0.02);
   EXPECT_GT(map.occupied.size(), 0u);
@@ -386,8 +387,7 @@ TEST(OctomapLoader, TruncatedFilesAlwaysThrow) {
 }
 
 TEST(OctomapLoader, TruncatedRealMap) {
-  const std::string path = std::string(CLEARWAY_SHARED_DIR) + "/scenes/box_panda/box_panda_0001.bt";
-  if (!fs::exists(path)) GTEST_SKIP() << "shared scenes not found: " << path;
+  CLEARWAY_SHARED_OR_SKIP(path, "scenes/box_panda/box_panda_0001.bt");
   TempDir dir;
   const std::string whole = readBytes(path);
   writeBytes(dir.file("cut.bt"), whole.substr(0, whole.size() - 1));

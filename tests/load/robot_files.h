@@ -4,6 +4,8 @@
 // that a LoadError names what it should.
 #include <clearway/load/load_error.h>
 
+#include "shared_data.h"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -48,17 +50,11 @@ class TempDir {
 /// robots/<rel> in the source tree.
 inline std::string sourceRobot(const std::string& rel) { return std::string(CLEARWAY_SOURCE_DIR) + "/robots/" + rel; }
 
-/// ../shared/robots/<rel>, or "" when the shared data is not there.
-inline std::string sharedRobot(const std::string& rel) {
-  const std::string p = std::string(CLEARWAY_SHARED_DIR) + "/robots/" + rel;
-  return std::filesystem::exists(p) ? p : "";
-}
+/// <shared>/robots/<rel> (shared_data.h), or "" when the shared data is not there.
+inline std::string sharedRobot(const std::string& rel) { return sharedPath("robots/" + std::string(rel)); }
 
-#define CLEARWAY_SHARED_ROBOT_OR_SKIP(var, rel)                                                        \
-  const std::string var = ::clearway::test::sharedRobot(rel);                                        \
-  if (var.empty())                                                                                   \
-    GTEST_SKIP() << "shared robot data not found: " << CLEARWAY_SHARED_DIR << "/robots/" << rel       \
-                 << " (the development data next to the repository; see DATA.md)"
+/// Declares `var` = <shared>/robots/<rel>; a missing file skips the test, or fails it when CI=true.
+#define CLEARWAY_SHARED_ROBOT_OR_SKIP(var, rel) CLEARWAY_SHARED_OR_SKIP(var, "robots/" + std::string(rel))
 
 /// A closed unit-free tetrahedron as an ASCII STL (4 outward triangles).
 inline std::string tetrahedronStl(const std::string& extra_facets = "") {

@@ -347,6 +347,78 @@ TEST(MotionCertified, RandomSegmentsNeverMissWhatDenseSamplingFinds) {
   EXPECT_GT(free, 20);
 }
 
+TEST(MotionCertified, EveryCapEndsInACollision) {
+  // The planar arm among two posts, with each cap forced: the certified loop's query cap, the sampled
+  // check's state cap, and the narrow phase's iteration caps (GJK, EPA, casts at 0) under the scene's
+  // states and every motion mode. A capped answer is a collision, never free; no capped checker is freer
+  // than the uncapped one; and each cap is reached at least once, or this proves nothing.
+  TempDir dir;
+  const std::string obstacles =
+      "    - {name: post, cylinder: {radius: 0.03, length: 1}, pose: {position: [0, 1.2, 0]}}\n"
+      "    - {name: rod, box: {size: [0.02, 0.02, 1]}, pose: {position: [-0.9, -0.9, 0]}}\n";
+  const auto scene = planarScene(dir, obstacles);
+  SceneOptions no_iterations;
+  no_iterations.tolerances.gjk_max_iterations = 0;
+  no_iterations.tolerances.epa_max_iterations = 0;
+  no_iterations.tolerances.cast_max_iterations = 0;
+  const auto uncertain = Scene::load(dir.path("planar.yaml"), no_iterations);
+  MotionOptions one_query, one_state = sampled(1e-3), cast;
+  one_query.max_queries = 1;
+  one_state.max_samples = 1;
+  cast.mode = MotionMode::Cast;
+  const MotionChecker exact(scene), query_capped(scene, one_query), state_capped(scene, one_state);
+  const MotionChecker gjk_capped(uncertain), cast_capped(uncertain, cast), sampled_capped(uncertain, sampled(0.05));
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> s1(-3.1, 3.1), s2(-2.5, 2.5);
+  int query_caps = 0, state_caps = 0, refused_states = 0, segments = 0;
+  int narrow_collisions[3] = {0, 0, 0}, exact_collisions = 0;
+  for (int trial = 0; trial < 150; ++trial) {
+    const std::vector<double> q0{s1(rng), s2(rng)}, q1{s1(rng), s2(rng)};
+    // States: the scene without iterations may refuse free states, never accept colliding ones.
+    for (const auto& q : {q0, q1}) {
+      const bool free = scene->isFree(q), capped_free = uncertain->isFree(q);
+      if (capped_free) EXPECT_TRUE(free) << "trial " << trial;
+      refused_states += free && !capped_free;
+    }
+    if (!scene->isFree(q0) || !scene->isFree(q1)) continue;
+    ++segments;
+    MotionContext c = exact.makeContext();
+    const MotionResult reference = exact.check(q0.data(), q1.data(), c);
+    MotionContext cq = query_capped.makeContext();
+    const MotionResult q = query_capped.check(q0.data(), q1.data(), cq);
+    if (q.capped) {
+      ++query_caps;
+      EXPECT_FALSE(q.free) << "trial " << trial;
+    }
+    MotionContext cs = state_capped.makeContext();
+    const MotionResult st = state_capped.check(q0.data(), q1.data(), cs);
+    if (st.capped) {
+      ++state_caps;
+      EXPECT_FALSE(st.free) << "trial " << trial;
+    }
+    int k = 0;
+    for (const MotionChecker* m : {&gjk_capped, &cast_capped, &sampled_capped}) {
+      MotionContext cm = m->makeContext();
+      const MotionResult r = m->check(q0.data(), q1.data(), cm);
+      if (!reference.free) EXPECT_FALSE(r.free) << "trial " << trial << " checker " << k;
+      narrow_collisions[k++] += !r.free;
+    }
+    exact_collisions += !reference.free;
+    for (const MotionResult* r : {&q, &st})
+      if (!reference.free) EXPECT_FALSE(r->free) << "trial " << trial;
+  }
+  EXPECT_GT(segments, 20);
+  EXPECT_GT(query_caps, segments / 2);
+  EXPECT_EQ(state_caps, segments);  // a 1 mm resolution needs more than one state on any segment drawn
+  EXPECT_GT(refused_states, 0);
+  // With no iterations nothing near an obstacle can be certified: motions that pass near one end there.
+  // The certified and cast loops decide most items by bounds that need no GJK iterations (boxes, spheres,
+  // the parts' lower bounds give 0 and fall through to contact), so they may refuse no more than the
+  // exact scene; sampling over the capped scene refuses more.
+  EXPECT_GT(narrow_collisions[2], exact_collisions);
+  for (int k = 0; k < 2; ++k) EXPECT_GE(narrow_collisions[k], exact_collisions) << "checker " << k;
+}
+
 TEST(MotionCertified, BadInput) {
   TempDir dir;
   const auto scene =
@@ -727,13 +799,9 @@ void randomStep(const Scene& scene, std::mt19937& rng, std::vector<double>& q0, 
 // The bounds on the shared robots, where the reaches come from real meshes, rigid grippers and chains
 // that fork: over random steps, no hull vertex of a link moves farther than link() says, and no distance
 // between hull vertices of a checked pair changes by more than pair() says.
-TEST(MotionBound, HoldsOnTheSharedRobots) {
-  const std::string root = std::string(CLEARWAY_SHARED_DIR) + "/scenes";
-  if (!std::filesystem::is_directory(root) || test::sharedRobot("panda/panda.urdf").empty())
-    GTEST_SKIP() << "shared scenes not found at " << root << " (see DATA.md)";
-  std::mt19937 rng(11);
-  for (const char* name : {"box_panda/box_panda_0001.yaml", "box_ur5/box_ur5_0001.yaml"}) {
-    const auto scene = std::make_shared<const Scene>(parseSceneFile(root + "/" + name));
+void expectBoundsHold(const std::shared_ptr<const Scene>& scene, std::mt19937& rng) {
+  const std::string name = scene->name();
+  {
     const MotionBound bound(*scene);
     const int n = scene->dimension();
     SceneContext c0 = scene->makeContext(), c1 = scene->makeContext();
@@ -794,6 +862,86 @@ TEST(MotionBound, HoldsOnTheSharedRobots) {
     }
     EXPECT_GT(checked, 1000) << name;
   }
+}
+
+TEST(MotionBound, HoldsOnTheSharedRobots) {
+  CLEARWAY_REQUIRE_SHARED("robots/panda/panda.urdf");
+  CLEARWAY_SHARED_OR_SKIP(root, "scenes");
+  std::mt19937 rng(11);
+  for (const char* name : {"box_panda/box_panda_0001.yaml", "box_ur5/box_ur5_0001.yaml"})
+    expectBoundsHold(std::make_shared<const Scene>(parseSceneFile(root + "/" + name)), rng);
+}
+
+// The two-armed robot (robots/twin_arm): its tree forks at the torso, so pairs with one link on each arm
+// take the bound's code for links on two branches (their motions relative to each other add up from the
+// fork, not along one chain). The shared robots are serial chains, and so are our others.
+std::shared_ptr<const Scene> twinArmScene() {
+  return Scene::load(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/twin_arm_table.yaml");
+}
+
+TEST(MotionBound, HoldsForLinksOnTwoBranchesOfAFork) {
+  const auto scene = twinArmScene();
+  int across = 0;
+  for (const LinkPair& p : scene->selfCollision().pairs()) {
+    const std::string a = scene->robot().link(p.a).name, b = scene->robot().link(p.b).name;
+    across += (a.rfind("left_", 0) == 0 && b.rfind("right_", 0) == 0) || (a.rfind("right_", 0) == 0 && b.rfind("left_", 0) == 0);
+  }
+  EXPECT_EQ(across, 16);  // every link of one arm against every link of the other
+  std::mt19937 rng(13);
+  for (int round = 0; round < 3; ++round) expectBoundsHold(scene, rng);
+}
+
+TEST(MotionCertified, BranchingPaddedRobotNeverMissesWhatDenseSamplingFinds) {
+  // The two arms over a table, by a thin post and under a thin bar, with 1 cm of padding: random steps
+  // between free states, checked by the certified loop and by dense sampling (2 mm in the joint vector).
+  // A collision sampling finds must be found no later; the arms meet each other often enough that
+  // self-collisions across the fork are among them.
+  const auto scene = twinArmScene();
+  ASSERT_GT(scene->description().padding, 0.0);
+  const MotionChecker certified(scene);
+  MotionContext ctx = certified.makeContext();
+  const MotionChecker fine(scene, sampled(2e-3));
+  MotionContext fc = fine.makeContext();
+  std::mt19937 rng(14);
+  const int n = scene->dimension();
+  int collide = 0, free = 0, misses = 0, across = 0;
+  for (int trial = 0; trial < 6000; ++trial) {
+    // Half the segments between random states, half short steps (free more often).
+    std::vector<double> q0 = randomState(*scene, rng), q1 = randomState(*scene, rng), dq(n);
+    if (trial % 2) randomStep(*scene, rng, q0, q1, dq);
+    if (!scene->isFree(q0) || !scene->isFree(q1)) continue;
+    const MotionResult c = certified.check(q0.data(), q1.data(), ctx);
+    const MotionResult d = fine.check(q0.data(), q1.data(), fc);
+    EXPECT_FALSE(c.capped);
+    (c.free ? free : collide)++;
+    if (!d.free) {
+      misses += c.free;
+      EXPECT_FALSE(c.free) << "trial " << trial << ": certified missed a collision sampling found";
+      EXPECT_LE(c.first_contact, d.first_contact + 1e-9) << "trial " << trial;
+      if (d.report.kind != CollisionReport::Kind::Self) continue;
+      const std::string a = scene->robot().link(d.report.link).name, b = scene->robot().link(d.report.other_link).name;
+      across += (a.rfind("left_", 0) == 0 && b.rfind("right_", 0) == 0) || (a.rfind("right_", 0) == 0 && b.rfind("left_", 0) == 0);
+    }
+  }
+  std::printf("twin_arm: %d segments free, %d collide (%d first between the arms), %d missed\n", free, collide, across,
+              misses);
+  EXPECT_EQ(misses, 0);
+  EXPECT_GT(collide, 30);
+  EXPECT_GT(free, 30);
+  // Random segments meet the torso, table and bar first; one that folds the left forearm across the right
+  // arm meets the other branch: both checks find it, the certified one no later.
+  std::vector<double> q0(n, 0.0), q1(n, 0.0);
+  q1[3] = -2.5;  // left_elbow
+  ASSERT_TRUE(scene->isFree(q0));
+  const MotionResult c = certified.check(q0.data(), q1.data(), ctx);
+  const MotionResult d = fine.check(q0.data(), q1.data(), fc);
+  ASSERT_FALSE(d.free);
+  ASSERT_EQ(d.report.kind, CollisionReport::Kind::Self) << scene->describe(d.report);
+  const std::string a = scene->robot().link(d.report.link).name, b = scene->robot().link(d.report.other_link).name;
+  EXPECT_TRUE((a.rfind("left_", 0) == 0 && b.rfind("right_", 0) == 0) || (a.rfind("right_", 0) == 0 && b.rfind("left_", 0) == 0))
+      << scene->describe(d.report);
+  EXPECT_FALSE(c.free);
+  EXPECT_LE(c.first_contact, d.first_contact + 1e-9);
 }
 
 // The slider with a 1 mm wall that starts at x = x0 and moves along +x at 1 m/s (checks: moving).
@@ -892,9 +1040,8 @@ TEST(MotionCertified, MovingObstaclesNeverMissWhatDenseSamplingFinds) {
 // pair(part, other) says; and a part next to the axes that turn it gets a bound well below its link's
 // (the UR5's upper arm turns about the shoulder, where its near end sits beside the base).
 TEST(MotionBound, HoldsForConvexParts) {
-  const std::string root = std::string(CLEARWAY_SHARED_DIR) + "/scenes";
-  if (!std::filesystem::is_directory(root) || test::sharedRobot("panda/panda.urdf").empty())
-    GTEST_SKIP() << "shared scenes not found at " << root << " (see DATA.md)";
+  CLEARWAY_REQUIRE_SHARED("robots/panda/panda.urdf");
+  CLEARWAY_SHARED_OR_SKIP(root, "scenes");
   std::mt19937 rng(5);
   for (const char* name : {"box_panda/box_panda_0001.yaml", "box_ur5/box_ur5_0001.yaml"}) {
     const auto scene = std::make_shared<const Scene>(parseSceneFile(root + "/" + name));
@@ -945,9 +1092,8 @@ TEST(MotionBound, HoldsForConvexParts) {
 // reporting a contact that sampling does not see is allowed only where the robot is truly within
 // contact_distance (clearance measured at the contact parameter).
 TEST(MotionCertified, SharedProblemsAgreeWithDenseSampling) {
-  const std::string root = std::string(CLEARWAY_SHARED_DIR) + "/scenes";
-  if (!std::filesystem::is_directory(root) || test::sharedRobot("panda/panda.urdf").empty())
-    GTEST_SKIP() << "shared scenes not found at " << root << " (see DATA.md)";
+  CLEARWAY_REQUIRE_SHARED("robots/panda/panda.urdf");
+  CLEARWAY_SHARED_OR_SKIP(root, "scenes");
   int segments = 0, both_free = 0, both_hit = 0, certified_only = 0;
   std::mt19937 rng(3);
   for (const char* name : {"bookshelf_small_panda/bookshelf_small_panda_0001.yaml", "box_ur5/box_ur5_0002.yaml",

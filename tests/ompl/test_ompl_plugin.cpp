@@ -94,6 +94,7 @@ TEST(OmplPlugin, StateSpaces) {
 }
 
 TEST(OmplPlugin, ValidityCheckerAgreesWithTheScene) {
+  ompl::RNG::setSeed(11);  // sampled states: a failure replays with the same ones
   const auto scene = Scene::load(bundledScene());
   auto si = std::make_shared<ob::SpaceInformation>(makeStateSpace(*scene));
   const CollisionChecking c = setupCollisionChecking(si, scene);
@@ -205,6 +206,7 @@ void planAndCertify(const std::function<ob::PlannerPtr(const ob::SpaceInformatio
 std::string ourScene(const std::string& name) { return std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/" + name; }
 
 TEST(OmplPlugin, PlanarAndFloatingJointsAreSE2AndSE3) {
+  ompl::RNG::setSeed(12);  // sampled states: a failure replays with the same ones
   const auto rover = Scene::load(ourScene("rover_gap.yaml"));
   const auto flyer = Scene::load(ourScene("flyer_post.yaml"));
   const ob::StateSpacePtr rs = makeStateSpace(*rover), fs = makeStateSpace(*flyer);
@@ -275,9 +277,8 @@ TEST(OmplPlugin, PlansOnTheBundledScene) {
 // A Panda start 0.5 mm below a ceiling: within the certified check's contact distance (1 mm), but free,
 // so it must be leavable and the problem planned (it once used up the whole time limit).
 TEST(OmplPlugin, PlansFromAStartJustBelowACeiling) {
-  const std::string file = std::string(CLEARWAY_SHARED_DIR) + "/scenes/box_panda/box_panda_0001.yaml";
-  if (test::sharedRobot("panda/panda.urdf").empty() || !std::ifstream(file))
-    GTEST_SKIP() << "shared scene not found: " << file;
+  CLEARWAY_REQUIRE_SHARED("robots/panda/panda.urdf");
+  CLEARWAY_SHARED_OR_SKIP(file, "scenes/box_panda/box_panda_0001.yaml");
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
   ompl::RNG::setSeed(5);
   SceneDescription d = parseSceneFile(file);
@@ -325,6 +326,7 @@ TEST(OmplPlugin, PlansFromAStartJustBelowACeiling) {
 // parallel; PRM: the roadmap grows in one thread while another looks for a solution). Run under
 // ThreadSanitizer by scripts/tsan.sh.
 TEST(OmplPlugin, ParallelPlannersShareTheCheckers) {
+  ompl::RNG::setSeed(13);  // sampled states: a failure replays with the same ones
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
   planAndCertify([](const ob::SpaceInformationPtr& si) {
     auto p = std::make_shared<og::pRRT>(si);
@@ -336,6 +338,7 @@ TEST(OmplPlugin, ParallelPlannersShareTheCheckers) {
 
 // Four threads ask the same checkers what one thread asked them: the answers must not change.
 TEST(OmplPlugin, ThreadsShareTheCheckers) {
+  ompl::RNG::setSeed(14);  // sampled states: a failure replays with the same ones
   const auto scene = Scene::load(bundledScene());
   auto si = std::make_shared<ob::SpaceInformation>(makeStateSpace(*scene));
   setupCollisionChecking(si, scene);

@@ -64,6 +64,54 @@ TEST(Audit, KnownAnswers) {
   EXPECT_FALSE(never.near_miss);
   EXPECT_GT(never.min_clearance, 0.3);
   EXPECT_NEAR(never.p_upper, 1.0 - std::pow(0.05, 1.0 / 20000), 1e-12);
+  // Adjacent pairs are not measured: no samples, no clearance, no warning.
+  const PairAudit& adjacent = find(*model, audit, "base", "link1");
+  EXPECT_EQ(adjacent.samples, 0);
+  EXPECT_TRUE(std::isnan(adjacent.min_clearance));
+  EXPECT_EQ(adjacent.warning, "");
+  // Default pairs are sampled too. link1 meets the post in 2·asin(0.1/0.7)/2π = 4.6% of the shoulder's
+  // turn: MoveIt's rule disables the pair, which hides those collisions, so it is flagged. The cap always
+  // overlaps link1's end: disabling it hides nothing a planner could use, so it is not.
+  const PairAudit& post = find(*model, audit, "link1", "post");
+  EXPECT_EQ(post.samples, 20000);
+  EXPECT_NEAR(static_cast<double>(post.colliding) / post.samples, 2.0 * std::asin(0.1 / 0.7) / (2.0 * M_PI), 0.006);
+  EXPECT_EQ(post.min_clearance, 0.0);
+  EXPECT_NE(post.warning.find("disabled as Default but collides in"), std::string::npos) << post.warning;
+  const PairAudit& cap = find(*model, audit, "link1", "cap");
+  EXPECT_EQ(cap.colliding, cap.samples);
+  EXPECT_EQ(cap.warning, "");
+  // With the threshold above its 4.6%, the Default pair is not flagged.
+  options.warn_fraction = 0.06;
+  options.samples = 5000;
+  EXPECT_EQ(find(*model, auditSelfCollision(geometry, options), "link1", "post").warning, "");
+}
+
+TEST(Audit, RigidPairsAreMeasuredOnce) {
+  // A camera on a mast on the base (fixed joints; the mast has geometry, so base and camera are not
+  // adjacent): no joint moves them apart, so their one clearance (0.3 − 0.05 − 0.05 = 0.2 m) holds in
+  // every sample, with probability 0 exactly. The arm is not rigid with the base.
+  TempDir dir;
+  auto model = std::make_shared<const RobotModel>(loadRobot(dir.write("r.urdf", R"(<robot name="r">
+    <link name="base"><collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>
+    <link name="mast"><collision><geometry><cylinder radius="0.01" length="0.05"/></geometry></collision></link>
+    <link name="camera"><collision><geometry><sphere radius="0.05"/></geometry></collision></link>
+    <link name="arm"><collision><origin xyz="0.5 0 0"/><geometry><box size="0.6 0.05 0.05"/></geometry></collision></link>
+    <joint name="m" type="fixed"><parent link="base"/><child link="mast"/><origin xyz="0 0 0.2"/></joint>
+    <joint name="c" type="fixed"><parent link="mast"/><child link="camera"/><origin xyz="0 0 0.1"/></joint>
+    <joint name="j" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 1 0"/>
+      <limit lower="-1" upper="1" velocity="1" effort="1"/></joint>
+  </robot>)")));
+  AuditOptions options;
+  options.samples = 500;
+  const auto audit = auditSelfCollision(std::make_shared<const RobotGeometry>(model), options);
+  const PairAudit& rigid = find(*model, audit, "base", "camera");
+  EXPECT_EQ(rigid.reason, "Never");
+  EXPECT_EQ(rigid.samples, 500);
+  EXPECT_EQ(rigid.p_upper, 0.0);
+  EXPECT_NEAR(rigid.min_clearance, 0.2, 1e-9);
+  const PairAudit& moving = find(*model, audit, "camera", "arm");
+  EXPECT_GT(moving.p_upper, 0.0);
+  EXPECT_EQ(moving.samples, 500);
 }
 
 TEST(Audit, KnownFractionAndAlwaysThreshold) {
@@ -87,6 +135,14 @@ TEST(Audit, KnownFractionAndAlwaysThreshold) {
   // A lower "always" threshold turns the same evidence into Always.
   options.always_fraction = 0.04;
   EXPECT_EQ(find(*model, auditSelfCollision(geometry, options), "link1", "post").reason, "Always");
+  // A checked pair that collides in more than most_fraction of the samples is flagged; at 4.6% it is not
+  // by default.
+  EXPECT_EQ(p.warning, "");
+  options.always_fraction = 0.95;
+  options.most_fraction = 0.03;
+  const std::string warning = find(*model, auditSelfCollision(geometry, options), "link1", "post").warning;
+  EXPECT_NE(warning.find("checked but collides in"), std::string::npos) << warning;
+  options.most_fraction = 0.5;
   // The same seed gives the same audit on one thread or two.
   options.always_fraction = 0.95;
   options.samples = 3000;
@@ -148,6 +204,12 @@ TEST(Audit, BadInput) {
   EXPECT_THROW(auditSelfCollision(geometry, o), std::invalid_argument);
   o = {};
   o.always_fraction = 1.5;
+  EXPECT_THROW(auditSelfCollision(geometry, o), std::invalid_argument);
+  o = {};
+  o.warn_fraction = -0.1;
+  EXPECT_THROW(auditSelfCollision(geometry, o), std::invalid_argument);
+  o = {};
+  o.most_fraction = 2;
   EXPECT_THROW(auditSelfCollision(geometry, o), std::invalid_argument);
 }
 

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "shared_data.h"
 #include "tree/mesh_reference.h"
 
 namespace clearway {
@@ -142,7 +143,7 @@ TEST(LinkGeometry, PaddingMatchesBruteForce) {
   runRandomCases(generatedMeshes(), 23, 6, 0.05);
 }
 
-std::string pandaMeshDir() { return std::string(CLEARWAY_SHARED_DIR) + "/robots/panda/meshes/collision"; }
+std::string pandaMeshDir() { return test::sharedDir() + "/robots/panda/meshes/collision"; }
 
 std::vector<TestMesh> pandaMeshes() {
   std::vector<TestMesh> out;
@@ -155,8 +156,7 @@ std::vector<TestMesh> pandaMeshes() {
 }
 
 TEST(LinkGeometry, MeshModeMatchesBruteForceOnPandaLinks) {
-  if (!std::filesystem::is_directory(pandaMeshDir()))
-    GTEST_SKIP() << "no Panda meshes at " << pandaMeshDir() << " (CLEARWAY_SHARED_DIR/robots/panda): skipped";
+  CLEARWAY_REQUIRE_SHARED("robots/panda/meshes/collision");
   const std::vector<TestMesh> meshes = pandaMeshes();
   runRandomCases(meshes, 24, 3, 0.0);
   runRandomCases(meshes, 25, 1, 0.02);
@@ -381,7 +381,8 @@ TEST(LinkGeometry, PrimitivesAgainstPrimitives) {
 TEST(LinkGeometry, DistanceMatchesBruteForce) {
   const std::vector<TestMesh> generated = generatedMeshes();
   std::vector<TestMesh> meshes{generated[0], generated[1], generated[4]};  // sphere, torus, dumbbell
-  if (std::filesystem::is_directory(pandaMeshDir())) {
+  // The Panda's meshes join when present (and must be there when CI=true).
+  if (std::filesystem::is_directory(pandaMeshDir()) || test::sharedDataRequired()) {
     const std::vector<TestMesh> panda = pandaMeshes();
     meshes.push_back(panda[3]);
     meshes.push_back(panda[8]);

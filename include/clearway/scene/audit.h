@@ -21,6 +21,11 @@ struct AuditOptions {
   std::uint64_t seed = 1;         ///< the same seed gives the same audit, whatever the thread count
   double always_fraction = 0.95;  ///< MoveIt's default threshold for "always in collision"
   double near_margin = 1e-3;      ///< a Never pair whose clearance came under this is flagged near_miss
+  /// A Default pair (disabled by MoveIt's rule) that collides in more than this fraction of the samples,
+  /// yet less than always_fraction, gets a warning: disabling it hides those collisions.
+  double warn_fraction = 0.01;
+  /// A pair left checked that collides in more than this fraction of the samples gets a warning.
+  double most_fraction = 0.5;
   int threads = 2;
   Tolerances tolerances = {};
   /// Called from the calling thread with (samples done, samples in all) about every 1% of a run and once
@@ -32,18 +37,24 @@ struct AuditOptions {
 struct PairAudit {
   int a = -1, b = -1;
   std::string reason;        ///< "Adjacent", "Default", "Always", "Never", or "" (must be checked)
-  int samples = 0;           ///< configurations tested (0 for Adjacent and Default pairs)
-  int colliding = 0;
-  double p_upper = 1.0;      ///< 95% upper confidence bound on the collision probability
-  double min_clearance = 0;  ///< smallest exact distance seen over the samples (0 when it collided)
+  int samples = 0;           ///< configurations tested (0 for Adjacent pairs: nothing is measured)
+  int colliding = 0;         ///< samples in collision (for a Default pair, away from the default configuration)
+  /// 95% upper confidence bound on the collision probability; exact (0 or 1) for a rigid pair, whose links
+  /// no sampled joint moves apart, measured once for all samples.
+  double p_upper = 1.0;
+  double min_clearance = 0;  ///< smallest exact distance seen (0 when it collided; NaN when not measured)
   bool near_miss = false;    ///< Never, but closer than near_margin at some sample
+  /// Why the verdict may mislead ("" when it does not): a Default pair that collides in more than
+  /// warn_fraction of the samples, or a checked pair that collides in more than most_fraction.
+  std::string warning;
 };
 
 /// The 95% one-sided Clopper–Pearson upper bound on p after k successes in n trials (1 when n = 0).
 double clopperPearsonUpper(int k, int n);
 
 /// Audits every pair of links with geometry (the SRDF of the model is ignored: adjacency only). Throws
-/// std::invalid_argument when samples < 1, threads < 1 or always_fraction is not in (0, 1].
+/// std::invalid_argument when samples < 1, threads < 1, always_fraction is not in (0, 1] or
+/// warn_fraction or most_fraction is not in [0, 1].
 std::vector<PairAudit> auditSelfCollision(std::shared_ptr<const RobotGeometry> geometry, const AuditOptions& options = {});
 
 /// SRDF text with one disable_collisions element per pair that has a reason, for robot `name`.
