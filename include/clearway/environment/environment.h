@@ -2,7 +2,7 @@
 // The robot's world: primitive and mesh obstacles with poses (some moving at constant velocity), and
 // OctoMap occupancy (occupied leaves at any depth become boxes; unknown space counts as free or as
 // occupied, by choice). Everything sits in AABB trees in the world frame, so a link is tested only
-// against the obstacles and voxels its bounds can touch, then exactly (shape/link_geometry.h).
+// against the obstacles and voxels its bounds can touch, then exactly (body/link_geometry.h).
 #include <clearway/load/load_error.h>
 #include <clearway/shape/triangle_mesh.h>
 #include <clearway/math.h>
