@@ -17,7 +17,7 @@ namespace clearway {
 
 using motion_detail::alignedUnit;
 
-void MotionChecker::castAhead(const double* q0, const double* q1, double t0, int n_items, MotionContext& ctx,
+void MotionChecker::castAhead(const double* q0, const double* q1, double t0, int n_items, motion_detail::Scratch& ctx,
                               MotionResult& r) const noexcept {
   const Scene& sc = *scene_;
   const Tolerances& tol = sc.options().tolerances;
@@ -69,7 +69,7 @@ struct MotionChecker::Sweep {
   static constexpr double kNear = 8.0;
 
   const MotionChecker& mc;
-  MotionContext& ctx;
+  motion_detail::Scratch& ctx;
   MotionResult& r;
   const double* q0;
   const double* q1;
@@ -89,7 +89,7 @@ struct MotionChecker::Sweep {
   int split_item = -1;
   double clear_a[kSplit], clear_b[kSplit];
 
-  Sweep(const MotionChecker& checker, MotionContext& c, MotionResult& result, const double* from, const double* to)
+  Sweep(const MotionChecker& checker, motion_detail::Scratch& c, MotionResult& result, const double* from, const double* to)
       : mc(checker), ctx(c), r(result), q0(from), q1(to) {
     ctx.scene.poses[0] = Pose::identity();
   }
@@ -368,7 +368,7 @@ struct MotionChecker::Sweep {
     ctx.intervals.push_back({a, b, witness});
     CollisionReport report;
     while (ctx.intervals.size() > base && !stop()) {
-      const MotionContext::Interval iv = ctx.intervals.back();
+      const motion_detail::Scratch::Interval iv = ctx.intervals.back();
       ctx.intervals.pop_back();
       const double hi = std::min(iv.b, limit);
       if (iv.a > hi || (hit && iv.a >= hi)) continue;
@@ -434,7 +434,7 @@ double MotionChecker::itemBound(const Item& it, const double* dq, double obstacl
   return it.b >= 0 ? bound_.pair(it.a, it.b, dq) : bound_.link(it.a, dq) + obstacle_motion;
 }
 
-MotionResult MotionChecker::certified(const double* q0, double t0, const double* q1, double t1, MotionContext& ctx,
+MotionResult MotionChecker::certified(const double* q0, double t0, const double* q1, double t1, motion_detail::Scratch& ctx,
                                       bool locate_contact) const noexcept {
   MotionResult r;
   const Scene& sc = *scene_;

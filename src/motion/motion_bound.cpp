@@ -19,7 +19,46 @@ using motion_detail::rigidAnchors;
 
 // ---- MotionBound --------------------------------------------------------------------------------------
 
-MotionBound::MotionBound(const Scene& scene, const std::vector<Body>& bodies)
+struct MotionBound::Tables {
+  Tables(const Scene& scene, const std::vector<MotionBound::Body>& bodies);
+  double link(int link, const double* dq) const noexcept;
+  double pair(int a, int b, const double* dq) const noexcept;
+  double linkStep(int link, const double* dq, const Pose* poses, double d, double extra) const noexcept;
+  double pairStep(int a, int b, const double* dq, const Pose* poses, double d) const noexcept;
+  bool translates(int a, int b, const double* dq) const noexcept;
+  bool translates(int link, const double* dq) const noexcept;
+  static constexpr double kSpin = MotionBound::kSpin;
+  using Body = MotionBound::Body;
+
+  struct DynamicBound;
+  // Adds to f the joints of link's chain from index `from` on.
+  void addDynamic(int link, std::size_t from, const double* dq, const Pose* poses, DynamicBound& f) const noexcept;
+
+  int dim_ = 0, links_ = 0;
+  std::vector<int> frame_;                        // per link: the link whose pose places it (a body's anchor)
+  std::vector<double> link_coef_;                 // links × dim
+  std::vector<std::vector<int>> chain_;           // per link: the joints from the root, in order
+  std::vector<std::vector<double>> prefix_;       // per link: running sum of step_ along its chain
+  std::vector<std::vector<double>> joint_reach_;  // per link: per joint of its chain, its reach to the link
+  std::vector<double> radius_;                    // per link: farthest hull vertex from the link's origin
+  std::vector<int> joint_var_;                    // per joint: the state entry that drives it, -1 if none
+  // The arrays "per joint" below are per element: a joint of one variable is one element, a planar joint
+  // three and a floating joint seven (see the constructor); chains list elements.
+  enum class Kind : char { Revolute, Prismatic, Spin };
+  std::vector<double> joint_mult_;                // per joint: |multiplier| of a mimic, kSpin for a spin, else 1
+  std::vector<char> kind_;                        // per joint: a Kind
+  std::vector<int> joint_of_;                     // per joint: the robot's joint
+  bool isSlide(int j) const noexcept { return kind_[j] == static_cast<char>(Kind::Prismatic); }
+  std::vector<double> step_;                      // per joint: largest parent-to-child frame offset
+  std::vector<Vec3> axis_;                        // per joint: unit axis in the joint (child link) frame
+  std::vector<int> child_;                        // per joint: child link
+  std::vector<Vec3> sphere_center_;               // per link: its bounding ball (link frame)
+  std::vector<double> sphere_radius_;
+  std::vector<double> exact_;  // links × joints: the link's farthest point from a revolute axis it is rigid with; else ∞
+  double exactReach(int link, int joint) const noexcept { return exact_[static_cast<std::size_t>(link) * joint_var_.size() + joint]; }
+};
+
+MotionBound::Tables::Tables(const Scene& scene, const std::vector<Body>& bodies)
     : dim_(scene.dimension()), links_(scene.robot().linkCount() + static_cast<int>(bodies.size())) {
   const RobotModel& model = scene.robot();
   const int model_links = model.linkCount();
@@ -174,7 +213,7 @@ MotionBound::MotionBound(const Scene& scene, const std::vector<Body>& bodies)
   }
 }
 
-bool MotionBound::translates(int a, int b, const double* dq) const noexcept {
+bool MotionBound::Tables::translates(int a, int b, const double* dq) const noexcept {
   // Joints above the fork move both links alike; only the path between them matters.
   std::size_t fork = 0;
   while (fork < chain_[a].size() && fork < chain_[b].size() && chain_[a][fork] == chain_[b][fork]) ++fork;
@@ -186,13 +225,13 @@ bool MotionBound::translates(int a, int b, const double* dq) const noexcept {
   return true;
 }
 
-bool MotionBound::translates(int link, const double* dq) const noexcept {
+bool MotionBound::Tables::translates(int link, const double* dq) const noexcept {
   for (const int j : chain_[link])
     if (joint_var_[j] >= 0 && dq[joint_var_[j]] != 0.0 && !isSlide(j)) return false;
   return true;
 }
 
-double MotionBound::link(int link, const double* dq) const noexcept {
+double MotionBound::Tables::link(int link, const double* dq) const noexcept {
   double b = 0.0;
   const double* c = &link_coef_[static_cast<std::size_t>(link) * dim_];
   for (int v = 0; v < dim_; ++v)
@@ -205,7 +244,7 @@ double MotionBound::link(int link, const double* dq) const noexcept {
 // ball) of the axis, plus how far the joints after k can move them relative to it, h·γ_k, and never
 // beyond the static reach R_k. So they move at most f(h) = h·Σ w_k·min(R_k, r_k + h·γ_k): convex and
 // piecewise quadratic, a piece starting where a joint's dynamic reach meets its static one.
-struct MotionBound::DynamicBound {
+struct MotionBound::Tables::DynamicBound {
   static constexpr int kMax = 64;
   double a = 0.0, c = 0.0;   // f(h) = h·(a + c·h) on the first piece
   double fixed = 0.0;        // Σ w·R: the static bound for h = 1
@@ -237,7 +276,7 @@ struct MotionBound::DynamicBound {
   }
 };
 
-void MotionBound::addDynamic(int link, std::size_t from, const double* dq, const Pose* poses, DynamicBound& f) const noexcept {
+void MotionBound::Tables::addDynamic(int link, std::size_t from, const double* dq, const Pose* poses, DynamicBound& f) const noexcept {
   const std::vector<int>& chain = chain_[link];
   const Vec3 center = poses[frame_[link]] * sphere_center_[link];
   double after = 0.0;  // Σ w·R over the joints below k: γ_k
@@ -264,14 +303,14 @@ void MotionBound::addDynamic(int link, std::size_t from, const double* dq, const
   f.fixed += after;
 }
 
-double MotionBound::linkStep(int link, const double* dq, const Pose* poses, double d, double extra) const noexcept {
+double MotionBound::Tables::linkStep(int link, const double* dq, const Pose* poses, double d, double extra) const noexcept {
   DynamicBound f;
   addDynamic(link, 0, dq, poses, f);
   f.a += extra, f.fixed += extra;  // (linear in h)
   return f.solve(d);
 }
 
-double MotionBound::pairStep(int a, int b, const double* dq, const Pose* poses, double d) const noexcept {
+double MotionBound::Tables::pairStep(int a, int b, const double* dq, const Pose* poses, double d) const noexcept {
   // Watched from the fork: each link moves by the joints below it, from where their axes are now.
   std::size_t fork = 0;
   while (fork < chain_[a].size() && fork < chain_[b].size() && chain_[a][fork] == chain_[b][fork]) ++fork;
@@ -281,7 +320,7 @@ double MotionBound::pairStep(int a, int b, const double* dq, const Pose* poses, 
   return f.solve(d);
 }
 
-double MotionBound::pair(int a, int b, const double* dq) const noexcept {
+double MotionBound::Tables::pair(int a, int b, const double* dq) const noexcept {
   // Joints shared by both chains move the pair rigidly. The others lie on the path a → fork → b, and
   // the pair may be watched from any link X on that path: the joints between a and X move a, the rest
   // move b. Each joint costs |Δq| times its reach to the link it moves (for a link above the joint, the
@@ -339,5 +378,19 @@ double MotionBound::pair(int a, int b, const double* dq) const noexcept {
   return best;
 }
 
+
+MotionBound::MotionBound(const Scene& scene, const std::vector<Body>& bodies)
+    : t_(std::make_shared<const Tables>(scene, bodies)) {}
+double MotionBound::link(int link, const double* dq) const noexcept { return t_->link(link, dq); }
+double MotionBound::pair(int a, int b, const double* dq) const noexcept { return t_->pair(a, b, dq); }
+double MotionBound::linkStep(int link, const double* dq, const Pose* poses, double d, double extra) const noexcept {
+  return t_->linkStep(link, dq, poses, d, extra);
+}
+double MotionBound::pairStep(int a, int b, const double* dq, const Pose* poses, double d) const noexcept {
+  return t_->pairStep(a, b, dq, poses, d);
+}
+bool MotionBound::translates(int a, int b, const double* dq) const noexcept { return t_->translates(a, b, dq); }
+bool MotionBound::translates(int link, const double* dq) const noexcept { return t_->translates(link, dq); }
+double MotionBound::linkCoefficient(int link, int v) const noexcept { return t_->link_coef_[link * t_->dim_ + v]; }
 
 }  // namespace clearway

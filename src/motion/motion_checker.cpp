@@ -205,8 +205,15 @@ void MotionChecker::buildItems() {
   emit(single, groups, heads);
 }
 
+MotionContext::MotionContext() noexcept = default;
+MotionContext::MotionContext(MotionContext&&) noexcept = default;
+MotionContext& MotionContext::operator=(MotionContext&&) noexcept = default;
+MotionContext::~MotionContext() = default;
+MotionContext::MotionContext(std::unique_ptr<motion_detail::Scratch> scratch) noexcept : scratch_(std::move(scratch)) {}
+
 MotionContext MotionChecker::makeContext() const {
-  MotionContext c;
+  auto scratch = std::make_unique<motion_detail::Scratch>();
+  motion_detail::Scratch& c = *scratch;
   c.scene = scene_->makeContext();
   c.q.resize(scene_->dimension());
   c.dq.resize(scene_->dimension());
@@ -241,7 +248,7 @@ MotionContext MotionChecker::makeContext() const {
   c.pose_path.reserve(scene_->robot().linkCount());
   c.intervals.reserve(256);
   if (options_.mode == MotionMode::Cast) c.end_poses.resize(scene_->robot().linkCount());
-  return c;
+  return MotionContext(std::move(scratch));
 }
 
 
@@ -264,8 +271,14 @@ MotionResult MotionChecker::check(const double* q0, const double* q1, MotionCont
   return check(q0, 0.0, q1, 0.0, ctx, locate_contact);
 }
 
-MotionResult MotionChecker::check(const double* q0, double t0, const double* q1, double t1, MotionContext& ctx,
+MotionResult MotionChecker::check(const double* q0, double t0, const double* q1, double t1, MotionContext& context,
                                   bool locate_contact) const noexcept {
+  if (!context.scratch_) {  // an empty context: a collision, never free by accident
+    MotionResult r;
+    r.report.kind = CollisionReport::Kind::Invalid;
+    return r;
+  }
+  motion_detail::Scratch& ctx = *context.scratch_;
   return options_.mode == MotionMode::Sampled ? sampled(q0, t0, q1, t1, ctx)
                                               : certified(q0, t0, q1, t1, ctx, locate_contact);
 }

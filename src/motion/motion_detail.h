@@ -1,11 +1,53 @@
 #pragma once
 // What the parts of motion/ share and callers do not: the reference state, rigid bodies, quaternion ends.
+#include <clearway/motion/motion.h>
 #include <clearway/scene/scene.h>
 
 #include <Eigen/Core>
 #include <vector>
 
 namespace clearway::motion_detail {
+
+// What one thread's checks of one MotionChecker keep between and within segments (MotionContext holds it).
+struct Scratch {
+  SceneContext scene;
+  std::vector<double> q, dq;
+  std::vector<double> safe_until;  // per item: where its coverage starts (Cast: where its shape cast reached)
+  std::vector<double> bound;       // per item: its motion bound for this segment
+  std::vector<double> first_reach; // per item: how far its first measurement (in the middle) clears, −1: none
+  // Per item: its contact distance on this segment, set when it first comes within contact_distance
+  // (contact_stamp[k] == segment); below contact_distance where an end of the segment is itself that near.
+  std::vector<double> contact;
+  std::vector<std::uint64_t> contact_stamp;
+  std::vector<SimplexCache> hull_cache;  // per self item: the hulls' last GJK axis (warm starts within a segment)
+  // Per self item, its part pairs' GJK axes: they start at part_slot[k] in part_cache (−1: none) and are
+  // reset when first used in a segment (part_stamp[k] != segment).
+  std::vector<SimplexCache> part_cache;
+  std::vector<int> part_slot;
+  std::vector<std::uint64_t> part_stamp;
+  // Per environment item, its hull's GJK axes against each static obstacle, kept the same way (the
+  // item's block starts at env_slot[k − first environment item], −1: none).
+  std::vector<SimplexCache> env_cache;
+  std::vector<int> env_slot;
+  std::vector<std::uint64_t> env_stamp;
+  // Per self item, the motion bounds of its links' convex parts against the other link for this segment
+  // (a's parts, then b's, from split_slot[k]), computed when the item first needs them (split_stamp[k]).
+  std::vector<double> split_bound;
+  std::vector<int> split_slot;
+  std::vector<std::uint64_t> split_stamp;
+  double obstacle_motion = 0.0;  // how far moving obstacles travel over the segment (per unit of s)
+  std::uint64_t segment = 0;  // segments checked with this context (the stamps above refer to it)
+  std::vector<std::uint64_t> pose_stamp;  // per link: the step its pose in scene.poses was computed for
+  std::vector<int> pose_path;             // scratch: links whose poses are due, deepest first
+  std::vector<Pose> end_poses;            // Cast: the link poses at the segment's end
+  std::uint64_t step_stamp = 0;
+  struct Interval {
+    double a, b;     // the parameters to cover
+    double witness;  // a parameter ≤ a the item was measured clear at (−1: none)
+  };
+  std::vector<Interval> intervals;  // scratch: what items have yet to cover
+  int lead = -1;                    // the item that met the last contact: measured first
+};
 
 // A state inside the scene's bounds (their midpoints) with unit quaternions, where the poses are defined.
 inline std::vector<double> referenceState(const Scene& scene) {

@@ -10,10 +10,12 @@
 #include <limits>
 #include <stdexcept>
 
+#include "motion_detail.h"
+
 namespace clearway {
 
 MotionResult MotionChecker::sampled(const double* q0, double t0, const double* q1, double t1,
-                                    MotionContext& ctx) const noexcept {
+                                    motion_detail::Scratch& ctx) const noexcept {
   MotionResult r;
   const Scene& sc = *scene_;
   const auto time = [&](double s) { return t0 + s * (t1 - t0); };

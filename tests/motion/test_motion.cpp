@@ -429,6 +429,14 @@ TEST(MotionCertified, BadInput) {
   cast_options.mode = MotionMode::Cast;
   const MotionChecker cast(scene, cast_options);
   const double ok[2] = {-1, 0};
+  {  // a context not made by a checker: a collision, never free
+    MotionContext empty;
+    EXPECT_TRUE(certified.check(ok, ok, ctx).free);
+    EXPECT_FALSE(certified.check(ok, ok, empty).free);
+    EXPECT_EQ(certified.check(ok, ok, empty).report.kind, CollisionReport::Kind::Invalid);
+    empty = certified.makeContext();
+    EXPECT_TRUE(certified.check(ok, ok, empty).free);
+  }
   for (const double bad : {std::nan(""), std::numeric_limits<double>::infinity(), 5.0}) {
     const double q[2] = {-0.5, bad};
     const double p[2] = {bad, 0};
@@ -1105,6 +1113,7 @@ TEST(MotionCertified, SharedProblemsAgreeWithDenseSampling) {
     MotionOptions dense = sampled(1e-3);
     const MotionChecker fine(scene, dense);
     MotionContext c = certified.makeContext(), f = fine.makeContext();
+    SceneContext sc = scene->makeContext();
     const int n = scene->dimension();
     std::vector<double> q1(n), mid(n);
     for (int trial = 0; trial < 40; ++trial) {
@@ -1127,7 +1136,7 @@ TEST(MotionCertified, SharedProblemsAgreeWithDenseSampling) {
       } else {
         ++certified_only;
         certified.interpolate(q0.data(), q1.data(), a.first_contact, mid.data());
-        const double clearance = scene->clearance(mid.data(), c.scene);
+        const double clearance = scene->clearance(mid.data(), sc);
         EXPECT_LE(clearance, certified.options().contact_distance * 1.5 + 1e-6)
             << name << " trial " << trial << " at s = " << a.first_contact;
       }

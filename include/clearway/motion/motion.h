@@ -68,35 +68,11 @@ class MotionBound {
   /// their Euclidean distance (4·asin(c/2) ≤ (π/√2)·c for c ≤ √2).
   static constexpr double kSpin = 2.2214414690791831;
   /// Coefficient of state entry v for link i (metres per radian, or 1 for prismatic).
-  double linkCoefficient(int link, int v) const noexcept { return link_coef_[link * dim_ + v]; }
+  double linkCoefficient(int link, int v) const noexcept;
 
  private:
-  struct DynamicBound;  // motion_bound.cpp
-  // Adds to f the joints of link's chain from index `from` on.
-  void addDynamic(int link, std::size_t from, const double* dq, const Pose* poses, DynamicBound& f) const noexcept;
-
-  int dim_ = 0, links_ = 0;
-  std::vector<int> frame_;                        // per link: the link whose pose places it (a body's anchor)
-  std::vector<double> link_coef_;                 // links × dim
-  std::vector<std::vector<int>> chain_;           // per link: the joints from the root, in order
-  std::vector<std::vector<double>> prefix_;       // per link: running sum of step_ along its chain
-  std::vector<std::vector<double>> joint_reach_;  // per link: per joint of its chain, its reach to the link
-  std::vector<double> radius_;                    // per link: farthest hull vertex from the link's origin
-  std::vector<int> joint_var_;                    // per joint: the state entry that drives it, -1 if none
-  // The arrays "per joint" below are per element: a joint of one variable is one element, a planar joint
-  // three and a floating joint seven (see the constructor); chains list elements.
-  enum class Kind : char { Revolute, Prismatic, Spin };
-  std::vector<double> joint_mult_;                // per joint: |multiplier| of a mimic, kSpin for a spin, else 1
-  std::vector<char> kind_;                        // per joint: a Kind
-  std::vector<int> joint_of_;                     // per joint: the robot's joint
-  bool isSlide(int j) const noexcept { return kind_[j] == static_cast<char>(Kind::Prismatic); }
-  std::vector<double> step_;                      // per joint: largest parent-to-child frame offset
-  std::vector<Vec3> axis_;                        // per joint: unit axis in the joint (child link) frame
-  std::vector<int> child_;                        // per joint: child link
-  std::vector<Vec3> sphere_center_;               // per link: its bounding ball (link frame)
-  std::vector<double> sphere_radius_;
-  std::vector<double> exact_;  // links × joints: the link's farthest point from a revolute axis it is rigid with; else ∞
-  double exactReach(int link, int joint) const noexcept { return exact_[static_cast<std::size_t>(link) * joint_var_.size() + joint]; }
+  struct Tables;  // motion_bound.cpp: the chains, reaches and coefficients, shared by copies
+  std::shared_ptr<const Tables> t_;
 };
 
 /// How a segment is checked.
@@ -144,45 +120,24 @@ struct MotionResult {
   bool capped = false;      ///< the query cap was reached (reported as a collision)
 };
 
-/// Scratch for MotionChecker::check, one per thread (allocates once), made by the checking MotionChecker's makeContext().
-struct MotionContext {
-  SceneContext scene;
-  std::vector<double> q, dq;
-  std::vector<double> safe_until;  // per item: where its coverage starts (Cast: where its shape cast reached)
-  std::vector<double> bound;       // per item: its motion bound for this segment
-  std::vector<double> first_reach; // per item: how far its first measurement (in the middle) clears, −1: none
-  // Per item: its contact distance on this segment, set when it first comes within contact_distance
-  // (contact_stamp[k] == segment); below contact_distance where an end of the segment is itself that near.
-  std::vector<double> contact;
-  std::vector<std::uint64_t> contact_stamp;
-  std::vector<SimplexCache> hull_cache;  // per self item: the hulls' last GJK axis (warm starts within a segment)
-  // Per self item, its part pairs' GJK axes: they start at part_slot[k] in part_cache (−1: none) and are
-  // reset when first used in a segment (part_stamp[k] != segment).
-  std::vector<SimplexCache> part_cache;
-  std::vector<int> part_slot;
-  std::vector<std::uint64_t> part_stamp;
-  // Per environment item, its hull's GJK axes against each static obstacle, kept the same way (the
-  // item's block starts at env_slot[k − first environment item], −1: none).
-  std::vector<SimplexCache> env_cache;
-  std::vector<int> env_slot;
-  std::vector<std::uint64_t> env_stamp;
-  // Per self item, the motion bounds of its links' convex parts against the other link for this segment
-  // (a's parts, then b's, from split_slot[k]), computed when the item first needs them (split_stamp[k]).
-  std::vector<double> split_bound;
-  std::vector<int> split_slot;
-  std::vector<std::uint64_t> split_stamp;
-  double obstacle_motion = 0.0;  // how far moving obstacles travel over the segment (per unit of s)
-  std::uint64_t segment = 0;  // segments checked with this context (the stamps above refer to it)
-  std::vector<std::uint64_t> pose_stamp;  // per link: the step its pose in scene.poses was computed for
-  std::vector<int> pose_path;             // scratch: links whose poses are due, deepest first
-  std::vector<Pose> end_poses;            // Cast: the link poses at the segment's end
-  std::uint64_t step_stamp = 0;
-  struct Interval {
-    double a, b;     // the parameters to cover
-    double witness;  // a parameter ≤ a the item was measured clear at (−1: none)
-  };
-  std::vector<Interval> intervals;  // scratch: what items have yet to cover
-  int lead = -1;                    // the item that met the last contact: measured first
+namespace motion_detail {
+struct Scratch;  // motion_detail.h
+}  // namespace motion_detail
+
+/// One thread's scratch for MotionChecker::check (allocated once, then reused): made by the checking
+/// MotionChecker's makeContext(). Movable, not copyable; a default-made one is empty and only good for
+/// assigning to (a check given it reports a collision).
+class MotionContext {
+ public:
+  MotionContext() noexcept;
+  MotionContext(MotionContext&&) noexcept;
+  MotionContext& operator=(MotionContext&&) noexcept;
+  ~MotionContext();
+
+ private:
+  friend class MotionChecker;
+  explicit MotionContext(std::unique_ptr<motion_detail::Scratch> scratch) noexcept;
+  std::unique_ptr<motion_detail::Scratch> scratch_;
 };
 
 /// Checks the segment. Both ends must be states of the scene's dimension; an invalid state (NaN, out
@@ -218,11 +173,12 @@ class MotionChecker {
   void interpolate(const double* q0, const double* q1, double s, double* out) const noexcept;
 
  private:
-  MotionResult certified(const double* q0, double t0, const double* q1, double t1, MotionContext& ctx,
+  MotionResult certified(const double* q0, double t0, const double* q1, double t1, motion_detail::Scratch& ctx,
                          bool locate_contact) const noexcept;
-  MotionResult sampled(const double* q0, double t0, const double* q1, double t1, MotionContext& ctx) const noexcept;
+  MotionResult sampled(const double* q0, double t0, const double* q1, double t1, motion_detail::Scratch& ctx) const noexcept;
   // Cast mode: items that only translate on the segment start from their shape cast's time of impact.
-  void castAhead(const double* q0, const double* q1, double t0, int n_items, MotionContext& ctx, MotionResult& r) const noexcept;
+  void castAhead(const double* q0, const double* q1, double t0, int n_items, motion_detail::Scratch& ctx,
+                 MotionResult& r) const noexcept;
 
   // Links that move rigidly together: those with geometry merged, per body of two or more.
   struct Bodies {
