@@ -373,6 +373,22 @@ double Environment::hullLowerBound(const LinkGeometry& link, const Pose& pose, c
   return lower >= 0.0 ? lower : 0.0;  // (NaN: 0)
 }
 
+double Environment::lowerBound(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, const BoundQuery& q,
+                               double t, SimplexCache* warm, EnvironmentHit* hit,
+                               EnvironmentCounters* counters) const noexcept {
+  if (hit) *hit = EnvironmentHit{};
+  const double climb = q.climb >= 0.0 ? q.climb : q.enough;
+  double lower = hullLowerBound(link, pose, tol, q.enough, q.relative, t, counters, warm);
+  if (!(lower <= climb) || q.mode == GeometryMode::Hull) return lower;
+  // (The bound so far second in max(): a NaN leaves it.)
+  lower = std::max(hullLowerBound(link, pose, tol, q.enough, q.relative, t, counters, nullptr, true), lower);
+  if (!(lower <= climb)) return lower;
+  if (q.within >= 0.0 && linkIntersects(link, pose, tol, GeometryMode::Mesh, q.within, t, hit, counters)) return 0.0;
+  const DistanceResult m = linkDistance(link, pose, tol, std::min(q.enough, q.near), t, q.relative, counters);
+  if (isFailure(m.status)) return 0.0;
+  return q.within >= 0.0 ? std::max(m.lower_bound, q.within * (1.0 + 1e-9)) : m.lower_bound;
+}
+
 double Environment::linkCast(const LinkGeometry& link, const Pose& pose, const Vec3& velocity, double margin,
                              const Tolerances& tol, double max_s, double t,
                              EnvironmentCounters* counters) const noexcept {

@@ -165,23 +165,14 @@ struct MotionChecker::Sweep {
     if (r.distance_queries >= mc.options_.max_queries) capped = true;
     const Pose pa = pose(s, it.frame_a);
     double d;
+    BoundQuery q;  // (no warm starts: an end's clearance must not depend on what was measured before)
+    q.enough = cutoff;
+    q.relative = relative;
+    q.mode = exact ? GeometryMode::Mesh : GeometryMode::Hull;
     if (it.b >= 0) {
-      const Pose& pb = pose(s, it.frame_b);
-      if (exact) {
-        const DistanceResult m = meshDistance(*it.ga, pa, *it.gb, pb, tol, relative, cutoff);
-        d = isFailure(m.status) ? 0.0 : m.lower_bound;
-      } else {
-        SimplexCache cold;
-        d = gjkLowerBound(it.ga->hull(), pa, it.gb->hull(), pb, tol, cold, cutoff, relative);
-      }
+      d = BodyPair(*it.ga, *it.gb).lowerBound(pa, pose(s, it.frame_b), tol, q);
     } else {
-      EnvironmentCounters* counters = &ctx.scene.counters.environment;
-      if (exact) {
-        const DistanceResult m = sc.environment().linkDistance(*it.ga, pa, tol, cutoff, time(s), relative, counters);
-        d = isFailure(m.status) ? 0.0 : m.lower_bound;
-      } else {
-        d = sc.environment().hullLowerBound(*it.ga, pa, tol, cutoff, relative, time(s), counters);
-      }
+      d = sc.environment().lowerBound(*it.ga, pa, tol, q, time(s), nullptr, nullptr, &ctx.scene.counters.environment);
     }
     return d - it.padding;
   }
@@ -201,36 +192,22 @@ struct MotionChecker::Sweep {
     ++r.distance_queries;
     split_item = -1;
     need = std::max(need, 2.0 * contact);  // a clearance must exceed the contact distance to count
+    // The ladder (body/proximity.h), climbed only while within contact: a clearance beyond it is all a ball
+    // needs. A group stops at its merged hulls; its members decide the rest.
+    BoundQuery q;
+    q.enough = need + it.padding;
+    q.relative = relative;
+    q.mode = exact && !head ? GeometryMode::Mesh : GeometryMode::Hull;
+    q.climb = it.padding + contact;
+    q.within = lowered ? -1.0 : it.padding + contact;
+    q.near = it.padding + kNear * contact;
     const Pose pa = pose(s, it.frame_a);
     double d;
     if (it.b >= 0) {
       const Pose& pb = pose(s, it.frame_b);
-      const LinkGeometry& a = *it.ga;
-      const LinkGeometry& b = *it.gb;
-      // Ever tighter and dearer lower bounds, each only when the one before falls short of `enough`: the
-      // bounding balls, the hulls (warm-started GJK), the convex parts, and last the triangles.
-      const double enough = need + it.padding;
-      double lower = (pa * a.sphereCenter() - pb * b.sphereCenter()).norm() - a.sphereRadius() - b.sphereRadius();
-      if (!(lower >= enough))  // (the GJK bound first in max(): it is a number even if the balls' is not)
-        lower = std::max(gjkLowerBound(a.hull(), pa, b.hull(), pb, tol, ctx.hull_cache[k], enough, relative), lower);
-      d = lower - it.padding;
-      if (d > contact) split_item = k;  // (the hulls' last GJK axis: this measurement's, or an earlier one's)
-      if (d <= contact && exact && !head) {
-        SimplexCache* caches =
-            warmStarts(ctx.part_cache, ctx.part_slot[k], ctx.part_stamp[k], a.parts().size() * b.parts().size());
-        d = std::max(d, partsLowerBound(a, pa, b, pb, tol, enough, relative, caches) - it.padding);  // (d first: NaN)
-      }
-      if (d <= contact && exact && !head) {
-        // The convex pieces are within contact, so the triangles are near (and a fine mesh has many near):
-        // whether they are within contact is a search that stops at the first pair; only if not, how far
-        // they are, measured no farther than a few contact distances.
-        if (!lowered && meshesIntersect(a, pa, b, pb, tol, GeometryMode::Mesh, it.padding + contact)) {
-          d = 0.0;
-        } else {
-          const DistanceResult m = meshDistance(a, pa, b, pb, tol, relative, std::min(enough, it.padding + kNear * contact));
-          d = isFailure(m.status) ? 0.0 : std::max(m.lower_bound - it.padding, lowered ? 0.0 : kBeyond * contact);
-        }
-      }
+      d = ctx.pairs[k].lowerBound(pa, pb, tol, q) - it.padding;
+      // (The hulls' last GJK axis, this measurement's or an earlier one's, where the hulls cleared it.)
+      if (d > contact && ctx.pairs[k].lastRung() <= Rung::Hulls) split_item = k;
       if (d <= contact && !head) {
         report = CollisionReport{};
         report.kind = CollisionReport::Kind::Self;
@@ -238,31 +215,12 @@ struct MotionChecker::Sweep {
         report.other_link = it.b;
       }
     } else {
-      const double cutoff = need + it.padding + contact;
       const double t = time(s);  // where moving obstacles are
-      // As for pairs: the hull's bound first, the exact geometry only when the hull comes close.
       const int e = k - mc.env_begin_;
       SimplexCache* warm = warmStarts(ctx.env_cache, ctx.env_slot[e], ctx.env_stamp[e], sc.environment().staticCount());
-      const double h =
-          sc.environment().hullLowerBound(*it.ga, pa, tol, cutoff, relative, t, &ctx.scene.counters.environment, warm);
-      d = h - it.padding;
-      EnvironmentHit hit;
-      bool found = false;  // `hit` names what is within contact
-      EnvironmentCounters* counters = &ctx.scene.counters.environment;
-      if (d <= contact && exact && !head)  // the convex parts, then (as for pairs) within contact, then how far
-        d = std::max(d, sc.environment().hullLowerBound(*it.ga, pa, tol, cutoff, relative, t, counters, nullptr, true) -
-                            it.padding);  // (d first: NaN)
-      if (d <= contact && exact && !head) {
-        if (!lowered &&
-            sc.environment().linkIntersects(*it.ga, pa, tol, GeometryMode::Mesh, it.padding + contact, t, &hit, counters)) {
-          d = 0.0;
-          found = true;
-        } else {
-          const DistanceResult e =
-              sc.environment().linkDistance(*it.ga, pa, tol, std::min(cutoff, it.padding + kNear * contact), t, relative, counters);
-          d = isFailure(e.status) ? 0.0 : std::max(e.lower_bound - it.padding, lowered ? 0.0 : kBeyond * contact);
-        }
-      }
+      EnvironmentHit hit;  // what lies within contact, when that settled it
+      d = sc.environment().lowerBound(*it.ga, pa, tol, q, t, warm, &hit, &ctx.scene.counters.environment) - it.padding;
+      const bool found = hit.kind != EnvironmentHit::Kind::None;
       if (d <= contact && !head) {
         report = CollisionReport{};
         report.kind = CollisionReport::Kind::Environment;
@@ -285,7 +243,7 @@ struct MotionChecker::Sweep {
   // False when there is no axis or too many parts.
   bool splitClearances(int k, double d) {
     const Item& it = mc.items_[k];
-    const SimplexCache& cache = ctx.hull_cache[k];
+    const SimplexCache& cache = ctx.pairs[k].hullAxis();
     const std::vector<LinkGeometry::Part>& parts_a = it.ga->parts();
     const std::vector<LinkGeometry::Part>& parts_b = it.gb->parts();
     if (!cache.valid || parts_a.size() > kSplit || parts_b.size() > kSplit) return false;
@@ -467,8 +425,8 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
   const int n_items = check_env ? static_cast<int>(items_.size()) : env_begin_;
   // No warm start from other segments: a segment's verdict then depends on nothing but its ends (a planner's
   // threads, and a later re-check of its path, must agree even on pairs within the contact distance).
-  for (SimplexCache& c : ctx.hull_cache) c = SimplexCache{};
-  ++ctx.segment;  // (the part pairs' and obstacles' warm starts are emptied as their items first need them)
+  for (BodyPair& p : ctx.pairs) p.forget();
+  ++ctx.segment;  // (the obstacles' warm starts are emptied as their items first need them)
   // How far moving obstacles travel over the segment (per unit of s): it adds to every environment item's
   // motion; none unless the scene declares them.
   const bool timed = sc.effects().moving && sc.environment().hasMovingObstacles();

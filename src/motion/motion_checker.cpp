@@ -222,18 +222,13 @@ MotionContext MotionChecker::makeContext() const {
   c.first_reach.resize(items_.size());
   c.contact.assign(items_.size(), options_.contact_distance);
   c.contact_stamp.assign(items_.size(), 0);
-  c.hull_cache.resize(env_begin_);
-  c.part_slot.assign(env_begin_, -1);
-  c.part_stamp.assign(env_begin_, 0);
   c.split_slot.assign(env_begin_, 0);
   c.split_stamp.assign(env_begin_, 0);
   for (int k = 0; k < env_begin_; ++k) {
     const Item& it = items_[k];
     c.split_slot[k] = static_cast<int>(c.split_bound.size());
     c.split_bound.resize(c.split_bound.size() + it.ga->parts().size() + it.gb->parts().size());
-    if (it.last > it.first) continue;  // a head stops at its hulls
-    c.part_slot[k] = static_cast<int>(c.part_cache.size());
-    c.part_cache.resize(c.part_cache.size() + it.ga->parts().size() * it.gb->parts().size());
+    c.pairs.emplace_back(*it.ga, *it.gb);
   }
   // (Warm starts per static obstacle while there are few: with many, the tree visits only a few per query.)
   const std::size_t obstacles = scene_->environment().staticCount();

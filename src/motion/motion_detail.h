@@ -1,5 +1,6 @@
 #pragma once
 // What the parts of motion/ share and callers do not: the reference state, rigid bodies, quaternion ends.
+#include <clearway/body/proximity.h>
 #include <clearway/motion/motion.h>
 #include <clearway/scene/scene.h>
 
@@ -19,12 +20,7 @@ struct Scratch {
   // (contact_stamp[k] == segment); below contact_distance where an end of the segment is itself that near.
   std::vector<double> contact;
   std::vector<std::uint64_t> contact_stamp;
-  std::vector<SimplexCache> hull_cache;  // per self item: the hulls' last GJK axis (warm starts within a segment)
-  // Per self item, its part pairs' GJK axes: they start at part_slot[k] in part_cache (−1: none) and are
-  // reset when first used in a segment (part_stamp[k] != segment).
-  std::vector<SimplexCache> part_cache;
-  std::vector<int> part_slot;
-  std::vector<std::uint64_t> part_stamp;
+  std::vector<BodyPair> pairs;  // per self item: its bodies and their warm starts (forgotten every segment)
   // Per environment item, its hull's GJK axes against each static obstacle, kept the same way (the
   // item's block starts at env_slot[k − first environment item], −1: none).
   std::vector<SimplexCache> env_cache;

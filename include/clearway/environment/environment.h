@@ -8,6 +8,7 @@
 #include <clearway/math.h>
 #include <clearway/narrowphase/gjk.h>
 #include <clearway/body/link_geometry.h>
+#include <clearway/body/proximity.h>
 #include <clearway/shape/shape.h>
 #include <clearway/tolerances.h>
 #include <clearway/tree/aabb_tree.h>
@@ -104,6 +105,13 @@ class Environment {
   double hullLowerBound(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, double enough,
                         double relative, double t = 0.0, EnvironmentCounters* counters = nullptr,
                         SimplexCache* warm = nullptr, bool by_parts = false) const noexcept;
+  /// BodyPair::lowerBound's ladder against everything near the link, at time t: the hull's bound (with the
+  /// warm starts `warm`, as hullLowerBound takes them), the convex parts' (Mesh mode), then the exact
+  /// geometry (q.within, q.near as there); `hit` (optional) names what lies within q.within when that
+  /// settles it. 0 for non-finite input or a failed query.
+  double lowerBound(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, const BoundQuery& q,
+                    double t = 0.0, SimplexCache* warm = nullptr, EnvironmentHit* hit = nullptr,
+                    EnvironmentCounters* counters = nullptr) const noexcept;
   /// How many obstacles do not move (the warm starts hullLowerBound takes).
   std::size_t staticCount() const noexcept { return static_.size(); }
 

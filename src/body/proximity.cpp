@@ -1,0 +1,58 @@
+// BodyPair: the proximity ladder of two bodies, written once.
+#include <clearway/body/proximity.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace clearway {
+
+BodyPair::BodyPair(const LinkGeometry& a, const LinkGeometry& b)
+    : a_(&a), b_(&b), parts_(a.parts().size() * b.parts().size()) {}
+
+void BodyPair::forget() noexcept {
+  hull_ = SimplexCache{};
+  parts_stale_ = true;
+}
+
+bool BodyPair::intersects(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol,
+                          const IntersectQuery& q) noexcept {
+  return meshesIntersect(*a_, pose_a, *b_, pose_b, tol, q.mode, q.padding, &hull_);
+}
+
+double BodyPair::lowerBound(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol,
+                            const BoundQuery& q) noexcept {
+  if (!pose_a.isFinite() || !pose_b.isFinite()) return 0.0;
+  const LinkGeometry& a = *a_;
+  const LinkGeometry& b = *b_;
+  const double climb = q.climb >= 0.0 ? q.climb : q.enough;
+  // (In every max() below the bound so far comes second: a NaN rung leaves it, and a NaN first bound
+  // gives way to the rung's number.)
+  rung_ = Rung::Balls;
+  double lower = (pose_a * a.sphereCenter() - pose_b * b.sphereCenter()).norm() - a.sphereRadius() - b.sphereRadius();
+  if (!(lower >= q.enough)) {
+    rung_ = Rung::Hulls;
+    lower = std::max(gjkLowerBound(a.hull(), pose_a, b.hull(), pose_b, tol, hull_, q.enough, q.relative), lower);
+  }
+  if (!(lower <= climb) || q.mode == GeometryMode::Hull) return lower >= 0.0 ? lower : 0.0;
+  if (parts_stale_) {
+    std::fill(parts_.begin(), parts_.end(), SimplexCache{});
+    parts_stale_ = false;
+  }
+  rung_ = Rung::Parts;
+  lower = std::max(partsLowerBound(a, pose_a, b, pose_b, tol, q.enough, q.relative, parts_.data()), lower);
+  if (!(lower <= climb)) return lower;
+  rung_ = Rung::Exact;
+  // The convex pieces are near, so the triangles are (and a fine mesh has many near): whether they lie
+  // within `within` is a search that stops at the first pair; only if not, how far they are.
+  if (q.within >= 0.0 && meshesIntersect(a, pose_a, b, pose_b, tol, GeometryMode::Mesh, q.within)) return 0.0;
+  const DistanceResult m = meshDistance(a, pose_a, b, pose_b, tol, q.relative, std::min(q.enough, q.near));
+  if (isFailure(m.status)) return 0.0;
+  return q.within >= 0.0 ? std::max(m.lower_bound, q.within * (1.0 + 1e-9)) : m.lower_bound;
+}
+
+DistanceResult BodyPair::distance(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol,
+                                  const DistanceQuery& q) const noexcept {
+  return meshDistance(*a_, pose_a, *b_, pose_b, tol, q.relative, q.cutoff);
+}
+
+}  // namespace clearway

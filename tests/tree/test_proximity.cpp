@@ -1,0 +1,144 @@
+// BodyPair (body/proximity.h): the ladder's bound never exceeds the brute-force distance of
+// tests/tree/mesh_reference.h, `within` decides as the reference does, Hull mode is never tighter than
+// Mesh mode, forgetting the warm starts gives a fresh pair's answers bit for bit, and bad input is
+// never "far".
+#include <clearway/body/proximity.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "tree/mesh_reference.h"
+
+namespace clearway {
+namespace {
+
+constexpr double kBand = 1e-9;
+
+Pose randomPose(std::mt19937_64& rng, double reach) {
+  Pose p;
+  p.R = tree_ref::randomRotation(rng);
+  p.t = tree_ref::randomInBall(rng, reach);
+  return p;
+}
+
+struct Named {
+  std::string name;
+  TriangleMesh mesh;
+};
+
+std::vector<Named> meshes() {
+  return {{"sphere", tree_ref::uvSphere(0.1, 10, 16)},
+          {"torus", tree_ref::torus(0.12, 0.03, 20, 10)},
+          {"plate", tree_ref::gridBox(Vec3(0.15, 0.1, 0.002), 4)},
+          {"dumbbell", tree_ref::joined(tree_ref::uvSphere(0.04, 6, 10), tree_ref::gridBox(Vec3(0.03, 0.03, 0.03), 2),
+                                        Vec3(0.2, 0.05, 0.0))}};
+}
+
+TEST(BodyPair, LadderBoundsTheBruteForceDistance) {
+  const std::vector<Named> m = meshes();
+  std::vector<LinkGeometry> g;
+  for (const Named& n : m) g.emplace_back(n.mesh);
+  const Tolerances tol;
+  std::mt19937_64 rng(7);
+  int exact = 0, within_hits = 0, within_clear = 0, cases = 0;
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    for (std::size_t j = i; j < m.size(); ++j) {
+      BodyPair pair(g[i], g[j]);  // warm starts carried from case to case, as along a segment
+      const double reach = 1.2 * (tree_ref::meshRadius(m[i].mesh) + tree_ref::meshRadius(m[j].mesh));
+      for (int c = 0; c < 12; ++c, ++cases) {
+        const Pose pa = randomPose(rng, 0.1);
+        Pose pb = randomPose(rng, reach);
+        pb.t += pa.t;
+        const std::string what = m[i].name + " vs " + m[j].name + " case " + std::to_string(c);
+        const double ref = tree_ref::meshDistance(tree_ref::place(m[i].mesh, pa), tree_ref::place(m[j].mesh, pb));
+        BoundQuery q;
+        q.relative = 0.1;
+        const double full = pair.lowerBound(pa, pb, tol, q);  // climbs to the triangles unless a rung reaches ∞
+        EXPECT_LE(full, ref + kBand) << what;
+        EXPECT_GE(full, ref / 1.1 - kBand) << what;
+        if (pair.lastRung() == Rung::Exact) ++exact;
+        // Asked only as far as `enough`: still a bound, and at least min(enough, the distance / 1.1).
+        q.enough = 0.5 * ref;
+        const double part = pair.lowerBound(pa, pb, tol, q);
+        EXPECT_LE(part, ref + kBand) << what;
+        EXPECT_GE(part, std::min(q.enough, ref / 1.1) - kBand) << what;
+        // Hull mode stops at the hulls: never tighter than the exact answer.
+        BoundQuery hull = q;
+        hull.mode = GeometryMode::Hull;
+        hull.enough = std::numeric_limits<double>::infinity();
+        EXPECT_LE(pair.lowerBound(pa, pb, tol, hull), ref + kBand) << what;
+        // `within` a contact distance: 0 exactly when the reference is that near (outside the band).
+        BoundQuery near;
+        near.relative = 0.1;
+        near.within = 0.01;
+        near.climb = 0.01;
+        const double w = pair.lowerBound(pa, pb, tol, near);
+        if (ref < near.within - kBand) {
+          EXPECT_EQ(w, 0.0) << what;
+          ++within_hits;
+        } else if (ref > near.within + kBand) {
+          EXPECT_GT(w, near.within) << what << ": beyond `within` must compare beyond it";
+          EXPECT_LE(w, ref + kBand) << what;
+          ++within_clear;
+        }
+        // The warm starts only speed it up: forgotten, the answers are a fresh pair's, bit for bit.
+        pair.forget();
+        BodyPair fresh(g[i], g[j]);
+        EXPECT_EQ(pair.lowerBound(pa, pb, tol, near), fresh.lowerBound(pa, pb, tol, near)) << what;
+        EXPECT_EQ(pair.intersects(pa, pb, tol, {0.01, GeometryMode::Mesh}),
+                  meshesIntersect(g[i], pa, g[j], pb, tol, GeometryMode::Mesh, 0.01))
+            << what;
+        const DistanceResult d = pair.distance(pa, pb, tol, {});
+        EXPECT_NEAR(d.distance, ref, 1e-7) << what;
+      }
+    }
+  }
+  std::printf("  %d cases: %d reached the triangles, %d within 1 cm, %d beyond\n", cases, exact, within_hits,
+              within_clear);
+  EXPECT_GT(exact, cases / 10);
+  EXPECT_GT(within_hits, cases / 10);
+  EXPECT_GT(within_clear, cases / 10);
+}
+
+TEST(BodyPair, FarBodiesStopAtTheBalls) {
+  const LinkGeometry a(tree_ref::uvSphere(0.1, 8, 12)), b(tree_ref::gridBox(Vec3(0.15, 0.1, 0.002), 2));
+  BodyPair pair(a, b);
+  const Tolerances tol;
+  BoundQuery q;
+  q.enough = 0.5;
+  EXPECT_GE(pair.lowerBound(Pose(), Pose::translation(Vec3(2, 0, 0)), tol, q), 0.5);
+  EXPECT_EQ(pair.lastRung(), Rung::Balls);
+  // A plate 0.098 above the sphere: the balls overlap, the hulls are apart by more than asked.
+  q.enough = 0.04;
+  const double d = pair.lowerBound(Pose(), Pose::translation(Vec3(0, 0, 0.2)), tol, q);
+  EXPECT_GE(d, 0.04);
+  EXPECT_EQ(pair.lastRung(), Rung::Hulls);
+}
+
+TEST(BodyPair, NeverFarByAccident) {
+  const LinkGeometry a(tree_ref::uvSphere(0.1, 8, 12)), b(tree_ref::gridBox(Vec3(0.1, 0.1, 0.1), 2));
+  BodyPair pair(a, b);
+  const Tolerances tol;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  Pose bad = Pose::translation(Vec3(5, 0, 0));
+  bad.t.x() = nan;
+  EXPECT_EQ(pair.lowerBound(Pose(), bad, tol, {}), 0.0);
+  EXPECT_EQ(pair.lowerBound(bad, Pose(), tol, {}), 0.0);
+  EXPECT_TRUE(pair.intersects(Pose(), bad, tol, {}));
+  EXPECT_TRUE(pair.intersects(Pose(), Pose::translation(Vec3(5, 0, 0)), tol, {nan, GeometryMode::Mesh}));
+  BoundQuery q;
+  q.enough = nan;  // a NaN request climbs every rung and still answers a bound
+  EXPECT_LE(pair.lowerBound(Pose(), Pose::translation(Vec3(0.5, 0, 0)), tol, q), 0.3 + kBand);
+  // A box wholly inside the closed sphere: a solid, so 0 apart.
+  const LinkGeometry small(tree_ref::gridBox(Vec3(0.01, 0.01, 0.01), 1));
+  BodyPair inside(a, small);
+  EXPECT_EQ(inside.lowerBound(Pose(), Pose(), tol, {}), 0.0);
+}
+
+}  // namespace
+}  // namespace clearway
