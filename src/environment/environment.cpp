@@ -140,6 +140,73 @@ Environment::Environment(std::vector<Obstacle> obstacles, std::shared_ptr<const 
   scale_ = std::max(maxAbs(static_tree_.bounds()), maxAbs(voxel_tree_.bounds()));
 }
 
+// Which items a query visits: those whose boxes overlap a world box, or those within `limit` of the link's
+// box as an oriented box (the limit is read again before each item: a nearest search lowers it).
+struct Environment::Reach {
+  const Aabb* box = nullptr;    // overlap
+  const Aabb* local = nullptr;  // within: the link's box in its frame, placed by *pose
+  const Pose* pose = nullptr;
+  double* limit = nullptr;
+
+  static Reach overlapping(const Aabb& world_box) noexcept {
+    Reach r;
+    r.box = &world_box;
+    return r;
+  }
+  static Reach within(const Aabb& local_box, const Pose& pose, double& limit) noexcept {
+    Reach r;
+    r.local = &local_box;
+    r.pose = &pose;
+    r.limit = &limit;
+    return r;
+  }
+};
+
+// One item near the link: an obstacle where it is at the query's time, or a voxel.
+struct Environment::Item {
+  EnvironmentHit::Kind kind;
+  int index;                   // obstacle index, or voxel index
+  const Obstacle* obstacle;    // null for a voxel
+  const Aabb* voxel;           // null for an obstacle
+  Pose pose;                   // the obstacle's at the query's time, or the voxel's centre
+  int warm;                    // a static obstacle's index among the static ones (its warm start), else −1
+
+  Aabb box() const noexcept { return obstacle ? obstacleBox(*obstacle, pose) : *voxel; }
+  // f applied to the item as a convex shape: a mesh obstacle's hull, a primitive, a voxel's box.
+  template <class F>
+  decltype(auto) convex(F&& f) const {
+    return obstacle ? onConvex(*obstacle, f) : f(Box(voxel->halfExtents()));
+  }
+};
+
+template <class F>
+Environment::Walk Environment::forEachItem(const Reach& reach, double t, F&& visit) const {
+  const auto tree = [&](const AabbTree& items, auto&& on_item) {
+    return reach.box ? items.query(*reach.box, on_item) : items.forEachWithin(*reach.local, *reach.pose, *reach.limit, on_item);
+  };
+  if (tree(static_tree_, [&](std::int32_t k) {
+        const int i = static_[k];
+        return visit(Item{EnvironmentHit::Kind::Obstacle, i, &obstacles_[i], nullptr, obstacles_[i].pose, k});
+      }))
+    return Walk::Stopped;
+  // Moving obstacles are few by nature: each box is placed at t and tested on its own.
+  const Aabb link_box = reach.box ? Aabb() : transformed(*reach.local, *reach.pose);
+  for (const int i : moving_) {
+    const Item item{EnvironmentHit::Kind::Obstacle, i, &obstacles_[i], nullptr, poseAt(obstacles_[i], t), -1};
+    if (!item.pose.isFinite()) return Walk::Invalid;
+    const Aabb box = item.box();
+    if (reach.box ? !overlaps(box, *reach.box) : !(boxDistance(box, link_box) <= *reach.limit)) continue;
+    if (visit(item)) return Walk::Stopped;
+  }
+  if (voxel_tree_.empty()) return Walk::Done;
+  const std::vector<Aabb>& voxels = map_->occupied;
+  return tree(voxel_tree_, [&](std::int32_t v) {
+           return visit(Item{EnvironmentHit::Kind::Voxel, v, nullptr, &voxels[v], Pose::translation(voxels[v].center()), -1});
+         })
+             ? Walk::Stopped
+             : Walk::Done;
+}
+
 bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, GeometryMode mode,
                                  double padding, double t, EnvironmentHit* hit,
                                  EnvironmentCounters* counters) const noexcept {
@@ -156,50 +223,45 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
   const double slack = padding + bandOf(scale_ + maxAbs(link_box) + padding, tol);
   const Aabb query = link_box.inflated(slack);
 
-  int found = -1;
-  static_tree_.query(query, [&](std::int32_t item) {
-    const int i = static_[item];
-    if (counters) ++counters->obstacle_tests;
-    if (!obstacleIntersects(obstacles_[i], obstacles_[i].pose, link, pose, tol, mode, padding)) return false;
-    found = i;
-    return true;
-  });
-  if (found >= 0) return report(EnvironmentHit::Kind::Obstacle, found);
-
-  // Moving obstacles are few by nature; shapeIntersectsLink's bounding-sphere test is their cull.
-  for (const int i : moving_) {
-    const Pose at = poseAt(obstacles_[i], t);
-    if (counters) ++counters->obstacle_tests;
-    if (!at.isFinite() || obstacleIntersects(obstacles_[i], at, link, pose, tol, mode, padding))
-      return report(EnvironmentHit::Kind::Obstacle, i);
-  }
-
-  if (voxel_tree_.empty()) return false;
-  const std::vector<Aabb>& voxels = map_->occupied;
-  // The link's box as an oriented box in the world (A = world, B = the link frame).
+  // The link's box as an oriented box in the world (A = world, B = the link frame): the voxels' first cull.
   const detail::OrientedBoxTest obb(pose, slack, scale_ + maxAbs(link_box));
   const detail::OrientedBoxTest::PlacedB placed_link = obb.place(link.bounds());
-  SimplexCache cache;
+  SimplexCache cache;  // one for all voxels: they are axis-aligned, so the last separating axis starts the next well
   int passed[kFewVoxels];
   int n_passed = 0;
   bool many = false;
-  voxel_tree_.query(query, [&](std::int32_t v) {
+  int found = -1;
+  EnvironmentHit::Kind found_kind = EnvironmentHit::Kind::None;
+  const Walk walk = forEachItem(Reach::overlapping(query), t, [&](const Item& item) {
+    found_kind = item.kind;
+    if (item.obstacle) {
+      if (counters) ++counters->obstacle_tests;
+      if (!obstacleIntersects(*item.obstacle, item.pose, link, pose, tol, mode, padding)) return false;
+      found = item.index;
+      return true;
+    }
     double c[3], h[3];
-    detail::OrientedBoxTest::centerHalf(voxels[v], c, h);
+    detail::OrientedBoxTest::centerHalf(*item.voxel, c, h);
     if (obb.separated<false>(c, h, placed_link)) return false;
     if (counters) ++counters->voxel_tests;
-    const Box box(Vec3(h[0], h[1], h[2]));
-    if (!shapeIntersectsLink(box, Pose::translation(Vec3(c[0], c[1], c[2])), link, pose, tol, GeometryMode::Hull,
-                             padding, &cache))
+    if (!shapeIntersectsLink(Box(Vec3(h[0], h[1], h[2])), Pose::translation(Vec3(c[0], c[1], c[2])), link, pose, tol,
+                             GeometryMode::Hull, padding, &cache))
       return false;
     if (mode == GeometryMode::Hull || n_passed == kFewVoxels) {
-      found = v;
+      found = item.index;
       many = mode == GeometryMode::Mesh;
       return true;
     }
-    passed[n_passed++] = v;
+    passed[n_passed++] = item.index;
     return false;
   });
+  if (walk == Walk::Invalid) {  // a moving obstacle out of reach of the doubles: touching, never free
+    for (const int i : moving_)
+      if (!poseAt(obstacles_[i], t).isFinite()) return report(EnvironmentHit::Kind::Obstacle, i);
+  }
+  if (found >= 0 && found_kind == EnvironmentHit::Kind::Obstacle) return report(found_kind, found);
+  if (voxel_tree_.empty()) return false;
+  const std::vector<Aabb>& voxels = map_->occupied;
   if (mode == GeometryMode::Hull) return found >= 0 ? report(EnvironmentHit::Kind::Voxel, found) : false;
 
   if (!many) {
@@ -273,44 +335,20 @@ DistanceResult Environment::linkDistance(const LinkGeometry& link, const Pose& p
     return r;
   }
   NearestSearch search(cutoff, relative_error);
-  const Aabb link_box = transformed(link.bounds(), pose);
 
-  // One obstacle: the hull's lower bound first (one GJK), the exact geometry only when it may be nearer.
-  const auto visit = [&](const Obstacle& o, const Pose& pose_o) {
-    const DistanceResult hull = onConvex(o, [&](const auto& s) { return gjkDistance(link.hull(), pose, s, pose_o, tol); });
+  // One item: the hull's lower bound first (one GJK), the exact geometry only when it may be nearer. The
+  // link's box as an oriented box sees items much nearer than its world box admits.
+  const Walk walk = forEachItem(Reach::within(link.bounds(), pose, search.limit), t, [&](const Item& item) {
+    const DistanceResult hull = item.convex([&](const auto& s) { return gjkDistance(link.hull(), pose, s, item.pose, tol); });
     if (!isFailure(hull.status) && hull.lower_bound >= search.limit) return false;
     if (mode == GeometryMode::Hull) return search.add(hull);
     if (counters) ++counters->distance_tests;
-    return search.add(o.mesh ? meshDistance(link, pose, *o.mesh, pose_o, tol, relative_error)
-                             : swapped(shapeLinkDistance(o.shape, pose_o, link, pose, tol, relative_error)));
-  };
-
-  // The link's box as an oriented box sees obstacles and voxels much nearer than its world box admits.
-  bool stop = static_tree_.forEachWithin(link.bounds(), pose, search.limit, [&](std::int32_t item) {
-    const Obstacle& o = obstacles_[static_[item]];
-    return visit(o, o.pose);
+    if (item.obstacle && item.obstacle->mesh)
+      return search.add(meshDistance(link, pose, *item.obstacle->mesh, item.pose, tol, relative_error));
+    const Shape shape = item.obstacle ? item.obstacle->shape : Shape(Box(item.voxel->halfExtents()));
+    return search.add(swapped(shapeLinkDistance(shape, item.pose, link, pose, tol, relative_error)));
   });
-  for (std::size_t k = 0; k < moving_.size() && !stop; ++k) {
-    const Obstacle& o = obstacles_[moving_[k]];
-    const Pose at = poseAt(o, t);
-    if (!at.isFinite()) {
-      search.failed = true;
-      break;
-    }
-    if (boxDistance(obstacleBox(o, at), link_box) <= search.limit) stop = visit(o, at);
-  }
-  if (!stop && !search.failed && !voxel_tree_.empty()) {
-    const std::vector<Aabb>& voxels = map_->occupied;
-    voxel_tree_.forEachWithin(link.bounds(), pose, search.limit, [&](std::int32_t v) {
-      const Box box(voxels[v].halfExtents());
-      const Pose pose_v = Pose::translation(voxels[v].center());
-      const DistanceResult hull = gjkDistance(link.hull(), pose, box, pose_v, tol);
-      if (!isFailure(hull.status) && hull.lower_bound >= search.limit) return false;
-      if (mode == GeometryMode::Hull) return search.add(hull);
-      if (counters) ++counters->distance_tests;
-      return search.add(swapped(shapeLinkDistance(box, pose_v, link, pose, tol, relative_error)));
-    });
-  }
+  if (walk == Walk::Invalid) search.failed = true;
 
   DistanceResult r = search.best;
   if (search.failed) {
@@ -349,27 +387,12 @@ double Environment::hullLowerBound(const LinkGeometry& link, const Pose& pose, c
     lower = std::min(lower, gjkLowerBound(link.hull(), pose, shape, pose_o, tol, cache ? *cache : cold, lower, relative));
     return !(lower > 0.0);
   };
-  const auto obstacle = [&](const Obstacle& o, const Pose& at, SimplexCache* cache) {
-    return onConvex(o, [&](const auto& s) { return measure(s, at, cache); });
-  };
-  bool stop = static_tree_.forEachWithin(link.bounds(), pose, lower, [&](std::int32_t item) {
-    const Obstacle& o = obstacles_[static_[item]];
-    return obstacle(o, o.pose, warm ? warm + item : nullptr);
+  const Walk walk = forEachItem(Reach::within(link.bounds(), pose, lower), t, [&](const Item& item) {
+    if (!item.obstacle && counters) ++counters->voxel_tests;  // (as linkDistance counts: voxel hull tests)
+    SimplexCache* cache = warm && item.warm >= 0 ? warm + item.warm : nullptr;
+    return item.convex([&](const auto& s) { return measure(s, item.pose, cache); });
   });
-  const Aabb link_box = transformed(link.bounds(), pose);
-  for (std::size_t k = 0; k < moving_.size() && !stop; ++k) {
-    const Obstacle& o = obstacles_[moving_[k]];
-    const Pose at = poseAt(o, t);
-    if (!at.isFinite()) return 0.0;
-    if (boxDistance(obstacleBox(o, at), link_box) <= lower) stop = obstacle(o, at, nullptr);
-  }
-  if (!stop && !voxel_tree_.empty()) {
-    const std::vector<Aabb>& voxels = map_->occupied;
-    voxel_tree_.forEachWithin(link.bounds(), pose, lower, [&](std::int32_t v) {
-      if (counters) ++counters->voxel_tests;  // (as linkDistance counts: voxel hull tests, not obstacles')
-      return measure(Box(voxels[v].halfExtents()), Pose::translation(voxels[v].center()), nullptr);
-    });
-  }
+  if (walk == Walk::Invalid) return 0.0;
   return lower >= 0.0 ? lower : 0.0;  // (NaN: 0)
 }
 
@@ -425,24 +448,11 @@ double Environment::linkCast(const LinkGeometry& link, const Pose& pose, const V
     const CastResult c = gjkShapeCast(grown, pose, velocity, shape, pose_o, limit, tol);
     if (c.hit) first = std::min(first, std::max(0.0, c.t));
   };
-  const auto visitObstacle = [&](const Obstacle& o, const Pose& pose_o) {
-    onConvex(o, [&](const auto& shape) { visit(obstacleBox(o, pose_o), shape, pose_o); });
-  };
-  static_tree_.query(swept, [&](std::int32_t item) {
-    const Obstacle& o = obstacles_[static_[item]];
-    visitObstacle(o, o.pose);
+  const Walk walk = forEachItem(Reach::overlapping(swept), t, [&](const Item& item) {
+    item.convex([&](const auto& shape) { visit(item.box(), shape, item.pose); });
+    return false;
   });
-  for (const int k : moving_) {
-    const Pose at = poseAt(obstacles_[k], t);
-    if (!at.isFinite()) return 0.0;
-    visitObstacle(obstacles_[k], at);
-  }
-  if (!voxel_tree_.empty()) {
-    const std::vector<Aabb>& voxels = map_->occupied;
-    voxel_tree_.query(swept, [&](std::int32_t v) {
-      visit(voxels[v], Box(voxels[v].halfExtents()), Pose::translation(voxels[v].center()));
-    });
-  }
+  if (walk == Walk::Invalid) return 0.0;
   return first <= max_s ? first : kNone;
 }
 
@@ -460,31 +470,18 @@ double Environment::linkPenetration(const LinkGeometry& link, const Pose& pose, 
     if (isFailure(r.status)) failed = true;
     deepest = std::max(deepest, padding - r.signed_distance);  // padded links may touch with the hull apart
   };
-  const auto visit = [&](const Obstacle& o, const Pose& pose_o) {
-    if (o.mesh) {
-      if (meshesIntersect(link, pose, *o.mesh, pose_o, tol, GeometryMode::Mesh, padding)) depth(o.mesh->hull(), pose_o);
-    } else if (shapeIntersectsLink(o.shape, pose_o, link, pose, tol, GeometryMode::Mesh, padding)) {
-      std::visit([&](const auto& s) { depth(s, pose_o); }, o.shape);
+  const Walk walk = forEachItem(Reach::overlapping(link_box), t, [&](const Item& item) {
+    const Obstacle* o = item.obstacle;
+    if (o && o->mesh) {
+      if (meshesIntersect(link, pose, *o->mesh, item.pose, tol, GeometryMode::Mesh, padding)) depth(o->mesh->hull(), item.pose);
+      return false;
     }
-  };
-  static_tree_.query(link_box, [&](std::int32_t item) {
-    const Obstacle& o = obstacles_[static_[item]];
-    visit(o, o.pose);
+    const Shape shape = o ? o->shape : Shape(Box(item.voxel->halfExtents()));
+    if (shapeIntersectsLink(shape, item.pose, link, pose, tol, GeometryMode::Mesh, padding))
+      std::visit([&](const auto& s) { depth(s, item.pose); }, shape);
+    return false;
   });
-  for (const int k : moving_) {
-    const Obstacle& o = obstacles_[k];
-    const Pose at = poseAt(o, t);
-    if (!at.isFinite()) return nan;
-    if (overlaps(obstacleBox(o, at), link_box)) visit(o, at);
-  }
-  if (!voxel_tree_.empty()) {
-    const std::vector<Aabb>& voxels = map_->occupied;
-    voxel_tree_.query(link_box, [&](std::int32_t v) {
-      const Box box(voxels[v].halfExtents());
-      const Pose pose_v = Pose::translation(voxels[v].center());
-      if (shapeIntersectsLink(box, pose_v, link, pose, tol, GeometryMode::Mesh, padding)) depth(box, pose_v);
-    });
-  }
+  if (walk == Walk::Invalid) return nan;
   return failed ? nan : deepest;
 }
 

@@ -131,6 +131,14 @@ class Environment {
                          double t = 0.0, EnvironmentCounters* counters = nullptr) const noexcept;
 
  private:
+  // The one walk over what lies near a link (environment.cpp): static obstacles from their tree, moving
+  // ones where they are at the query's time, then voxels; every query above is a visit of it.
+  struct Reach;
+  struct Item;
+  enum class Walk { Done, Stopped, Invalid };
+  template <class F>
+  Walk forEachItem(const Reach& reach, double t, F&& visit) const;
+
   std::vector<Obstacle> obstacles_;
   std::shared_ptr<const OccupancyMap> map_;
   AabbTree static_tree_;          // static obstacles, world frame
