@@ -9,6 +9,9 @@
 #include <string>
 
 namespace clearway {
+namespace {
+constexpr double kNoCutoff = std::numeric_limits<double>::infinity();
+}  // namespace
 
 SelfCollision::SelfCollision(std::shared_ptr<const RobotGeometry> geometry, const CollisionFilter& filter,
                              SelfCollisionOptions options)
@@ -36,16 +39,17 @@ SelfCollision::SelfCollision(std::shared_ptr<const RobotGeometry> geometry, cons
 
 SelfCollisionContext SelfCollision::makeContext() const {
   SelfCollisionContext c;
-  c.pair_caches.resize(pairs_.size());
+  c.bodies.reserve(pairs_.size());
+  for (const LinkPair& p : pairs_) c.bodies.emplace_back(*geometry_->link(p.a), *geometry_->link(p.b));
   return c;
 }
 
 bool SelfCollision::pairCollides(int k, const Pose* poses, SelfCollisionContext& ctx) const noexcept {
   const LinkPair& p = pairs_[k];
   ++ctx.pair_tests;
-  SimplexCache* cache = k < static_cast<int>(ctx.pair_caches.size()) ? &ctx.pair_caches[k] : nullptr;
-  return meshesIntersect(*geometry_->link(p.a), poses[p.a], *geometry_->link(p.b), poses[p.b], options_.tolerances,
-                         options_.mode, pair_padding_[k], cache);
+  const IntersectQuery q{pair_padding_[k], options_.mode};
+  if (k < static_cast<int>(ctx.bodies.size())) return ctx.bodies[k].intersects(poses[p.a], poses[p.b], options_.tolerances, q);
+  return BodyPair(*geometry_->link(p.a), *geometry_->link(p.b)).intersects(poses[p.a], poses[p.b], options_.tolerances, q);
 }
 
 const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionContext& ctx) const noexcept {
@@ -76,8 +80,8 @@ DistanceResult SelfCollision::minimumDistance(const Pose* poses, LinkPair* pair,
   double lower = best.lower_bound;  // the minimum's lower bound is the least of all pairs' lower bounds
   for (int k = 0; k < static_cast<int>(pairs_.size()); ++k) {
     const LinkPair& p = pairs_[k];
-    DistanceResult r = meshDistance(*geometry_->link(p.a), poses[p.a], *geometry_->link(p.b), poses[p.b],
-                                    options_.tolerances, relative_error);
+    DistanceResult r = BodyPair(*geometry_->link(p.a), *geometry_->link(p.b))
+                           .distance(poses[p.a], poses[p.b], options_.tolerances, {kNoCutoff, relative_error});
     if (isFailure(r.status)) return r;
     r.distance = std::max(0.0, r.distance - pair_padding_[k]);
     r.lower_bound = std::max(0.0, r.lower_bound - pair_padding_[k]);

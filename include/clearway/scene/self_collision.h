@@ -5,6 +5,7 @@
 // pair's hulls, the pair that collided last) lives in a SelfCollisionContext, one per thread.
 #include <clearway/kinematics/robot_model.h>
 #include <clearway/scene/collision_filter.h>
+#include <clearway/body/proximity.h>
 #include <clearway/body/robot_geometry.h>
 #include <clearway/tolerances.h>
 
@@ -30,7 +31,7 @@ struct SelfCollisionOptions {
 
 /// Per-thread state of self-collision queries: one hull cache per pair and the pair that last collided.
 struct SelfCollisionContext {
-  std::vector<SimplexCache> pair_caches;
+  std::vector<BodyPair> bodies;  ///< per checked pair: its two links' geometry and warm starts
   int last_hit = -1;
   long long pair_tests = 0;  ///< pairs that reached the narrow phase (bounding spheres not apart), cumulative
 };
