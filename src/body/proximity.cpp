@@ -1,13 +1,15 @@
 // BodyPair: the proximity ladder of two bodies, written once.
 #include <clearway/body/proximity.h>
 
+#include <clearway/narrowphase/epa.h>
+
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace clearway {
 
-BodyPair::BodyPair(const LinkGeometry& a, const LinkGeometry& b)
-    : a_(&a), b_(&b), parts_(a.parts().size() * b.parts().size()) {}
+BodyPair::BodyPair(const LinkGeometry& a, const LinkGeometry& b) : a_(&a), b_(&b) {}
 
 void BodyPair::forget() noexcept {
   hull_ = SimplexCache{};
@@ -34,8 +36,8 @@ double BodyPair::lowerBound(const Pose& pose_a, const Pose& pose_b, const Tolera
     lower = std::max(gjkLowerBound(a.hull(), pose_a, b.hull(), pose_b, tol, hull_, q.enough, q.relative), lower);
   }
   if (!(lower <= climb) || q.mode == GeometryMode::Hull) return lower >= 0.0 ? lower : 0.0;
-  if (parts_stale_) {
-    std::fill(parts_.begin(), parts_.end(), SimplexCache{});
+  if (parts_stale_ || parts_.empty()) {  // (allocated when first needed: most pairs never get this far)
+    parts_.assign(a.parts().size() * b.parts().size(), SimplexCache{});
     parts_stale_ = false;
   }
   rung_ = Rung::Parts;
@@ -48,6 +50,14 @@ double BodyPair::lowerBound(const Pose& pose_a, const Pose& pose_b, const Tolera
   const DistanceResult m = meshDistance(a, pose_a, b, pose_b, tol, q.relative, std::min(q.enough, q.near));
   if (isFailure(m.status)) return 0.0;
   return q.within >= 0.0 ? std::max(m.lower_bound, q.within * (1.0 + 1e-9)) : m.lower_bound;
+}
+
+double BodyPair::penetration(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol,
+                              double padding) const noexcept {
+  if (!(padding >= 0.0) || !std::isfinite(padding)) return std::numeric_limits<double>::quiet_NaN();
+  const PenetrationResult r = epaPenetration(a_->hull(), pose_a, b_->hull(), pose_b, tol);
+  if (isFailure(r.status)) return std::numeric_limits<double>::quiet_NaN();
+  return std::max(0.0, padding - r.signed_distance);  // padded bodies may overlap with their hulls apart
 }
 
 DistanceResult BodyPair::distance(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol,

@@ -1,7 +1,5 @@
 #include <clearway/scene/self_collision.h>
 
-#include <clearway/narrowphase/epa.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -100,11 +98,9 @@ double SelfCollision::penetration(const Pose* poses, SelfCollisionContext& conte
   for (int k = 0; k < static_cast<int>(pairs_.size()); ++k) {
     if (!pairCollides(k, poses, context)) continue;
     const LinkPair& p = pairs_[k];
-    const PenetrationResult r = epaPenetration(geometry_->link(p.a)->hull(), poses[p.a], geometry_->link(p.b)->hull(),
-                                               poses[p.b], options_.tolerances);
-    if (isFailure(r.status)) return std::numeric_limits<double>::quiet_NaN();
-    // Padded pairs may collide with their hulls apart: then the depth is padding − distance.
-    const double depth = pair_padding_[k] - r.signed_distance;
+    const double depth = BodyPair(*geometry_->link(p.a), *geometry_->link(p.b))
+                             .penetration(poses[p.a], poses[p.b], options_.tolerances, pair_padding_[k]);
+    if (std::isnan(depth)) return depth;
     if (depth > deepest) {
       deepest = depth;
       if (pair) *pair = p;

@@ -105,6 +105,22 @@ TEST(BodyPair, LadderBoundsTheBruteForceDistance) {
   EXPECT_GT(within_clear, cases / 10);
 }
 
+TEST(BodyPair, PenetrationBoundsTheOverlap) {
+  // Two unit-ish boxes (closed meshes) overlapping by a known depth along x: their hulls are the boxes.
+  const LinkGeometry a(tree_ref::gridBox(Vec3(0.1, 0.1, 0.1), 2)), b(tree_ref::gridBox(Vec3(0.05, 0.05, 0.05), 2));
+  const BodyPair pair(a, b);
+  const Tolerances tol;
+  EXPECT_NEAR(pair.penetration(Pose(), Pose::translation(Vec3(0.13, 0, 0)), tol), 0.02, 1e-9);
+  EXPECT_NEAR(pair.penetration(Pose(), Pose::translation(Vec3(0.13, 0, 0)), tol, 0.01), 0.03, 1e-9);
+  EXPECT_EQ(pair.penetration(Pose(), Pose::translation(Vec3(0.5, 0, 0)), tol), 0.0);
+  EXPECT_NEAR(pair.penetration(Pose(), Pose::translation(Vec3(0.16, 0, 0)), tol, 0.02), 0.01, 1e-9)
+      << "padding counts as overlap: 1 cm apart, padded by 2";
+  Pose bad;
+  bad.t.x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_TRUE(std::isnan(pair.penetration(Pose(), bad, tol)));
+  EXPECT_TRUE(std::isnan(pair.penetration(Pose(), Pose(), tol, -1.0)));
+}
+
 TEST(BodyPair, FarBodiesStopAtTheBalls) {
   const LinkGeometry a(tree_ref::uvSphere(0.1, 8, 12)), b(tree_ref::gridBox(Vec3(0.15, 0.1, 0.002), 2));
   BodyPair pair(a, b);

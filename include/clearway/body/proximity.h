@@ -43,8 +43,8 @@ struct DistanceQuery {
 /// The rungs of the ladder, cheapest first.
 enum class Rung : char { Balls, Hulls, Parts, Exact };
 
-/// Two bodies (two links, or a link and a mesh obstacle) and the warm starts of their convex bounds. Cheap
-/// to copy; the geometries must outlive it. Not thread-safe: one per pair and thread.
+/// Two bodies (two links, or a link and a mesh obstacle) and the warm starts of their convex bounds. Made
+/// without allocating; the geometries must outlive it. Not thread-safe: one per pair and thread.
 class BodyPair {
  public:
   BodyPair(const LinkGeometry& a, const LinkGeometry& b);
@@ -58,6 +58,10 @@ class BodyPair {
   /// A certified lower bound on the distance between the bodies (see BoundQuery); 0 for non-finite input or
   /// a narrow-phase failure.
   double lowerBound(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, const BoundQuery& q) noexcept;
+  /// An upper bound on how deep the bodies overlap, counting `padding` as overlap (0 when they are farther
+  /// apart than padding): the hulls' EPA depth plus padding, the hulls containing the bodies. NaN when EPA
+  /// fails or the input is not finite (never a depth of 0 by accident).
+  double penetration(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, double padding = 0.0) const noexcept;
   /// The distance between the exact geometries: meshDistance.
   DistanceResult distance(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol,
                           const DistanceQuery& q) const noexcept;
