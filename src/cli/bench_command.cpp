@@ -6,6 +6,7 @@
 // `clearway bench merge` checks that shards 0 … N−1 of one configuration are all there, each once, and
 // writes the same files an unsharded run writes. Rows are copied verbatim and ordered by case, so a
 // merged results.csv equals an unsharded one except for the measured times.
+#include "data_paths.h"
 #include "scene_commands.h"
 
 #ifdef CLEARWAY_HAVE_BENCH_SUITES
@@ -45,7 +46,9 @@ const char* const kBenchUsage =
     "DIR/plots.gp and its PNG plots (when gnuplot is installed). --count: pairs per shape family, states\n"
     "or motions per problem (default 200); --problems: problems per scene family (default 1);\n"
     "--subjects: only the shape families or problems whose name contains one of the strings.\n"
-    "--shard I/N runs the cases with index I modulo N (0 <= I < N); merge combines shards 0..N-1.\n";
+    "--shard I/N runs the cases with index I modulo N (0 <= I < N); merge combines shards 0..N-1.\n"
+    "--shared DIR: the shared development data, the folder holding scenes/ (states, motions and plan need\n"
+    "it); default $CLEARWAY_SHARED, and for the binary in its build tree ../shared beside the source.\n";
 
 constexpr const char* kColumns =
     "suite,case,subject,engine,mode,tolerance,items,ns_per_item,work_per_item,positives,misses,false_alarms,"
@@ -419,7 +422,7 @@ int benchCommand(const std::vector<std::string>& args) {
   return 2;
 #else
   bench::SuiteConfig config;
-  config.shared = CLEARWAY_SOURCE_DIR "/../shared";
+  config.shared = sharedDataDir();
   config.out = "bench-results";
   long shard = -1, shards = 0;
   auto number = [&](std::size_t& i, const char* name, double lo, double& value) {

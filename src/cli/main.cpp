@@ -86,7 +86,8 @@ const Command kCommands[] = {
 
 void printUsage(std::ostream& os) {
   os << "usage: clearway COMMAND [ARGS...]\n"
-        "       clearway COMMAND --help\n\ncommands:\n";
+        "       clearway COMMAND --help\n"
+        "       clearway --version\n\ncommands:\n";
   for (const Command& c : kCommands) os << "  " << c.name << std::string(10 - std::strlen(c.name), ' ') << c.summary << "\n";
 }
 
@@ -101,6 +102,10 @@ int main(int argc, char** argv) {
   if (isHelp(name) || name == "help") {
     printUsage(std::cout);
     return kExitOk;
+  }
+  if (name == "--version") {
+    std::cout << "clearway " CLEARWAY_VERSION "\n";
+    return finishOutput(kExitOk);
   }
   for (const Command& c : kCommands)
     if (name == c.name) return c.run(Args(argv + 2, argv + argc));
