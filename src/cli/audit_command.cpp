@@ -224,14 +224,13 @@ int auditCommand(const std::vector<std::string>& args) {
   std::string srdf_text;                               // the given SRDF, which --srdf-out keeps
   try {
     model = std::make_shared<const RobotModel>(loadRobot(urdf, "", load));
-    for (const std::string& w : model->loadWarnings()) std::cerr << "warning: " << w << "\n";
+    for (const std::string& w : model->loadWarnings()) printWarning(w);
     if (!srdf.empty()) {
       const RobotModel with_srdf = loadRobot(urdf, srdf, load);
       for (const DisabledCollision& d : with_srdf.disabledCollisions())
         shipped[{std::min(d.link_a, d.link_b), std::max(d.link_a, d.link_b)}] = d.reason;
-      // The URDF's own warnings were printed above; those about the SRDF come only from this load.
-      for (const std::string& w : with_srdf.loadWarnings())
-        if (w.rfind(srdf + ":", 0) == 0) std::cerr << "warning: " << w << "\n";
+      // The URDF's own warnings come again, and are printed once (printWarning).
+      for (const std::string& w : with_srdf.loadWarnings()) printWarning(w);
       std::ifstream in(srdf);
       std::ostringstream content;
       content << in.rdbuf();
@@ -243,10 +242,11 @@ int auditCommand(const std::vector<std::string>& args) {
     return kExitUsage;
   }
   const auto geometry = std::make_shared<const RobotGeometry>(model);
-  std::cerr << "clearway audit: " << model->name() << ", " << geometry->geometricLinks().size()
-            << " links with geometry, " << options.samples << " samples (seed " << options.seed << "), "
-            << options.threads << " threads\n";
-  if (isatty(STDERR_FILENO)) options.progress = progressBar;
+  if (!quiet())
+    std::cerr << "clearway audit: " << model->name() << ", " << geometry->geometricLinks().size()
+              << " links with geometry, " << options.samples << " samples (seed " << options.seed << "), "
+              << options.threads << " threads\n";
+  if (isatty(STDERR_FILENO) && !quiet()) options.progress = progressBar;
   const std::vector<PairAudit> audit = auditSelfCollision(geometry, options);
 
   // The pairs whose verdict may mislead come first, the most often colliding first: the audit's own

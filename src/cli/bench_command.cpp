@@ -479,7 +479,8 @@ int benchCommand(const std::vector<std::string>& args) {
   for (std::size_t k = 0; k < cases.size(); ++k) {
     if (shard >= 0 && static_cast<long>(k) % shards != shard) continue;
     const bench::SuiteCase& c = cases[k];
-    std::cerr << "[" << ++done << "/" << mine << "] " << c.suite << " " << c.subject << "\n";
+    ++done;
+    if (!quiet()) std::cerr << "[" << done << "/" << mine << "] " << c.suite << " " << c.subject << "\n";
     std::vector<bench::SuiteRow> rows;
     try {
       bench::runCase(c, config, rows);
