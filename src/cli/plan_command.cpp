@@ -54,7 +54,7 @@ const char* const kPlanUsage =
     "using Clearway's validity checker and certified motion validator; simplifies the path and checks\n"
     "it again, segment by segment, with the certified check. Prints the path, one state per line, on\n"
     "stdout ('path N' then N lines) and the statistics on stderr. Without SCENE it plans on the bundled\n"
-    "scene " CLEARWAY_DEFAULT_SCENE ", found under share/clearway beside the installed tool.\n"
+    "scene " CLEARWAY_DEFAULT_SCENE " of the tool's prefix (BIN/../share/clearway/).\n"
     "Planners: RRTConnect RRT RRTstar LazyRRT BiTRRT pRRT PRM PRMstar LazyPRM KPIECE1 BKPIECE1 LBKPIECE1\n"
     "EST BiEST SBL pSBL.\n"
     "Exit status: 0 with a valid path, 1 when no valid path was found in time, 2 on bad input.\n";
