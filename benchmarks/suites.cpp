@@ -453,9 +453,11 @@ std::vector<SuiteCase> enumerateCases(const SuiteConfig& config) {
         for (const char* family : kShapeFamilies) cases.push_back({suite, family, ""});
       continue;
     }
+    // The tool's --shared DIR and $CLEARWAY_SHARED set config.shared: say so, a user has no other way to learn it.
+    const std::string need = "suite '" + suite + "' needs the shared scenes (clearway bench --shared DIR or $CLEARWAY_SHARED)";
+    if (config.shared.empty()) throw std::runtime_error(need + ", and no shared data folder was given");
     const std::string scenes = config.shared + "/scenes";
-    if (!std::filesystem::is_directory(scenes))
-      throw std::runtime_error("suite '" + suite + "' needs the shared scenes, and " + scenes + " is not a folder");
+    if (!std::filesystem::is_directory(scenes)) throw std::runtime_error(need + ", and " + scenes + " is not a folder");
     for (const std::string& family : sceneFamilies(scenes))
       for (int k = 1; k <= config.problems; ++k) {
         const std::string file = problemFile(scenes, family, k);
