@@ -42,6 +42,8 @@ T make(S&& s) {
 Tolerances tolerances(const py::object& tolerance) {
   Tolerances tol;
   if (tolerance.is_none()) return tol;
+  if (!py::isinstance<py::float_>(tolerance) && !py::isinstance<py::int_>(tolerance))
+    throw py::type_error("tolerance must be a number or None");
   const double t = tolerance.cast<double>();
   if (!(t > 0.0) || !std::isfinite(t)) throw py::value_error("tolerance must be finite and > 0, got " + py::str(tolerance).cast<std::string>());
   tol.gjk_relative = tol.cast_relative = tol.epa_relative = t;

@@ -1,10 +1,11 @@
-// Scenes from Python: load a scene file, classify states and segments in batches. Every batch runs with
-// the GIL released, in this thread's own context (one per scene and thread, as the C++ convenience
-// overloads keep), so several Python threads may share one scene.
+// Scenes from Python: load a scene file, classify states and segments in batches. Every call runs with
+// the GIL released in a context of its own, made fresh: the colliding pair a check reports depends on
+// what the context met before (the last colliding pair is tried first), so a fresh context makes each
+// call's answers depend on its arguments alone, whichever thread calls and whatever it asked before, and
+// equal to the tool's on the same rows. Several Python threads may share one scene.
 #include "bindings.h"
 #include "convert.h"
 
-#include <clearway/detail/per_thread.h>
 #include <clearway/motion/motion.h>
 #include <clearway/scene/scene.h>
 
@@ -21,15 +22,6 @@ namespace clearway::python {
 
 namespace {
 
-// A motion checker with its own per-thread contexts.
-struct Checker {
-  std::unique_ptr<const MotionChecker> checker;
-  detail::ScratchOwner owner;
-  MotionContext& context() const {
-    return detail::perThread<MotionContext>(owner, [this] { return checker->makeContext(); });
-  }
-};
-
 // The scene Python holds, and the motion checkers made for it (one per mode and contact distance: a
 // checker's construction measures the robot, too dear to repeat per call).
 class PyScene {
@@ -37,26 +29,17 @@ class PyScene {
   explicit PyScene(std::shared_ptr<const Scene> s) : scene(std::move(s)) {}
   std::shared_ptr<const Scene> scene;
 
-  SceneContext& context() const {
-    return detail::perThread<SceneContext>(owner_, [this] { return scene->makeContext(); });
-  }
-
-  const Checker& checker(const MotionOptions& options) {
+  const MotionChecker& checker(const MotionOptions& options) {
     const auto key = std::make_tuple(static_cast<int>(options.mode), options.resolution, options.contact_distance);
     std::lock_guard<std::mutex> lock(mutex_);
     auto& entry = checkers_[key];
-    if (!entry) {
-      auto made = std::make_unique<Checker>();
-      made->checker = std::make_unique<const MotionChecker>(scene, options);  // throws ValueError for bad options
-      entry = std::move(made);
-    }
+    if (!entry) entry = std::make_unique<const MotionChecker>(scene, options);  // throws ValueError for bad options
     return *entry;
   }
 
  private:
-  detail::ScratchOwner owner_;  // identifies this scene's per-thread contexts
   std::mutex mutex_;
-  std::map<std::tuple<int, double, double>, std::unique_ptr<Checker>> checkers_;
+  std::map<std::tuple<int, double, double>, std::unique_ptr<const MotionChecker>> checkers_;
 };
 
 // The reason a state is rejected, as `clearway check` prints it after "error ".
@@ -163,7 +146,8 @@ void bindScene(py::module_& m) {
              bool free;
              {
                py::gil_scoped_release release;
-               free = s.scene->isFree(q.data(), s.context(), &r);
+               SceneContext ctx = s.scene->makeContext();
+               free = s.scene->isFree(q.data(), ctx, &r);
              }
              if (r.kind == CollisionReport::Kind::Invalid) invalidRow(*s.scene, "q", 0, q.data());
              return free;
@@ -182,7 +166,7 @@ void bindScene(py::module_& m) {
                const double* q = Q.data();
                bool* out = free.mutable_data();
                py::gil_scoped_release release;
-               SceneContext& ctx = s.context();
+               SceneContext ctx = scene.makeContext();
                CollisionReport r;
                for (py::ssize_t i = 0; i < n; ++i) {
                  out[i] = scene.isFree(q + i * dof, ctx, &r);
@@ -213,7 +197,7 @@ void bindScene(py::module_& m) {
                const double* q = Q.data();
                double* c = out.mutable_data();
                py::gil_scoped_release release;
-               SceneContext& ctx = s.context();
+               SceneContext ctx = scene.makeContext();
                for (py::ssize_t i = 0; i < n; ++i) {
                  if (!scene.validState(q + i * dof)) { bad = i; break; }
                  c[i] = scene.clearance(q + i * dof, ctx);
@@ -233,7 +217,7 @@ void bindScene(py::module_& m) {
              requireRows(Q1, "Q1", scene.dimension());
              if (Q0.shape(0) != Q1.shape(0))
                throw py::value_error("Q0 and Q1 must have as many rows, got " + shapeText(Q0) + " and " + shapeText(Q1));
-             const Checker& c = s.checker(motionOptions(mode, contact_distance));
+             const MotionChecker& checker = s.checker(motionOptions(mode, contact_distance));
              const py::ssize_t n = Q0.shape(0), dof = scene.dimension();
              py::array_t<bool> free(n);
              py::array_t<double> last_valid(n);
@@ -245,7 +229,7 @@ void bindScene(py::module_& m) {
                bool* f = free.mutable_data();
                double* lv = last_valid.mutable_data();
                py::gil_scoped_release release;
-               MotionContext& ctx = c.context();
+               MotionContext ctx = checker.makeContext();
                for (py::ssize_t i = 0; i < n; ++i) {
                  const double *a = q0 + i * dof, *b = q1 + i * dof;
                  // As `clearway motion`: an invalid end is an error, not a colliding segment.
@@ -254,7 +238,7 @@ void bindScene(py::module_& m) {
                    bad_end = scene.validState(a);
                    break;
                  }
-                 const MotionResult r = c.checker->check(a, b, ctx);
+                 const MotionResult r = checker.check(a, b, ctx);
                  f[i] = r.free;
                  lv[i] = r.free ? 1.0 : r.last_valid;
                  if (report) reports[i] = r.report;
