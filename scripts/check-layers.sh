@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # The layering check: every folder of include/clearway/ and src/ is a pipeline stage, and a stage may
 # include only itself and the stages before it. Reads every `#include <clearway/STAGE/...>` (and the
-# plugin's, the tool's and the Python module's) and fails, naming file, line and both stages, when one points up the pipeline or
-# names a stage not listed here. Headers at include/clearway/ itself (math.h, tolerances.h) and detail/
-# are below every stage.
+# plugin's, the tool's and the Python module's) and fails, naming file, line and both stages, when one
+# points up the pipeline or names a stage not listed here. Headers at include/clearway/ itself (math.h,
+# tolerances.h) and detail/ are below every stage.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 

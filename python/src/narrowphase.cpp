@@ -91,22 +91,22 @@ void bindNarrowphase(py::module_& m) {
   py::class_<PyBox, PyShape>(m, "Box", "An axis-aligned box centred at the local origin.")
       .def(py::init([](const py::object& h) { return make<PyBox>(Box(toVec3(h, "half_extents"))); }),
            py::arg("half_extents"), "Half extents, each finite and >= 0.")
-      .def_property_readonly("half_extents", [](const PyBox& b) { return toArray(std::get<Box>(b.shape).half); });
+      .def_property_readonly("half_extents", [](const PyBox& b) { return toArray(std::get<Box>(b.shape).half); }, "Half extents.");
   py::class_<PySphere, PyShape>(m, "Sphere", "A sphere centred at the local origin.")
       .def(py::init([](double r) { return make<PySphere>(Sphere(r)); }), py::arg("radius"))
-      .def_property_readonly("radius", [](const PySphere& s) { return std::get<Sphere>(s.shape).r; });
+      .def_property_readonly("radius", [](const PySphere& s) { return std::get<Sphere>(s.shape).r; }, "Radius.");
   py::class_<PyCapsule, PyShape>(m, "Capsule", "A capsule along local z: the segment |z| <= half_length swept by radius.")
       .def(py::init([](double r, double h) { return make<PyCapsule>(Capsule(r, h)); }), py::arg("radius"), py::arg("half_length"))
-      .def_property_readonly("radius", [](const PyCapsule& s) { return std::get<Capsule>(s.shape).r; })
-      .def_property_readonly("half_length", [](const PyCapsule& s) { return std::get<Capsule>(s.shape).h; });
+      .def_property_readonly("radius", [](const PyCapsule& s) { return std::get<Capsule>(s.shape).r; }, "Radius.")
+      .def_property_readonly("half_length", [](const PyCapsule& s) { return std::get<Capsule>(s.shape).h; }, "Half length along z.");
   py::class_<PyCylinder, PyShape>(m, "Cylinder", "A solid cylinder along local z, |z| <= half_length.")
       .def(py::init([](double r, double h) { return make<PyCylinder>(Cylinder(r, h)); }), py::arg("radius"), py::arg("half_length"))
-      .def_property_readonly("radius", [](const PyCylinder& s) { return std::get<Cylinder>(s.shape).r; })
-      .def_property_readonly("half_length", [](const PyCylinder& s) { return std::get<Cylinder>(s.shape).h; });
+      .def_property_readonly("radius", [](const PyCylinder& s) { return std::get<Cylinder>(s.shape).r; }, "Radius.")
+      .def_property_readonly("half_length", [](const PyCylinder& s) { return std::get<Cylinder>(s.shape).h; }, "Half length along z.");
   py::class_<PyCone, PyShape>(m, "Cone", "A solid cone along local z: base at z = -half_length, apex at +half_length.")
       .def(py::init([](double r, double h) { return make<PyCone>(Cone(r, h)); }), py::arg("radius"), py::arg("half_length"))
-      .def_property_readonly("radius", [](const PyCone& s) { return std::get<Cone>(s.shape).r; })
-      .def_property_readonly("half_length", [](const PyCone& s) { return std::get<Cone>(s.shape).h; });
+      .def_property_readonly("radius", [](const PyCone& s) { return std::get<Cone>(s.shape).r; }, "Radius.")
+      .def_property_readonly("half_length", [](const PyCone& s) { return std::get<Cone>(s.shape).h; }, "Half length along z.");
   py::class_<PyConvexHull, PyShape>(m, "ConvexHull", "The convex hull of a point set (duplicates and interior points allowed).")
       .def(py::init([](const py::object& points) {
              const DoubleArray a = DoubleArray::ensure(points);
@@ -133,19 +133,21 @@ void bindNarrowphase(py::module_& m) {
   py::class_<DistanceResult>(m, "DistanceResult", "A distance query's answer; points and normal in the world frame.")
       .def_readonly("distance", &DistanceResult::distance, "Upper bound on the distance, 0 when the shapes overlap.")
       .def_readonly("lower_bound", &DistanceResult::lower_bound, "Certified lower bound on the distance.")
-      .def_property_readonly("point_a", [](const DistanceResult& r) { return toArray(r.point_a); })
-      .def_property_readonly("point_b", [](const DistanceResult& r) { return toArray(r.point_b); })
+      .def_property_readonly("point_a", [](const DistanceResult& r) { return toArray(r.point_a); }, "Closest point on A.")
+      .def_property_readonly("point_b", [](const DistanceResult& r) { return toArray(r.point_b); }, "Closest point on B.")
       .def_property_readonly("normal", [](const DistanceResult& r) { return toArray(r.normal); }, "Unit, from A towards B.")
-      .def_property_readonly("status", &statusOf<DistanceResult>)
-      .def_readonly("iterations", &DistanceResult::iterations)
+      .def_property_readonly("status", &statusOf<DistanceResult>,
+                             "Why the query stopped: 'converged', 'overlapping', ...; 'not_converged' and 'invalid_input' carry no certificate.")
+      .def_readonly("iterations", &DistanceResult::iterations, "GJK / EPA / cast iterations taken.")
       .def("may_collide", &DistanceResult::mayCollide, "True on overlap, touching, or a failed query (never free by accident).")
       .def("__repr__", [](const DistanceResult& r) {
         return "<DistanceResult distance=" + std::to_string(r.distance) + " status=" + statusName(r.status) + ">";
       });
   py::class_<IntersectResult>(m, "IntersectResult", "An intersection query's answer.")
       .def_readonly("intersecting", &IntersectResult::intersecting, "True also when the query failed: assume a collision.")
-      .def_property_readonly("status", &statusOf<IntersectResult>)
-      .def_readonly("iterations", &IntersectResult::iterations)
+      .def_property_readonly("status", &statusOf<IntersectResult>,
+                             "Why the query stopped: 'converged', 'overlapping', ...; 'not_converged' and 'invalid_input' carry no certificate.")
+      .def_readonly("iterations", &IntersectResult::iterations, "GJK / EPA / cast iterations taken.")
       .def("__bool__", [](const IntersectResult& r) { return r.intersecting; })
       .def("__repr__", [](const IntersectResult& r) {
         return std::string("<IntersectResult intersecting=") + (r.intersecting ? "True" : "False") + " status=" + statusName(r.status) + ">";
@@ -154,10 +156,11 @@ void bindNarrowphase(py::module_& m) {
       .def_readonly("depth", &PenetrationResult::depth, "> 0 when overlapping, 0 when apart.")
       .def_readonly("signed_distance", &PenetrationResult::signed_distance, "The distance when apart, -depth when overlapping.")
       .def_property_readonly("normal", [](const PenetrationResult& r) { return toArray(r.normal); }, "Unit: B moves along it to separate.")
-      .def_property_readonly("point_a", [](const PenetrationResult& r) { return toArray(r.point_a); })
-      .def_property_readonly("point_b", [](const PenetrationResult& r) { return toArray(r.point_b); })
-      .def_property_readonly("status", &statusOf<PenetrationResult>)
-      .def_readonly("iterations", &PenetrationResult::iterations)
+      .def_property_readonly("point_a", [](const PenetrationResult& r) { return toArray(r.point_a); }, "Deepest (or closest) point of A.")
+      .def_property_readonly("point_b", [](const PenetrationResult& r) { return toArray(r.point_b); }, "Deepest (or closest) point of B.")
+      .def_property_readonly("status", &statusOf<PenetrationResult>,
+                             "Why the query stopped: 'converged', 'overlapping', ...; 'not_converged' and 'invalid_input' carry no certificate.")
+      .def_readonly("iterations", &PenetrationResult::iterations, "GJK / EPA / cast iterations taken.")
       .def("__repr__", [](const PenetrationResult& r) {
         return "<PenetrationResult signed_distance=" + std::to_string(r.signed_distance) + " status=" + statusName(r.status) + ">";
       });
@@ -166,8 +169,9 @@ void bindNarrowphase(py::module_& m) {
       .def_readonly("t", &CastResult::t, "Time of impact (0 when starting in contact).")
       .def_property_readonly("normal", [](const CastResult& r) { return toArray(r.normal); }, "Outward normal of the still shape.")
       .def_property_readonly("point", [](const CastResult& r) { return toArray(r.point); }, "Contact point on the still shape.")
-      .def_property_readonly("status", &statusOf<CastResult>)
-      .def_readonly("iterations", &CastResult::iterations)
+      .def_property_readonly("status", &statusOf<CastResult>,
+                             "Why the query stopped: 'converged', 'overlapping', ...; 'not_converged' and 'invalid_input' carry no certificate.")
+      .def_readonly("iterations", &CastResult::iterations, "GJK / EPA / cast iterations taken.")
       .def("__repr__", [](const CastResult& r) {
         return std::string("<CastResult hit=") + (r.hit ? "True" : "False") + " t=" + std::to_string(r.t) +
                " normal=" + vecText(r.normal) + " status=" + statusName(r.status) + ">";

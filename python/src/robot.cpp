@@ -50,7 +50,7 @@ LoadOptions loadOptions(const std::vector<std::string>& package_paths) {
 
 void bindRobot(py::module_& m) {
   py::class_<PyRobot>(m, "Robot", "A robot as loaded from URDF (+ SRDF): links, joints, joint vector. Immutable.")
-      .def_property_readonly("name", [](const PyRobot& r) { return r.model->name(); })
+      .def_property_readonly("name", [](const PyRobot& r) { return r.model->name(); }, "The URDF's robot name.")
       .def_property_readonly("link_names", [](const PyRobot& r) {
         std::vector<std::string> names;
         for (const Link& l : r.model->links()) names.push_back(l.name);
@@ -132,8 +132,8 @@ void bindRobot(py::module_& m) {
         "Loads a URDF (and SRDF) with its meshes; raises LoadError naming file, element and reason.");
 
   py::class_<AuditPair>(m, "AuditPair", "One link pair's verdict and evidence.")
-      .def_readonly("link_a", &AuditPair::link_a)
-      .def_readonly("link_b", &AuditPair::link_b)
+      .def_readonly("link_a", &AuditPair::link_a, "The first link (in the robot's order).")
+      .def_readonly("link_b", &AuditPair::link_b, "The second link.")
       .def_readonly("reason", &AuditPair::reason, "'Adjacent', 'Default', 'Always', 'Never', or '' (must be checked).")
       .def_readonly("samples", &AuditPair::samples, "Configurations tested (0 for Adjacent pairs).")
       .def_readonly("colliding", &AuditPair::colliding, "Samples in collision.")
@@ -148,10 +148,10 @@ void bindRobot(py::module_& m) {
       });
 
   py::class_<AuditResult>(m, "AuditResult", "A self-collision audit: every pair of links with geometry, classified.")
-      .def_property_readonly("robot_name", [](const AuditResult& a) { return a.model->name(); })
+      .def_property_readonly("robot_name", [](const AuditResult& a) { return a.model->name(); }, "The URDF's robot name.")
       .def_readonly("pairs", &AuditResult::pairs, "An AuditPair per pair of links with geometry.")
-      .def_readonly("samples", &AuditResult::samples)
-      .def_readonly("seed", &AuditResult::seed)
+      .def_readonly("samples", &AuditResult::samples, "Random configurations per pair.")
+      .def_readonly("seed", &AuditResult::seed, "The seed: the same seed gives the same audit.")
       .def("counts", [](const AuditResult& a) {
         std::map<std::string, int> counts{{"Adjacent", 0}, {"Default", 0}, {"Always", 0}, {"Never", 0}, {"checked", 0}};
         for (const PairAudit& p : a.audit) ++counts[p.reason.empty() ? "checked" : p.reason];

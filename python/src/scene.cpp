@@ -115,7 +115,7 @@ void bindScene(py::module_& m) {
                   },
                   py::arg("path"), py::arg("geometry") = "mesh", py::arg("package_paths") = std::vector<std::string>{},
                   "Loads a scene file (YAML) with its robot and environment; raises LoadError naming file, key and reason.")
-      .def_property_readonly("name", [](const PyScene& s) { return s.scene->name(); })
+      .def_property_readonly("name", [](const PyScene& s) { return s.scene->name(); }, "The scene file's name.")
       .def_property_readonly("dof", [](const PyScene& s) { return s.scene->dimension(); }, "The length of a state.")
       .def_property_readonly("joint_names", [](const PyScene& s) {
         std::vector<std::string> names;
@@ -129,7 +129,7 @@ void bindScene(py::module_& m) {
         for (int i = 0; i < n; ++i) w(i, 0) = s.scene->lower(i), w(i, 1) = s.scene->upper(i);
         return out;
       }, "(dof, 2) array of each entry's lower and upper limit (+-inf when unbounded).")
-      .def_property_readonly("effects", [](const PyScene& s) { return s.scene->effects(); })
+      .def_property_readonly("effects", [](const PyScene& s) { return s.scene->effects(); }, "What the scene checks.")
       .def_property_readonly("link_names", [](const PyScene& s) {
         std::vector<std::string> names;
         for (const Link& l : s.scene->robot().links()) names.push_back(l.name);
@@ -182,7 +182,8 @@ void bindScene(py::module_& m) {
            },
            py::arg("Q"), py::arg("report") = false,
            "Q: (N, dof) states -> (N,) bool, True where free; with report=True also a list giving, per row, None or "
-           "the colliding pair (link, other link / obstacle / 'octomap'). ValueError naming the first invalid row.")
+           "the colliding pair (link, other link / obstacle / 'octomap'). ValueError naming the first invalid row. "
+           "Moving obstacles are where they are at time 0.")
       .def("clearance",
            [](const PyScene& s, const DoubleArray& Q) {
              const Scene& scene = *s.scene;
@@ -254,7 +255,8 @@ void bindScene(py::module_& m) {
            py::arg("report") = false,
            "Checks the straight segments Q0[i] -> Q1[i] -> (free, last_valid): (N,) bool and (N,) the last fraction "
            "known free (1 where free). mode: 'certified' (never steps over an obstacle), 'cast' or 'sampled:RES' (may "
-           "tunnel). With report=True also the colliding pair per row, as check(). ValueError naming an invalid end.")
+           "tunnel). With report=True also the colliding pair per row, as check(). ValueError naming an invalid end. "
+           "Moving obstacles stay where they are at time 0.")
       .def("__repr__", [](const PyScene& s) {
         return "<clearway.Scene " + s.scene->name() + ": " + std::to_string(s.scene->dimension()) + " dof, checks " +
                s.scene->effects().toString() + ">";
