@@ -29,12 +29,13 @@ class PyScene {
   explicit PyScene(std::shared_ptr<const Scene> s) : scene(std::move(s)) {}
   std::shared_ptr<const Scene> scene;
 
+  /// The checker for these options (finite: motionOptions checks them, and a NaN key would break the map).
   const MotionChecker& checker(const MotionOptions& options) {
     const auto key = std::make_tuple(static_cast<int>(options.mode), options.resolution, options.contact_distance);
     std::lock_guard<std::mutex> lock(mutex_);
-    auto& entry = checkers_[key];
-    if (!entry) entry = std::make_unique<const MotionChecker>(scene, options);  // throws ValueError for bad options
-    return *entry;
+    auto it = checkers_.find(key);
+    if (it == checkers_.end()) it = checkers_.emplace(key, std::make_unique<const MotionChecker>(scene, options)).first;
+    return *it->second;
   }
 
  private:
@@ -61,6 +62,8 @@ py::object pairOf(const Scene& scene, const CollisionReport& r) {
 }
 
 MotionOptions motionOptions(const std::string& mode, double contact_distance) {
+  if (!(contact_distance > 0.0) || !std::isfinite(contact_distance))
+    throw py::value_error("contact_distance must be finite and > 0, got " + std::to_string(contact_distance));
   MotionOptions o;
   o.contact_distance = contact_distance;
   if (mode == "certified") {

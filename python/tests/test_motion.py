@@ -87,5 +87,6 @@ def test_bad_motions_raise(arm6):
         arm6.check_motions(q0, q0, mode="exact")
     with pytest.raises(ValueError, match=r"sampled:RES needs a resolution > 0"):
         arm6.check_motions(q0, q0, mode="sampled:-1")
-    with pytest.raises(ValueError, match="contact_distance"):
-        arm6.check_motions(q0, q0, contact_distance=-1.0)
+    for bad in (-1.0, 0.0, math.nan, math.inf):
+        with pytest.raises(ValueError, match="contact_distance must be finite and > 0"):
+            arm6.check_motions(q0, q0, contact_distance=bad)
