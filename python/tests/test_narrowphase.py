@@ -185,3 +185,13 @@ def test_bad_shapes_and_poses_raise_with_the_library_message():
         cw.distance(s, None, s, at(3), tolerance=0)
     with pytest.raises(TypeError, match="tolerance must be a number or None"):
         cw.distance(s, None, s, at(3), tolerance="tight")
+
+
+def test_shapes_keep_their_parameters():
+    assert cw.Box([0.1, 0.2, 0.3]).half_extents.tolist() == [0.1, 0.2, 0.3]
+    assert cw.Sphere(0.4).radius == 0.4 and cw.Sphere(0.4).bounding_radius == pytest.approx(0.4)
+    for make in (cw.Capsule, cw.Cylinder, cw.Cone):
+        s = make(0.2, 0.5)
+        assert (s.radius, s.half_length, s.type) == (0.2, 0.5, make.__name__.lower())
+    assert cw.Capsule(0.2, 0.5).bounding_radius == pytest.approx(0.7)
+    assert isinstance(cw.Segment([0, 0, 0], [1, 0, 0]), cw.Shape) and cw.Triangle([0, 0, 0], [1, 0, 0], [0, 1, 0]).type == "triangle"

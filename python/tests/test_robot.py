@@ -80,3 +80,19 @@ def test_load_errors_name_file_element_and_reason(tmp_path):
         clearway.load_robot(str(bad))
     assert e.value.file == str(bad) and "elbow_joint" in e.value.element and "wobbly" in e.value.reason
     assert str(e.value) == f"{e.value.file}: {e.value.element}: {e.value.reason}"
+
+
+def test_load_warnings_name_file_and_element(tmp_path):
+    urdf = tmp_path / "two_links.urdf"
+    urdf.write_text("""<?xml version="1.0"?>
+<robot name="two">
+  <link name="base"><collision><geometry><box size="1 1 1"/></geometry></collision></link>
+  <link name="arm"><visual><geometry><box size="1 1 1"/></geometry></visual></link>
+  <joint name="j" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>
+""")
+    robot = clearway.load_robot(str(urdf))
+    assert robot.dof == 1 and robot.link_names == ["base", "arm"] and robot.joint_names == ["j"]
+    np.testing.assert_array_equal(robot.limits, [[-1, 1]])
+    assert len(robot.warnings) == 1 and robot.warnings[0].startswith(str(urdf) + ": ") and "arm" in robot.warnings[0]
