@@ -168,3 +168,17 @@ def test_reports_depend_on_the_call_alone(arm6):
     again = arm6.check(states, report=True)
     np.testing.assert_array_equal(first[0], again[0])
     assert first[1] == again[1]
+
+
+def test_load_warnings_name_file_and_element(tmp_path):
+    # An allowed pair naming a link the URDF lacks is skipped with a warning, as MoveIt does.
+    path = tmp_path / "arm6_srdf_extra.yaml"
+    srdf = tmp_path / "extra.srdf"
+    srdf.write_text((REPO / "robots" / "arm6" / "arm6.srdf").read_text().replace(
+        "</robot>", '<disable_collisions link1="base_link" link2="no_such_link" reason="Never"/></robot>'))
+    text = ARM6_WALL.read_text().replace("../arm6/arm6.urdf", str(REPO / "robots" / "arm6" / "arm6.urdf"))
+    path.write_text(text.replace("../arm6/arm6.srdf", str(srdf)))
+    scene = clearway.Scene.load(str(path))
+    base = clearway.Scene.load(str(ARM6_WALL)).warnings  # arm6's own (a COLLADA mesh)
+    assert scene.warnings[:-1] == base
+    assert scene.warnings[-1].startswith(str(srdf) + ": ") and "no_such_link" in scene.warnings[-1]
