@@ -89,6 +89,22 @@ GeometryMode geometryMode(const std::string& mode) {
   throw py::value_error("unknown geometry '" + mode + "' (mesh or hull)");
 }
 
+// A batch's times: None (all 0) or `cols` finite numbers per row; only scenes that declare `moving` look at them.
+std::vector<double> batchTimes(const py::object& times, py::ssize_t n, py::ssize_t cols) {
+  std::vector<double> t(static_cast<std::size_t>(n * cols), 0.0);
+  if (times.is_none()) return t;
+  const DoubleArray a = DoubleArray::ensure(times);
+  if (!a) throw py::value_error("times must be an array of numbers");
+  if (cols == 1) requireVector(a, "times", n);
+  else requireRows(a, "times", cols);
+  if (a.shape(0) != n) throw py::value_error("times must have a row per state, got " + shapeText(a));
+  for (py::ssize_t i = 0; i < n * cols; ++i) {
+    t[i] = a.data()[i];
+    if (!std::isfinite(t[i])) throw py::value_error("times[" + std::to_string(i / cols) + "] is not finite");
+  }
+  return t;
+}
+
 py::object stateOrNone(const std::vector<double>& q) {
   if (q.empty()) return py::none();
   return py::array_t<double>(static_cast<py::ssize_t>(q.size()), q.data());
@@ -146,25 +162,28 @@ void bindScene(py::module_& m) {
       .def_property_readonly("goal", [](const PyScene& s) { return stateOrNone(s.scene->description().goal); },
                              "The scene file's goal state, or None.")
       .def("is_free",
-           [](const PyScene& s, const DoubleArray& q) {
+           [](const PyScene& s, const DoubleArray& q, double t) {
              requireVector(q, "q", s.scene->dimension());
+             if (!std::isfinite(t)) throw py::value_error("t is not finite");
              CollisionReport r;
              bool free;
              {
                py::gil_scoped_release release;
                SceneContext ctx = s.scene->makeContext();
-               free = s.scene->isFree(q.data(), ctx, &r);
+               free = s.scene->isFree(q.data(), ctx, &r, t);
              }
              if (r.kind == CollisionReport::Kind::Invalid) invalidRow(*s.scene, "q", 0, q.data());
              return free;
            },
-           py::arg("q"),
-           "True when the state is free of every declared collision; ValueError for a non-finite or out-of-bounds state.")
+           py::arg("q"), py::arg("t") = 0.0,
+           "True when the state is free of every declared collision (moving obstacles where they are at time t); "
+           "ValueError for a non-finite or out-of-bounds state.")
       .def("check",
-           [](const PyScene& s, const DoubleArray& Q, bool report) -> py::object {
+           [](const PyScene& s, const DoubleArray& Q, bool report, const py::object& times) -> py::object {
              const Scene& scene = *s.scene;
              requireRows(Q, "Q", scene.dimension());
              const py::ssize_t n = Q.shape(0), dof = scene.dimension();
+             const std::vector<double> t = batchTimes(times, n, 1);
              py::array_t<bool> free(n);
              std::vector<CollisionReport> reports(report ? static_cast<std::size_t>(n) : 0);
              py::ssize_t bad = -1;
@@ -175,7 +194,7 @@ void bindScene(py::module_& m) {
                SceneContext ctx = scene.makeContext();
                CollisionReport r;
                for (py::ssize_t i = 0; i < n; ++i) {
-                 out[i] = scene.isFree(q + i * dof, ctx, &r);
+                 out[i] = scene.isFree(q + i * dof, ctx, &r, t[i]);
                  if (r.kind == CollisionReport::Kind::Invalid) { bad = i; break; }
                  if (report) reports[i] = r;
                }
@@ -186,18 +205,19 @@ void bindScene(py::module_& m) {
              for (const CollisionReport& r : reports) pairs.append(pairOf(scene, r));
              return py::make_tuple(free, pairs);
            },
-           py::arg("Q"), py::arg("report") = false,
+           py::arg("Q"), py::arg("report") = false, py::arg("times") = py::none(),
            "Q: (N, dof) states -> (N,) bool, True where free; with report=True also a list giving, per row, None or "
-           "the colliding pair (link, other link / obstacle / 'octomap'). ValueError naming the first invalid row. "
-           "Moving obstacles are where they are at time 0.")
+           "the colliding pair (link, other link / obstacle / 'octomap'). times: (N,) seconds at which each state "
+           "sees the moving obstacles (default 0). ValueError naming the first invalid row.")
       .def("clearance",
-           [](const PyScene& s, const DoubleArray& Q) {
+           [](const PyScene& s, const DoubleArray& Q, const py::object& times) {
              const Scene& scene = *s.scene;
              if (!scene.effects().clearance)
                throw py::value_error("scene " + scene.name() + " does not declare clearance (checks: " +
                                      scene.effects().toString() + ")");
              requireRows(Q, "Q", scene.dimension());
              const py::ssize_t n = Q.shape(0), dof = scene.dimension();
+             const std::vector<double> t = batchTimes(times, n, 1);
              py::array_t<double> out(n);
              py::ssize_t bad = -1;
              {
@@ -207,18 +227,18 @@ void bindScene(py::module_& m) {
                SceneContext ctx = scene.makeContext();
                for (py::ssize_t i = 0; i < n; ++i) {
                  if (!scene.validState(q + i * dof)) { bad = i; break; }
-                 c[i] = scene.clearance(q + i * dof, ctx);
+                 c[i] = scene.clearance(q + i * dof, ctx, nullptr, t[i]);
                }
              }
              if (bad >= 0) invalidRow(scene, "Q", bad, Q.data() + bad * dof);
              return out;
            },
-           py::arg("Q"),
+           py::arg("Q"), py::arg("times") = py::none(),
            "Q: (N, dof) states -> (N,) signed clearance in metres (negative: penetration depth); NaN where a query "
-           "failed. ValueError when the scene does not declare clearance or a row is invalid.")
+           "failed. times as check(). ValueError when the scene does not declare clearance or a row is invalid.")
       .def("check_motions",
            [](PyScene& s, const DoubleArray& Q0, const DoubleArray& Q1, const std::string& mode, double contact_distance,
-              bool report) -> py::object {
+              bool report, const py::object& times) -> py::object {
              const Scene& scene = *s.scene;
              requireRows(Q0, "Q0", scene.dimension());
              requireRows(Q1, "Q1", scene.dimension());
@@ -226,6 +246,7 @@ void bindScene(py::module_& m) {
                throw py::value_error("Q0 and Q1 must have as many rows, got " + shapeText(Q0) + " and " + shapeText(Q1));
              const MotionChecker& checker = s.checker(motionOptions(mode, contact_distance));
              const py::ssize_t n = Q0.shape(0), dof = scene.dimension();
+             const std::vector<double> t = batchTimes(times, n, 2);
              py::array_t<bool> free(n);
              py::array_t<double> last_valid(n);
              std::vector<CollisionReport> reports(report ? static_cast<std::size_t>(n) : 0);
@@ -245,7 +266,7 @@ void bindScene(py::module_& m) {
                    bad_end = scene.validState(a);
                    break;
                  }
-                 const MotionResult r = checker.check(a, b, ctx);
+                 const MotionResult r = checker.check(a, t[2 * i], b, t[2 * i + 1], ctx);
                  f[i] = r.free;
                  lv[i] = r.free ? 1.0 : r.last_valid;
                  if (report) reports[i] = r.report;
@@ -258,11 +279,11 @@ void bindScene(py::module_& m) {
              return py::make_tuple(free, last_valid, pairs);
            },
            py::arg("Q0"), py::arg("Q1"), py::arg("mode") = "certified", py::arg("contact_distance") = 1e-3,
-           py::arg("report") = false,
+           py::arg("report") = false, py::arg("times") = py::none(),
            "Checks the straight segments Q0[i] -> Q1[i] -> (free, last_valid): (N,) bool and (N,) the last fraction "
            "known free (1 where free). mode: 'certified' (never steps over an obstacle), 'cast' or 'sampled:RES' (may "
-           "tunnel). With report=True also the colliding pair per row, as check(). ValueError naming an invalid end. "
-           "Moving obstacles stay where they are at time 0.")
+           "tunnel). With report=True also the colliding pair per row, as check(). times: (N, 2) seconds at each end "
+           "(moving obstacles move on meanwhile; default 0 and 0). ValueError naming an invalid end.")
       .def("__repr__", [](const PyScene& s) {
         return "<clearway.Scene " + s.scene->name() + ": " + std::to_string(s.scene->dimension()) + " dof, checks " +
                s.scene->effects().toString() + ">";

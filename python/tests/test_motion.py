@@ -5,7 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from conftest import ARM6_WALL, random_states, write_rows
+import clearway
+from conftest import ARM6_WALL, REPO, random_states, write_rows
 
 
 def segments(scene, n, seed):
@@ -90,3 +91,60 @@ def test_bad_motions_raise(arm6):
     for bad in (-1.0, 0.0, math.nan, math.inf):
         with pytest.raises(ValueError, match="contact_distance must be finite and > 0"):
             arm6.check_motions(q0, q0, contact_distance=bad)
+
+
+RISING_PLATE = """format: 1
+name: rising_plate
+robot:
+  urdf: {urdf}
+  group: [fly]
+  bounds: {{fly/x: [-2, 2], fly/y: [-2, 2], fly/z: [-2, 2]}}
+environment:
+  obstacles:
+    - name: plate
+      box: {{size: [2, 2, 0.002]}}
+      pose: {{position: [0, 0, 0]}}
+      velocity: [0, 0, 1]
+checks: [environment, continuous, clearance, moving]
+"""
+
+
+@pytest.fixture
+def rising_plate(tmp_path):
+    """The flyer (a 0.04 m thick plate) above a plate that rises at 1 m/s from z = 0."""
+    path = tmp_path / "rising.yaml"
+    path.write_text(RISING_PLATE.format(urdf=REPO / "robots" / "flyer" / "flyer.urdf"))
+    return path, clearway.Scene.load(str(path))
+
+
+def test_states_see_moving_obstacles_at_their_times(rising_plate):
+    _, scene = rising_plate
+    level = [0, 0, 0.5, 0, 0, 0, 1]  # the flyer's underside at z = 0.48; the plate's top at 0.001 + t
+    times = np.array([0, 0.4, 0.47, 0.49, 0.7])  # at 0.7 the plate cuts the rod standing on the flyer
+    np.testing.assert_array_equal(scene.check(np.tile(level, (5, 1)), times=times), [True, True, True, False, False])
+    assert scene.is_free(level) and not scene.is_free(level, t=0.6)
+    np.testing.assert_allclose(scene.clearance(np.tile(level, (2, 1)), times=[0.2, 0.3]), [0.279, 0.179], rtol=1e-6)
+    with pytest.raises(ValueError, match=r"times\[1\] is not finite"):
+        scene.check(np.tile(level, (2, 1)), times=[0, math.nan])
+    with pytest.raises(ValueError, match=r"times must have shape \(2,\)"):
+        scene.check(np.tile(level, (2, 1)), times=[0, 1, 2])
+
+
+def test_timed_motions_equal_the_tools_timed_lines(rising_plate, tool, tmp_path):
+    path, scene = rising_plate
+    rng = np.random.default_rng(18)
+    n = 60
+    q0 = np.tile([0, 0, 0.5, 0, 0, 0, 1.0], (n, 1))
+    q1 = q0.copy()
+    q0[:, 2] = rng.uniform(0.3, 1.0, n)
+    q1[:, 2] = rng.uniform(0.3, 1.5, n)
+    times = np.sort(rng.uniform(0, 0.8, (n, 2)), axis=1)
+    free, last_valid, pairs = scene.check_motions(q0, q1, times=times, report=True)
+    lines = write_rows(tmp_path / "timed.txt", np.hstack([times[:, :1], q0, times[:, 1:], q1]))
+    assert as_tool_prints(free, last_valid, pairs) == tool("motion", path, "--motions", lines)
+    assert 5 < free.sum() < n - 5
+    # Standing still at z = 0.5 from t = 0 to 1, the plate arrives at t = 0.479: the last valid fraction is just before.
+    still = np.array([[0, 0, 0.5, 0, 0, 0, 1.0]])
+    free, last_valid = scene.check_motions(still, still, times=[[0, 1]])
+    assert not free[0] and 0.47 < last_valid[0] <= 0.479
+    assert scene.check_motions(still, still)[0][0]  # without times, at t = 0 throughout
