@@ -14,7 +14,7 @@ import clearway
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("urdf")
-    parser.add_argument("--srdf", help="an SRDF to compare with (the audit itself ignores it)")
+    parser.add_argument("--srdf", help="an SRDF to compare with, kept in --out but for the pairs the audit decides (the audit itself ignores it)")
     parser.add_argument("--samples", type=int, default=10000)
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--out", help="write the audit's SRDF here")

@@ -10,7 +10,9 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <fstream>
 #include <map>
+#include <sstream>
 #include <memory>
 
 namespace clearway::python {
@@ -38,6 +40,7 @@ struct AuditResult {
   std::vector<AuditPair> pairs;
   int samples = 0;
   std::uint64_t seed = 0;
+  std::string srdf_text;  // the given SRDF, which to_srdf() keeps (as clearway audit --srdf-out)
 };
 
 LoadOptions loadOptions(const std::vector<std::string>& package_paths) {
@@ -157,8 +160,9 @@ void bindRobot(py::module_& m) {
         for (const PairAudit& p : a.audit) ++counts[p.reason.empty() ? "checked" : p.reason];
         return counts;
       }, "Pairs per verdict: {'Adjacent': n, 'Default': n, 'Always': n, 'Never': n, 'checked': n}.")
-      .def("to_srdf", [](const AuditResult& a) { return auditSrdf(*a.model, a.audit); },
-           "SRDF text with a disable_collisions element per classified pair (as clearway audit --srdf-out).");
+      .def("to_srdf", [](const AuditResult& a) { return auditSrdf(*a.model, a.audit, a.srdf_text); },
+           "The given SRDF (or a new one) with the disable_collisions of every classified pair replaced, and the "
+           "rest kept (as clearway audit --srdf-out).");
 
   m.def("audit",
         [](const std::string& urdf, const py::object& srdf, int samples, std::uint64_t seed, int threads,
@@ -176,6 +180,10 @@ void bindRobot(py::module_& m) {
           result.model = std::make_shared<const RobotModel>(loadRobot(urdf, "", loadOptions(package_paths)));
           std::map<std::pair<int, int>, std::string> given;
           if (!srdf_path.empty()) {
+            std::ifstream in(srdf_path, std::ios::binary);
+            std::ostringstream text;
+            text << in.rdbuf();
+            result.srdf_text = text.str();
             const RobotModel with_srdf = loadRobot(urdf, srdf_path, loadOptions(package_paths));
             for (const DisabledCollision& d : with_srdf.disabledCollisions())
               given[{std::min(d.link_a, d.link_b), std::max(d.link_a, d.link_b)}] = d.reason;

@@ -43,7 +43,7 @@ def test_random_states_counts_each_pair(tmp_path):
 def test_audit_srdf_writes_the_audits_srdf(tmp_path):
     urdf, srdf = REPO / "robots" / "arm6" / "arm6.urdf", REPO / "robots" / "arm6" / "arm6.srdf"
     out = run("audit_srdf.py", urdf, "--srdf", srdf, "--samples", 500, "--seed", 2, "--out", tmp_path / "out.srdf")
-    assert (tmp_path / "out.srdf").read_text() == clearway.audit(str(urdf), samples=500, seed=2).to_srdf()
+    assert (tmp_path / "out.srdf").read_text() == clearway.audit(str(urdf), srdf=str(srdf), samples=500, seed=2).to_srdf()
     assert "arm6: 21 pairs: " in out and "differs: " in out
 
 
