@@ -334,8 +334,10 @@ DistanceResult Environment::linkDistance(const LinkGeometry& link, const Pose& p
     if (counters) ++counters->distance_tests;
     if (item.obstacle && item.obstacle->mesh)
       return search.add(meshDistance(link, pose, *item.obstacle->mesh, item.pose, tol, relative_error));
-    const Shape shape = item.obstacle ? item.obstacle->shape : Shape(Box(item.voxel->halfExtents()));
-    return search.add(swapped(shapeLinkDistance(shape, item.pose, link, pose, tol, relative_error)));
+    // (The obstacle's own shape by reference: a copy of a hull would allocate per item.)
+    if (item.obstacle)
+      return search.add(swapped(shapeLinkDistance(item.obstacle->shape, item.pose, link, pose, tol, relative_error)));
+    return search.add(swapped(shapeLinkDistance(Box(item.voxel->halfExtents()), item.pose, link, pose, tol, relative_error)));
   });
   if (walk == Walk::Invalid) search.failed = true;
 
@@ -465,9 +467,12 @@ double Environment::linkPenetration(const LinkGeometry& link, const Pose& pose, 
       if (meshesIntersect(link, pose, *o->mesh, item.pose, tol, GeometryMode::Mesh, padding)) depth(o->mesh->hull(), item.pose);
       return false;
     }
-    const Shape shape = o ? o->shape : Shape(Box(item.voxel->halfExtents()));
-    if (shapeIntersectsLink(shape, item.pose, link, pose, tol, GeometryMode::Mesh, padding))
-      std::visit([&](const auto& s) { depth(s, item.pose); }, shape);
+    const auto visit = [&](const Shape& shape) {  // (by reference: a copied hull would allocate)
+      if (shapeIntersectsLink(shape, item.pose, link, pose, tol, GeometryMode::Mesh, padding))
+        std::visit([&](const auto& s) { depth(s, item.pose); }, shape);
+    };
+    if (o) visit(o->shape);
+    else visit(Box(item.voxel->halfExtents()));
     return false;
   });
   if (walk == Walk::Invalid) return nan;
