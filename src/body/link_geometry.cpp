@@ -249,6 +249,7 @@ LinkGeometry::LinkGeometry(std::vector<Triangle> triangles, std::vector<Primitiv
   sphere_radius_ = sphere_radius_ * (1.0 + 1e-12) + 1e-12 * bounding_radius_;
   buildParts();
   findSolids();
+  findCores();
 }
 
 void LinkGeometry::buildParts() {
@@ -420,6 +421,8 @@ bool meshesIntersect(const LinkGeometry& a, const Pose& pose_a, const LinkGeomet
   const IntersectResult hulls = gjkIntersect(Margin<ConvexHull>{a.hull(), padding}, pose_a, b.hull(), pose_b, tol, cache);
   if (!hulls.intersecting) return false;
   if (mode == GeometryMode::Hull) return true;
+  // Overlapping cores settle deep contacts before the triangle search, which is slowest exactly there.
+  if (coresOverlap(a, b, b_in_a)) return true;
   return exactIntersect(a, b, b_in_a, tol, padding, slack) || linkContained(a, b, b_in_a);
 }
 
@@ -442,6 +445,7 @@ bool shapeIntersectsLink(const Shape& shape, const Pose& pose_shape, const LinkG
   // In the link's frame.
   const Pose shape_in_link = relativePose(pose_link, pose_shape);
   const double scale = link.boundingRadius() + shape_in_link.t.norm() + boundingRadius(shape);
+  if (coreMeetsShape(shape, shape_in_link, link)) return true;
   const double slack = padding + narrowBand(scale + padding, tol);
   if (shapeIntersectsTriangles(shape, shape_in_link, link, tol, padding, slack)) return true;
   for (const auto& p : link.primitives())

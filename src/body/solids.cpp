@@ -177,6 +177,12 @@ bool LinkGeometry::containsPoint(const Vec3& p) const noexcept {
   return false;
 }
 
+bool LinkGeometry::surelyInside(int s, const Vec3& p) const noexcept {
+  for (int r = 0; r < 3; ++r)
+    if (rayParity(s, p, rayDirection(r)) != 1) return false;
+  return true;
+}
+
 bool linkContained(const LinkGeometry& a, const LinkGeometry& b, const Pose& b_in_a) noexcept {
   if (b.solidCount() > 0) {
     const Pose a_in_b = b_in_a.inverse();

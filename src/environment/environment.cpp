@@ -266,8 +266,22 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
 
   // Many voxels inside the hull: voxel tree (world) against triangle tree (link frame), then box–triangle
   // GJK; then the link's primitives against the voxels near them.
-  const std::vector<Triangle>& tris = link.triangles();
   found = -1;
+  // A core of the link meeting an occupied voxel settles it without the triangle search.
+  const double core_margin = 1e-9 * (1.0 + scale_ + maxAbs(link_box));
+  for (const LinkGeometry::Ball& core : link.cores()) {
+    const Vec3 c = pose * core.center;
+    const double r = core.radius - core_margin;
+    if (!(r > 0.0)) continue;
+    voxel_tree_.query(Aabb::fromCenterHalf(c, Vec3::Constant(r)), [&](std::int32_t v) {
+      const Aabb& b = voxels[v];
+      if (((c - b.center()).cwiseAbs() - b.halfExtents()).cwiseMax(0.0).norm() >= r) return false;
+      found = v;
+      return true;
+    });
+    if (found >= 0) return report(EnvironmentHit::Kind::Voxel, found);
+  }
+  const std::vector<Triangle>& tris = link.triangles();
   forEachOverlap(
       voxel_tree_, link.tree(), pose,
       [&](std::int32_t v, std::int32_t j) {

@@ -39,12 +39,24 @@ SelfCollisionContext SelfCollision::makeContext() const {
   SelfCollisionContext c;
   c.bodies.reserve(pairs_.size());
   for (const LinkPair& p : pairs_) c.bodies.emplace_back(*geometry_->link(p.a), *geometry_->link(p.b));
+  c.balls = EnclosingBalls(*geometry_);
   return c;
 }
 
+bool SelfCollision::placeBalls(const Pose* poses, SelfCollisionContext& ctx) const noexcept {
+  if (!ctx.balls.madeFor(*geometry_)) return false;  // a default context, or another robot's
+  ctx.balls.place(poses);
+  return true;
+}
+
 bool SelfCollision::pairCollides(int k, const Pose* poses, SelfCollisionContext& ctx) const noexcept {
+  return pairHits(k, poses, ctx, false);
+}
+
+bool SelfCollision::pairHits(int k, const Pose* poses, SelfCollisionContext& ctx, bool balls_placed) const noexcept {
   const LinkPair& p = pairs_[k];
   ++ctx.pair_tests;
+  if (balls_placed && ctx.balls.apart(p.a, p.b, pair_padding_[k], options_.tolerances)) return false;
   const IntersectQuery q{pair_padding_[k], options_.mode};
   if (k < static_cast<int>(ctx.bodies.size())) return ctx.bodies[k].intersects(poses[p.a], poses[p.b], options_.tolerances, q);
   return BodyPair(*geometry_->link(p.a), *geometry_->link(p.b)).intersects(poses[p.a], poses[p.b], options_.tolerances, q);
@@ -52,12 +64,13 @@ bool SelfCollision::pairCollides(int k, const Pose* poses, SelfCollisionContext&
 
 const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionContext& ctx) const noexcept {
   const int n = static_cast<int>(pairs_.size());
+  const bool balls = placeBalls(poses, ctx);
   // A pair that collided a moment ago probably still does: trying it first ends most colliding queries
   // of a planner exploring near an obstacle after one pair test.
-  if (ctx.last_hit >= 0 && ctx.last_hit < n && pairCollides(ctx.last_hit, poses, ctx)) return &pairs_[ctx.last_hit];
+  if (ctx.last_hit >= 0 && ctx.last_hit < n && pairHits(ctx.last_hit, poses, ctx, balls)) return &pairs_[ctx.last_hit];
   for (int k = 0; k < n; ++k) {
     if (k == ctx.last_hit) continue;
-    if (pairCollides(k, poses, ctx)) {
+    if (pairHits(k, poses, ctx, balls)) {
       ctx.last_hit = k;
       return &pairs_[k];
     }
@@ -67,8 +80,9 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
 }
 
 void SelfCollision::allCollisions(const Pose* poses, SelfCollisionContext& ctx, std::vector<LinkPair>& out) const {
+  const bool balls = placeBalls(poses, ctx);
   for (int k = 0; k < static_cast<int>(pairs_.size()); ++k)
-    if (pairCollides(k, poses, ctx)) out.push_back(pairs_[k]);
+    if (pairHits(k, poses, ctx, balls)) out.push_back(pairs_[k]);
 }
 
 DistanceResult SelfCollision::minimumDistance(const Pose* poses, LinkPair* pair, double relative_error) const {
@@ -95,8 +109,9 @@ DistanceResult SelfCollision::minimumDistance(const Pose* poses, LinkPair* pair,
 
 double SelfCollision::penetration(const Pose* poses, SelfCollisionContext& context, LinkPair* pair) const {
   double deepest = 0.0;
+  const bool balls = placeBalls(poses, context);
   for (int k = 0; k < static_cast<int>(pairs_.size()); ++k) {
-    if (!pairCollides(k, poses, context)) continue;
+    if (!pairHits(k, poses, context, balls)) continue;
     const LinkPair& p = pairs_[k];
     const double depth = BodyPair(*geometry_->link(p.a), *geometry_->link(p.b))
                              .penetration(poses[p.a], poses[p.b], options_.tolerances, pair_padding_[k]);

@@ -182,7 +182,8 @@ std::vector<double> randomState(const RobotModel& m, std::mt19937_64& rng) {
 }
 
 // Mesh mode against brute force over every triangle pair (only where the hulls overlap: elsewhere the
-// hull containment, tested in tests/tree, already proves "free"); hull mode never free where mesh collides.
+// hull containment, tested in tests/tree, already proves "free"); hull mode never free where mesh collides;
+// each pair's verdict the same with and without the enclosing layer.
 void differential(const std::string& urdf, const std::string& srdf, int states, std::uint64_t seed) {
   auto model = std::make_shared<const RobotModel>(loadRobot(urdf, srdf));
   // The triangle brute force knows meshes only: pairs with a primitive link are compared with hull mode
@@ -213,6 +214,11 @@ void differential(const std::string& urdf, const std::string& srdf, int states, 
     mesh.allCollisions(poses.data(), mctx, mesh_hits);
     hull.allCollisions(poses.data(), hctx, hull_hits);
     EXPECT_EQ(mesh.firstCollision(poses.data(), mctx) != nullptr, !mesh_hits.empty());
+    // pairCollides skips the enclosing balls (body/enclosing.h): every verdict the same without them.
+    for (int k = 0; k < static_cast<int>(mesh.pairs().size()); ++k) {
+      const bool listed = std::find(mesh_hits.begin(), mesh_hits.end(), mesh.pairs()[k]) != mesh_hits.end();
+      EXPECT_EQ(mesh.pairCollides(k, poses.data(), mctx), listed) << "state " << s << ": the enclosing balls changed pair " << k;
+    }
     for (const LinkPair& p : mesh_hits)
       EXPECT_NE(std::find(hull_hits.begin(), hull_hits.end(), p), hull_hits.end()) << "hull free, mesh collides";
     bool any_collide = false, any_band = false;

@@ -91,13 +91,28 @@ class LinkGeometry {
   /// outside the other's solids.
   const std::vector<Vec3>& probes() const noexcept { return probes_; }
 
+  /// A ball, link frame.
+  struct Ball {
+    Vec3 center;
+    double radius;
+  };
+  /// At most this many cores per link: a pair compares up to kMaxCores² of them, which must stay cheap
+  /// beside the hull test they follow.
+  static constexpr int kMaxCores = 8;
+  /// Balls wholly inside the link's solids (closed meshes and primitives), largest first: two bodies whose
+  /// cores overlap share interior points, so they collide at any padding. Empty when the link has no solid.
+  const std::vector<Ball>& cores() const noexcept { return cores_; }
+
  private:
   LinkGeometry(std::vector<Triangle> triangles, std::vector<Primitive> primitives, const TreeBuildOptions& options);
   void buildParts();
   void findSolids();
+  void findCores();
   // Ray parity of solid s at p along `dir`: 1 inside, 0 outside, −1 when the ray passes too near an edge,
   // a vertex or a plane to tell.
   int rayParity(int s, const Vec3& p, const Vec3& dir) const noexcept;
+  // True only when three ray directions all decide that p lies inside closed piece s.
+  bool surelyInside(int s, const Vec3& p) const noexcept;
 
   std::vector<Triangle> triangles_;
   std::vector<Primitive> primitives_;
@@ -111,6 +126,7 @@ class LinkGeometry {
   std::vector<std::int32_t> solid_of_;  // per triangle: its closed piece, −1 for an open one
   std::vector<Aabb> solid_boxes_;       // per closed piece
   std::vector<Vec3> probes_;
+  std::vector<Ball> cores_;
 };
 
 /// The box, in the frame `pose` is given in, of a convex shape placed by it: 6 support queries plus its
@@ -139,6 +155,13 @@ bool linkContained(const LinkGeometry& a, const LinkGeometry& b, const Pose& b_i
 /// True when the convex shape (placed in the link's frame) lies inside one of the link's closed meshes,
 /// given that it meets none of the link's triangles.
 bool shapeInsideLink(const Shape& shape, const Pose& shape_in_link, const LinkGeometry& link) noexcept;
+
+/// True when a core of `a` and a core of `b` overlap (b placed in a's frame by b_in_a): the links collide.
+/// False proves nothing. The comparison keeps a margin far above the rounding of placing the centres.
+bool coresOverlap(const LinkGeometry& a, const LinkGeometry& b, const Pose& b_in_a) noexcept;
+/// True when a core of the link overlaps the convex shape (placed in the link's frame): they collide.
+/// Decided for boxes, spheres and capsules (exact point distances); other shapes answer false.
+bool coreMeetsShape(const Shape& shape, const Pose& shape_in_link, const LinkGeometry& link) noexcept;
 
 /// True when the two links are within `padding` metres of each other (padding ≥ 0; 0: touching counts).
 /// Hull: the bounding spheres, then one GJK test of the hulls. Mesh: the same, then the two triangle trees descended together

@@ -5,6 +5,7 @@
 // pair's hulls, the pair that collided last) lives in a SelfCollisionContext, one per thread.
 #include <clearway/kinematics/robot_model.h>
 #include <clearway/scene/collision_filter.h>
+#include <clearway/body/enclosing.h>
 #include <clearway/body/proximity.h>
 #include <clearway/body/robot_geometry.h>
 #include <clearway/tolerances.h>
@@ -32,6 +33,7 @@ struct SelfCollisionOptions {
 /// Per-thread state of self-collision queries: one hull cache per pair and the pair that last collided.
 struct SelfCollisionContext {
   std::vector<BodyPair> bodies;  ///< per checked pair: its two links' geometry and warm starts
+  EnclosingBalls balls;          ///< the links' enclosing balls at the current query's poses
   int last_hit = -1;
   long long pair_tests = 0;  ///< pairs that reached the narrow phase (bounding spheres not apart), cumulative
 };
@@ -70,6 +72,11 @@ class SelfCollision {
   double penetration(const Pose* link_poses, SelfCollisionContext& context, LinkPair* pair = nullptr) const;
 
  private:
+  // pairCollides, first asking the context's enclosing balls (placed for these poses by the caller).
+  bool pairHits(int k, const Pose* link_poses, SelfCollisionContext& context, bool balls_placed) const noexcept;
+  // Places the context's balls when it has them (a context made by makeContext); false otherwise.
+  bool placeBalls(const Pose* link_poses, SelfCollisionContext& context) const noexcept;
+
   std::shared_ptr<const RobotGeometry> geometry_;
   std::vector<LinkPair> pairs_;
   std::vector<double> pair_padding_;

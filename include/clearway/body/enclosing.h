@@ -1,0 +1,43 @@
+#pragma once
+// The enclosing layer: every link's bounding ball and its parts' balls (LinkGeometry::parts(), whose union
+// contains the link) placed in the world once per configuration. A pair of links is then cleared by
+// distance comparisons alone: its bounding balls apart, or every ball of one apart from every ball of the
+// other. Placing once per link instead of once per pair is what makes it cheap for robots with many
+// checked pairs; only pairs it cannot clear go on to the hulls and the triangles (proximity.h).
+#include <clearway/body/robot_geometry.h>
+#include <clearway/tolerances.h>
+
+#include <vector>
+
+namespace clearway {
+
+/// The enclosing balls of a robot's links at one configuration. Made per thread; place() allocates nothing.
+class EnclosingBalls {
+ public:
+  /// No robot: apart() is never called before a reset().
+  EnclosingBalls() = default;
+  /// Sized for the robot's links with geometry.
+  explicit EnclosingBalls(const RobotGeometry& geometry);
+
+  /// True when sized for this robot's geometry (a default-made layer is for none).
+  bool madeFor(const RobotGeometry& geometry) const noexcept { return geometry_ == &geometry; }
+  /// Places every link's balls by its world pose (one per link, indexed as the robot's links).
+  void place(const Pose* link_poses) noexcept;
+  /// True when links a and b, as last placed, are certainly more than `padding` metres apart (beyond the
+  /// narrow phase's band: tol.gjk_absolute of their size). False proves nothing; a non-finite pose, or
+  /// a link without geometry, is never apart.
+  bool apart(int a, int b, double padding, const Tolerances& tol) const noexcept;
+
+ private:
+  struct Link {
+    int first = 0;  // its balls in centers_/radii_: [first] the bounding ball, then the parts' balls
+    int count = 0;
+  };
+  const RobotGeometry* geometry_ = nullptr;
+  std::vector<Link> links_;
+  std::vector<Vec3> local_;    // ball centres, link frame
+  std::vector<Vec3> centers_;  // ball centres, world frame (as last placed)
+  std::vector<double> radii_;
+};
+
+}  // namespace clearway

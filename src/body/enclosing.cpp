@@ -1,0 +1,58 @@
+// The enclosing layer (enclosing.h): balls placed once per link, compared per pair.
+#include <clearway/body/enclosing.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace clearway {
+
+EnclosingBalls::EnclosingBalls(const RobotGeometry& geometry) : geometry_(&geometry) {
+  const int n = geometry.model().linkCount();
+  links_.assign(n, Link{});
+  for (int i : geometry.geometricLinks()) {
+    const LinkGeometry& g = *geometry.link(i);
+    links_[i].first = static_cast<int>(local_.size());
+    local_.push_back(g.sphereCenter());
+    radii_.push_back(g.sphereRadius());
+    // Parts' balls only when there are several: one part's ball is no tighter than the bounding ball.
+    if (g.parts().size() > 1)
+      for (const LinkGeometry::Part& p : g.parts()) {
+        local_.push_back(p.center);
+        radii_.push_back(p.radius);
+      }
+    links_[i].count = static_cast<int>(local_.size()) - links_[i].first;
+  }
+  centers_.assign(local_.size(), Vec3::Constant(std::numeric_limits<double>::quiet_NaN()));
+}
+
+void EnclosingBalls::place(const Pose* link_poses) noexcept {
+  for (std::size_t i = 0; i < links_.size(); ++i) {
+    const Link& l = links_[i];
+    const Pose& pose = link_poses[i];
+    for (int k = l.first; k < l.first + l.count; ++k) centers_[k] = pose * local_[k];
+  }
+}
+
+bool EnclosingBalls::apart(int a, int b, double padding, const Tolerances& tol) const noexcept {
+  const Link& la = links_[a];
+  const Link& lb = links_[b];
+  if (la.count == 0 || lb.count == 0) return false;
+  // As spheresApart in link_geometry.cpp: the band grows with the coordinates' size; a NaN compares false.
+  const double band = std::max(tol.gjk_absolute, 64.0 * std::numeric_limits<double>::epsilon());
+  const auto ballsApart = [&](int i, int j) {
+    const double reach = radii_[i] + radii_[j] + padding;
+    const double limit = reach + band * (centers_[i].norm() + centers_[j].norm() + reach);
+    return (centers_[i] - centers_[j]).squaredNorm() > limit * limit;
+  };
+  if (ballsApart(la.first, lb.first)) return true;
+  if (la.count == 1 && lb.count == 1) return false;
+  // The union of a link's parts contains it: every part ball of one apart from every part ball of the other.
+  const int ia = la.first + (la.count > 1), ib = lb.first + (lb.count > 1);
+  for (int i = ia; i < la.first + la.count; ++i)
+    for (int j = ib; j < lb.first + lb.count; ++j)
+      if (!ballsApart(i, j)) return false;
+  return true;
+}
+
+}  // namespace clearway
