@@ -14,6 +14,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev  # tests and benchmarks
   libfcl-dev                         # benchmarks only: FCL side by side
   gnuplot-nox                        # benchmark plots (PNG)
+  clang libfuzzer-14-dev             # scripts/fuzz.sh: the libFuzzer targets in fuzz/
   slurmd slurmctld slurm-client munge parallel  # clearway bench shards: the one-node Slurm test (GNU parallel without root)
 )
 missing=()
