@@ -44,6 +44,7 @@ class Checker {
       if (const char* n = e->Attribute("name")) names_.emplace(n, e);
     }
     if (name == "accessor") accessors_.push_back(e);
+    if (name == "polylist") polylist(e);
     for (const XMLElement* c = e->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) visit(c);
   }
 
@@ -65,6 +66,17 @@ class Checker {
         fail(a, "reaches value " + std::to_string(needed) + " of '" + (source + 1) + "', which holds " +
                     std::to_string(length));
     }
+  }
+
+  // A <polylist> of N polygons: assimp takes each polygon's corner count from <vcount> unchecked (a null
+  // read when <vcount> is missing, past its end when it is short).
+  void polylist(const XMLElement* e) const {
+    const std::uint64_t count = wholeNumber(e, "count");
+    const XMLElement* vcount = e->FirstChildElement("vcount");
+    const std::uint64_t given = vcount != nullptr ? countTokens(vcount) : 0;
+    if (given < count)
+      fail(e, "count=\"" + std::to_string(count) + "\" polygons, but <vcount> gives " + std::to_string(given) +
+                  " corner counts");
   }
 
   // No cycle through <instance_node>, and a bounded hierarchy once instances are expanded.

@@ -19,6 +19,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <system_error>
 #include <unordered_map>
@@ -207,6 +208,19 @@ void countBadEdges(const TriangleMesh& mesh, std::size_t* open, std::size_t* non
   }
 }
 
+// Assimp's PLY reader reads header lines until `end_header` without looking for the end of the file:
+// a header without that line never ends. The PLY header is text, one keyword per line.
+void checkPlyHeader(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw LoadError(path, "", "cannot open the file");
+  std::string line;
+  while (std::getline(in, line)) {
+    const std::size_t end = line.find_last_not_of(" \t\r");
+    if (end != std::string::npos && line.compare(0, end + 1, "end_header") == 0) return;
+  }
+  throw LoadError(path, "", "the PLY header has no 'end_header' line");
+}
+
 }  // namespace
 
 bool isClosed(const TriangleMesh& mesh) {
@@ -232,6 +246,7 @@ TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<st
   if (std::none_of(std::begin(kFormats), std::end(kFormats), [&](const char* f) { return ext == f; }))
     throw LoadError(path, "", "unsupported mesh format '" + ext + "' (Clearway reads " + kFormatList + ")");
   if (ext == "dae") detail::checkCollada(path);
+  if (ext == "ply") checkPlyHeader(path);
 
   // Only positions matter. Vertices are joined below by exact position, not by assimp's
   // JoinIdenticalVertices: on every mesh of ../shared/robots both give the same vertices, ours in a

@@ -311,6 +311,17 @@ TEST_F(BadInput, MeshFormatsAndPlyIndices) {
   EXPECT_LOAD_ERROR(loadMesh(two, Vec3::Ones()), two, "", "assimp cannot read it");
 }
 
+TEST_F(BadInput, PlyHeaderWithoutEndHeader) {
+  // Found by fuzz_mesh_ply: assimp read header lines forever, looking for end_header past the end of file.
+  const std::string header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                             "property float z\nelement face 1\nproperty list uchar int vertex_indices\n";
+  const std::string body = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const std::string none = dir.write("no_end.ply", header + body);
+  EXPECT_LOAD_ERROR(loadMesh(none, Vec3::Ones()), none, "", "the PLY header has no 'end_header' line");
+  // The same header closed loads, also with a CR LF line end.
+  EXPECT_EQ(loadMesh(dir.write("end.ply", header + "end_header\r\n" + body), Vec3::Ones()).triangles.size(), 1u);
+}
+
 namespace {
 
 // A COLLADA file around a library of nodes and a visual scene's content.
@@ -332,6 +343,15 @@ std::string collada(const std::string& geometry_p, const std::string& nodes, con
 }
 
 const char* const kTetP = "0 2 1 0 1 3 0 3 2 1 2 3";
+
+// The tetrahedron as a <polylist> of four triangles, with the given <vcount> element.
+std::string polylist(const std::string& vcount) {
+  std::string text = collada(kTetP, "", "<node id=\"n\"><instance_geometry url=\"#g\"/></node>");
+  const std::string triangles = "<triangles count=\"4\">";
+  text.replace(text.find(triangles), triangles.size(), "<polylist count=\"4\">" + vcount);
+  text.replace(text.find("</triangles>"), std::string("</triangles>").size(), "</polylist>");
+  return text;
+}
 const char* const kTetNode = "<node id=\"tet\"><instance_geometry url=\"#g\"/></node>";
 
 }  // namespace
@@ -340,6 +360,7 @@ TEST_F(BadInput, ColladaThatAssimpCannotSurvive) {
   // The reference: a tetrahedron through a library node loads.
   const std::string good = dir.write("good.dae", collada(kTetP, kTetNode, "<node id=\"n\"><instance_node url=\"#tet\"/></node>"));
   EXPECT_EQ(loadMesh(good, Vec3::Ones()).triangles.size(), 4u);
+  EXPECT_EQ(loadMesh(dir.write("polylist_ok.dae", polylist("<vcount>3 3 3 3</vcount>")), Vec3::Ones()).triangles.size(), 4u);
 
   struct Case {
     std::string name, text, element, reason;
@@ -380,6 +401,9 @@ TEST_F(BadInput, ColladaThatAssimpCannotSurvive) {
        "<accessor> (line 6)", "count=\"99999999999\" exceeds the size of the file"},
       {"accessor.dae", collada(kTetP, kTetNode, "<node id=\"n\"/>", "0 0 0 1 0 0 0 1 0 0 0 1", 4, "count=\"5\" stride=\"3\""),
        "<accessor> (line 6)", "reaches value 15 of 'pa', which holds 12"},
+      // Found by fuzz_mesh_dae: a <polylist> without <vcount>, which assimp read through a null pointer.
+      {"polylist.dae", polylist(""), "<polylist> (line 8)", "count=\"4\" polygons, but <vcount> gives 0 corner counts"},
+      {"short_vcount.dae", polylist("<vcount>3 3 3</vcount>"), "<polylist>", "<vcount> gives 3 corner counts"},
       {"stride.dae", collada(kTetP, kTetNode, "<node id=\"n\"/>", "0 0 0 1 0 0 0 1 0 0 0 1", 4, "count=\"4\" stride=\"-3\""),
        "<accessor>", "stride=\"-3\" is not a whole number"},
   };
