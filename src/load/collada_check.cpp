@@ -59,7 +59,9 @@ class Checker {
                           offset = wholeNumber(a, "offset");
       std::uint64_t params = 0;
       for (const XMLElement* p = a->FirstChildElement("param"); p != nullptr; p = p->NextSiblingElement("param")) ++params;
-      const std::uint64_t length = countTokens(it->second);
+      // Assimp reads as many values as the array's count="N" says (none when it is missing), at most
+      // the values written.
+      const std::uint64_t length = std::min(countTokens(it->second), wholeNumber(it->second, "count"));
       // Each of these is at most the file size (wholeNumber), so the sum cannot overflow 64 bits.
       const std::uint64_t needed = offset + (count - 1) * stride + params;
       if (count > 0 && params > 0 && needed > length)

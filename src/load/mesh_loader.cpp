@@ -136,14 +136,7 @@ class Merger {
         continue;
       }
       std::array<std::int32_t, 3> t{};
-      for (int k = 0; k < 3; ++k) {
-        // Assimp's PLY reader passes face indices on unchecked.
-        if (face.mIndices[k] >= m.mNumVertices)
-          throw LoadError(path_, "", "face " + std::to_string(f) + " of mesh '" + m.mName.C_Str() + "' uses vertex " +
-                                         std::to_string(face.mIndices[k]) + ", but the mesh has " +
-                                         std::to_string(m.mNumVertices) + " vertices");
-        t[k] = vertex(m, face.mIndices[k], world);
-      }
+      for (int k = 0; k < 3; ++k) t[k] = vertex(m, face.mIndices[k], world);  // in range: checkFaceIndices
       if (mirrored) std::swap(t[1], t[2]);
       if (isDegenerate(t)) {
         ++degenerate;
@@ -221,6 +214,20 @@ void checkPlyHeader(const std::string& path) {
   throw LoadError(path, "", "the PLY header has no 'end_header' line");
 }
 
+// Assimp's PLY reader passes face indices on unchecked, and its post-processing (triangulation) reads
+// through them: check them in the scene as read, before any step runs.
+void checkFaceIndices(const aiScene& scene, const std::string& path) {
+  for (unsigned i = 0; i < scene.mNumMeshes; ++i) {
+    const aiMesh& m = *scene.mMeshes[i];
+    for (unsigned f = 0; f < m.mNumFaces; ++f)
+      for (unsigned k = 0; k < m.mFaces[f].mNumIndices; ++k)
+        if (m.mFaces[f].mIndices[k] >= m.mNumVertices)
+          throw LoadError(path, "", "face " + std::to_string(f) + " of mesh '" + m.mName.C_Str() + "' uses vertex " +
+                                        std::to_string(m.mFaces[f].mIndices[k]) + ", but the mesh has " +
+                                        std::to_string(m.mNumVertices) + " vertices");
+  }
+}
+
 }  // namespace
 
 bool isClosed(const TriangleMesh& mesh) {
@@ -256,8 +263,11 @@ TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<st
                                   aiComponent_TEXCOORDS | aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS |
                                   aiComponent_TEXTURES | aiComponent_LIGHTS | aiComponent_CAMERAS |
                                   aiComponent_MATERIALS);
-  const aiScene* scene = importer.ReadFile(
-      path, aiProcess_Triangulate | aiProcess_RemoveComponent);
+  const aiScene* scene = importer.ReadFile(path, 0);
+  if (scene == nullptr || scene->mRootNode == nullptr)
+    throw LoadError(path, "", std::string("assimp cannot read it: ") + importer.GetErrorString());
+  checkFaceIndices(*scene, path);
+  scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_RemoveComponent);
   if (scene == nullptr || scene->mRootNode == nullptr)
     throw LoadError(path, "", std::string("assimp cannot read it: ") + importer.GetErrorString());
 

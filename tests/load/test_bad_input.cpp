@@ -300,6 +300,12 @@ TEST_F(BadInput, MeshFormatsAndPlyIndices) {
   EXPECT_EQ(loadMesh(ok, Vec3::Ones()).triangles.size(), 4u);
   const std::string bad = dir.write("bad.ply", header + "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 1000000000\n");
   EXPECT_LOAD_ERROR(loadMesh(bad, Vec3::Ones()), bad, "", "uses vertex 1000000000, but the mesh has 4 vertices");
+  // Found by fuzz_mesh_ply: one vertex fewer than the faces use aborted inside assimp's post-processing,
+  // before the check above ran.
+  std::string short_header = header;
+  short_header.replace(short_header.find("element vertex 4"), 16, "element vertex 3");
+  const std::string short_list = dir.write("short.ply", short_header + "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
+  EXPECT_LOAD_ERROR(loadMesh(short_list, Vec3::Ones()), short_list, "", "uses vertex 3, but the mesh has 3 vertices");
   // Formats other than these four are refused, by the name the error gives them.
   for (const std::string name : {"garbage.x", "model.3ds", "archive.zae", "scene.fbx"}) {
     const std::string path = dir.write(name, "xof 0302txt 0064\ngarbage");
@@ -343,6 +349,14 @@ std::string collada(const std::string& geometry_p, const std::string& nodes, con
 }
 
 const char* const kTetP = "0 2 1 0 1 3 0 3 2 1 2 3";
+
+// The tetrahedron with a <float_array> that does not say its count.
+std::string uncounted() {
+  std::string text = collada(kTetP, "", "<node id=\"n\"><instance_geometry url=\"#g\"/></node>");
+  const std::string counted = "<float_array id=\"pa\" count=\"12\">";
+  text.replace(text.find(counted), counted.size(), "<float_array id=\"pa\">");
+  return text;
+}
 
 // The tetrahedron as a <polylist> of four triangles, with the given <vcount> element.
 std::string polylist(const std::string& vcount) {
@@ -404,6 +418,8 @@ TEST_F(BadInput, ColladaThatAssimpCannotSurvive) {
       // Found by fuzz_mesh_dae: a <polylist> without <vcount>, which assimp read through a null pointer.
       {"polylist.dae", polylist(""), "<polylist> (line 8)", "count=\"4\" polygons, but <vcount> gives 0 corner counts"},
       {"short_vcount.dae", polylist("<vcount>3 3 3</vcount>"), "<polylist>", "<vcount> gives 3 corner counts"},
+      // Found by fuzz_mesh_dae: a <float_array> without count="N", of which assimp reads no value.
+      {"uncounted.dae", uncounted(), "<accessor> (line 6)", "reaches value 12 of 'pa', which holds 0"},
       {"stride.dae", collada(kTetP, kTetNode, "<node id=\"n\"/>", "0 0 0 1 0 0 0 1 0 0 0 1", 4, "count=\"4\" stride=\"-3\""),
        "<accessor>", "stride=\"-3\" is not a whole number"},
   };
