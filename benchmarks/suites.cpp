@@ -3,14 +3,19 @@
 #include "suites.h"
 
 #include "bench_clock.h"
+#include "bench_rng.h"
+#include "shared_problems.h"
+#ifdef CLEARWAY_HAVE_FCL
 #include "fcl_ompl.h"
 #include "narrowphase_shapes.h"
-#include "shared_problems.h"
+#endif
 
 #include <clearway/ompl/collision_checking.h>
 
+#ifdef CLEARWAY_HAVE_FCL
 #include <fcl/narrowphase/detail/gjk_solver_indep.h>
 #include <fcl/narrowphase/detail/gjk_solver_libccd.h>
+#endif
 #include <ompl/base/DiscreteMotionValidator.h>
 #include <ompl/geometric/SimpleSetup.h>
 #include <ompl/geometric/planners/rrt/RRTConnect.h>
@@ -67,7 +72,15 @@ void judge(SuiteRow& row, const std::vector<char>& verdict, const std::vector<ch
   row.max_error = row.misses + row.false_alarms > 0 ? 1.0 : 0.0;
 }
 
+// Built without FCL, the suites measure Clearway alone: these are the comparisons they cannot make.
+#ifdef CLEARWAY_HAVE_FCL
+constexpr bool kFcl = true;
+#else
+constexpr bool kFcl = false;
+#endif
+
 // ---- narrowphase: GJK distance on separated convex pairs, by tolerance --------------------------------
+#ifdef CLEARWAY_HAVE_FCL
 
 const double kGjkTolerances[] = {1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-9};
 
@@ -149,6 +162,7 @@ void narrowphaseCase(const SuiteCase& c, const SuiteConfig& config, std::vector<
     throw std::runtime_error("unknown shape family '" + c.subject + "'");
   }
 }
+#endif  // CLEARWAY_HAVE_FCL
 
 // ---- shared problems ------------------------------------------------------------------------------------
 
@@ -175,7 +189,6 @@ void statesCase(const SuiteCase& c, const SuiteConfig& config, std::vector<Suite
   SceneOptions hull_options;
   hull_options.mode = GeometryMode::Hull;
   const Scene hull(d, mesh->geometryPtr(), mesh->environmentPtr(), hull_options);
-  FclScene fcl(*mesh);
 
   Rng rng(caseSeed(config, c));
   const int n = mesh->dimension();
@@ -196,7 +209,20 @@ void statesCase(const SuiteCase& c, const SuiteConfig& config, std::vector<Suite
   row("clearway", "mesh", bestNs(count, [&](std::size_t i) { verdict[i] = !mesh->isFree(&states[i * n], ctx); }));
   SceneContext hull_ctx = hull.makeContext();
   row("clearway", "hull", bestNs(count, [&](std::size_t i) { verdict[i] = !hull.isFree(&states[i * n], hull_ctx); }));
+#ifdef CLEARWAY_HAVE_FCL
+  FclScene fcl(*mesh);
   row("fcl", "obbrss", bestNs(count, [&](std::size_t i) { verdict[i] = !fcl.isFree(&states[i * n]); }));
+#endif
+}
+
+// OMPL's validity checker over Clearway ("clearway") or over FCL ("fcl", only when built with it).
+ob::StateValidityCheckerPtr validity(const char* engine, const ob::SpaceInformationPtr& si,
+                                     const std::shared_ptr<const Scene>& scene) {
+#ifdef CLEARWAY_HAVE_FCL
+  if (!std::strcmp(engine, "fcl")) return std::make_shared<FclValidity>(si, *scene);
+#endif
+  (void)engine;
+  return std::make_shared<ValidityChecker>(si, scene);
 }
 
 // ---- motions: certified, and OMPL's sampling over Clearway and over FCL, by tolerance -------------------
@@ -267,14 +293,14 @@ void motionsCase(const SuiteCase& c, const SuiteConfig& config, std::vector<Suit
   };
   std::vector<Run> runs;
   for (const MotionMode& m : kMotionModes) {
+    if (!kFcl && !std::strcmp(m.engine, "fcl")) continue;
     auto si = std::make_shared<ob::SpaceInformation>(makeStateSpace(*scene));
     if (!std::strcmp(m.mode, "certified")) {
       MotionOptions options;
       options.contact_distance = m.tolerance;
       setupCollisionChecking(si, scene, options);
     } else {
-      if (!std::strcmp(m.engine, "fcl")) si->setStateValidityChecker(std::make_shared<FclValidity>(si, *scene));
-      else si->setStateValidityChecker(std::make_shared<ValidityChecker>(si, scene));
+      si->setStateValidityChecker(validity(m.engine, si, scene));
       si->setMotionValidator(std::make_shared<ob::DiscreteMotionValidator>(si));
       si->setStateValidityCheckingResolution(m.tolerance);
       si->setup();
@@ -344,14 +370,14 @@ void planCase(const SuiteCase& c, const SuiteConfig& config, std::vector<SuiteRo
     const char* mode;
   };
   for (const Checker& k : {Checker{"clearway", "certified"}, Checker{"clearway", "sampled"}, Checker{"fcl", "sampled"}}) {
+    if (!kFcl && !std::strcmp(k.engine, "fcl")) continue;
     const bool certified = !std::strcmp(k.mode, "certified");
     og::SimpleSetup setup(makeStateSpace(*scene));
     const ob::SpaceInformationPtr si = setup.getSpaceInformation();
     if (certified) {
       setupCollisionChecking(si, scene);
     } else {
-      if (!std::strcmp(k.engine, "fcl")) si->setStateValidityChecker(std::make_shared<FclValidity>(si, *scene));
-      else si->setStateValidityChecker(std::make_shared<ValidityChecker>(si, scene));
+      si->setStateValidityChecker(validity(k.engine, si, scene));
       si->setMotionValidator(std::make_shared<ob::DiscreteMotionValidator>(si));
       si->setStateValidityCheckingResolution(0.01);  // OMPL's default
     }
@@ -423,12 +449,15 @@ std::vector<SuiteCase> enumerateCases(const SuiteConfig& config) {
   for (const std::string& suite : suiteNames()) {
     if (std::find(config.suites.begin(), config.suites.end(), suite) == config.suites.end()) continue;
     if (suite == "narrowphase") {
-      for (const char* family : kShapeFamilies) cases.push_back({suite, family, ""});
+      if (kFcl)  // (its shape pools are built for both libraries)
+        for (const char* family : kShapeFamilies) cases.push_back({suite, family, ""});
       continue;
     }
+    // The tool's --shared DIR and $CLEARWAY_SHARED set config.shared: say so, a user has no other way to learn it.
+    const std::string need = "suite '" + suite + "' needs the shared scenes (clearway bench --shared DIR or $CLEARWAY_SHARED)";
+    if (config.shared.empty()) throw std::runtime_error(need + ", and no shared data folder was given");
     const std::string scenes = config.shared + "/scenes";
-    if (!std::filesystem::is_directory(scenes))
-      throw std::runtime_error("suite '" + suite + "' needs the shared scenes, and " + scenes + " is not a folder");
+    if (!std::filesystem::is_directory(scenes)) throw std::runtime_error(need + ", and " + scenes + " is not a folder");
     for (const std::string& family : sceneFamilies(scenes))
       for (int k = 1; k <= config.problems; ++k) {
         const std::string file = problemFile(scenes, family, k);
@@ -449,10 +478,24 @@ std::vector<SuiteCase> enumerateCases(const SuiteConfig& config) {
   return cases;
 }
 
+const std::vector<std::string>& missingComparisons() {
+  static const std::vector<std::string> missing =
+      kFcl ? std::vector<std::string>{}
+           : std::vector<std::string>{"narrowphase: the whole suite (Clearway's GJK against FCL's two solvers)",
+                                      "states: fcl obbrss", "motions: fcl sampled (OMPL's sampling over FCL)",
+                                      "plan: fcl sampled (RRTConnect over FCL)"};
+  return missing;
+}
+
 void runCase(const SuiteCase& c, const SuiteConfig& config, std::vector<SuiteRow>& rows) {
   ompl::msg::setLogLevel(ompl::msg::LOG_ERROR);
-  if (c.suite == "narrowphase") narrowphaseCase(c, config, rows);
-  else if (c.suite == "states") statesCase(c, config, rows);
+  if (c.suite == "narrowphase") {
+#ifdef CLEARWAY_HAVE_FCL
+    narrowphaseCase(c, config, rows);
+#else
+    throw std::runtime_error("the narrowphase suite needs FCL (libfcl-dev) at build time");
+#endif
+  } else if (c.suite == "states") statesCase(c, config, rows);
   else if (c.suite == "motions") motionsCase(c, config, rows);
   else if (c.suite == "plan") planCase(c, config, rows);
   else throw std::runtime_error("unknown suite '" + c.suite + "'");

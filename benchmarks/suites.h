@@ -47,6 +47,10 @@ struct SuiteRow {
 /// The known suites, in run order.
 const std::vector<std::string>& suiteNames();
 
+/// The comparisons this build cannot make, one line each (FCL was not found when it was built: its rows,
+/// and the narrowphase suite, which compares with FCL alone); empty when it makes them all.
+const std::vector<std::string>& missingComparisons();
+
 /// Every case of the config, in a fixed order (the case index is the position). Throws
 /// std::runtime_error when a suite is unknown or the shared scenes are missing for one that needs them.
 std::vector<SuiteCase> enumerateCases(const SuiteConfig& config);

@@ -1,14 +1,14 @@
 #!/usr/bin/env bash
 # The layering check: every folder of include/clearway/ and src/ is a pipeline stage, and a stage may
 # include only itself and the stages before it. Reads every `#include <clearway/STAGE/...>` (and the
-# plugin's and tool's) and fails, naming file, line and both stages, when one points up the pipeline or
-# names a stage not listed here. Headers at include/clearway/ itself (math.h, tolerances.h) and detail/
-# are below every stage.
+# plugin's, the tool's and the Python module's) and fails, naming file, line and both stages, when one
+# points up the pipeline or names a stage not listed here. Headers at include/clearway/ itself (math.h,
+# tolerances.h) and detail/ are below every stage.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 # The pipeline, from the bottom up: the one place its order is written.
-stages=(detail shape narrowphase tree kinematics load body environment scene motion ompl cli)
+stages=(detail shape narrowphase tree kinematics load body environment scene motion ompl cli python)
 
 rank() {
   local i
@@ -25,6 +25,7 @@ stageOf() {
     include/clearway/*) echo "-" ;;
     src/*/*) local rest=${1#src/}; echo "${rest%%/*}" ;;
     plugins/ompl/*) echo ompl ;;
+    python/*) echo python ;;
     *) echo "?" ;;
   esac
 }
@@ -57,7 +58,7 @@ while IFS= read -r file; do
     echo "check-layers: $file: a relative include leaves its stage: $(grep -nE '#[[:space:]]*include[[:space:]]*"\.\./' "$file" | head -n 1)"
     status=1
   fi
-done < <(find include/clearway src plugins/ompl -type f \( -name '*.h' -o -name '*.cpp' \) | sort)
+done < <(find include/clearway src plugins/ompl python -type f \( -name '*.h' -o -name '*.cpp' \) | sort)
 
 if [ $status -eq 0 ]; then
   echo "check-layers: $checked includes, all down the pipeline (${stages[*]})"

@@ -12,6 +12,7 @@ packages=(
   libompl-dev libboost-serialization-dev libboost-filesystem-dev libboost-system-dev  # OMPL plugin
   libyaml-cpp-dev nlohmann-json3-dev # scene files, query files
   libgtest-dev libgmock-dev libbenchmark-dev  # tests and benchmarks
+  python3-dev pybind11-dev python3-numpy python3-pytest  # the Python module and its tests
   libfcl-dev                         # benchmarks only: FCL side by side
   gnuplot-nox                        # benchmark plots (PNG)
   clang libfuzzer-14-dev             # scripts/fuzz.sh: the libFuzzer targets in fuzz/

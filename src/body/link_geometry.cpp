@@ -123,40 +123,6 @@ std::vector<Aabb> triangleBoxes(const std::vector<Triangle>& triangles) {
 
 // ---- Query helpers ----------------------------------------------------------------------------------
 
-// A shape with `pad` metres of skin, keeping the hull's warm-started support search (shape/support.h's
-// Margin forwards only support(d)).
-template <class S>
-struct Padded {
-  const S& shape;
-  double pad;
-  Vec3 support(const Vec3& d) const noexcept { return shape.support(d); }
-  Vec3 support(const Vec3& d, std::int32_t& hint) const noexcept { return detail::supportWithHint(shape, d, hint); }
-  double radius() const noexcept { return shape.radius() + pad; }
-  Vec3 center() const noexcept { return shape.center(); }
-};
-
-// The tight box, in the parent frame of `pose`, of a shape placed by it (6 support queries).
-template <class S>
-Aabb shapeBox(const S& s, const Pose& pose) noexcept {
-  Aabb box;
-  const double r = s.radius();
-  for (int i = 0; i < 3; ++i) {
-    const Vec3 d = pose.R.row(i).transpose();  // the parent's axis i in the shape's frame
-    box.max[i] = (pose * s.support(d))[i] + r;
-    box.min[i] = (pose * s.support(-d))[i] - r;
-  }
-  return box;
-}
-
-struct PairBand {
-  double slack;  // padding + band: what boxes and the SAT must keep
-};
-
-PairBand pairBand(double scale, double padding, const Tolerances& tol) noexcept {
-  const double rel = std::max(tol.gjk_absolute, 64.0 * std::numeric_limits<double>::epsilon());
-  return {padding + rel * (scale + padding)};
-}
-
 // Triangle of A (A's frame) against triangle of B (B's frame, placed by b_in_a): the SAT discards
 // pairs certainly apart; GJK decides the rest (and pads).
 bool trianglePairIntersects(const Triangle& ta, const Triangle& tb, const Pose& b_in_a, const Tolerances& tol,
@@ -164,7 +130,7 @@ bool trianglePairIntersects(const Triangle& ta, const Triangle& tb, const Pose& 
   const Vec3 vb[3] = {b_in_a * tb.v[0], b_in_a * tb.v[1], b_in_a * tb.v[2]};
   if (detail::trianglesSeparated(ta.v, vb, slack)) return false;
   SimplexCache cache;
-  return gjkIntersect(Padded<Triangle>{ta, padding}, Pose::identity(), tb, b_in_a, tol, cache).intersecting;
+  return gjkIntersect(Margin<Triangle>{ta, padding}, Pose::identity(), tb, b_in_a, tol, cache).intersecting;
 }
 
 // A convex shape placed in the link's frame by `shape_in_link` against the link's triangles.
@@ -175,8 +141,8 @@ bool shapeIntersectsTriangles(const S& s, const Pose& shape_in_link, const LinkG
   // Nodes are tested against the shape's world box (cheap) and then against its own box as an oriented
   // box (SAT lite; full SAT for single triangles): a large primitive turned against the link's frame,
   // such as a pedestal beside an arm, would otherwise reach every triangle its world box covers.
-  const Aabb box = shapeBox(s, shape_in_link).inflated(slack);
-  const Aabb own = shapeBox(s, Pose::identity()).inflated(slack);
+  const Aabb box = placedBox(s, shape_in_link).inflated(slack);
+  const Aabb own = placedBox(s, Pose::identity()).inflated(slack);
   const double scale = link.boundingRadius() + shape_in_link.t.norm() + own.min.cwiseAbs().cwiseMax(own.max.cwiseAbs()).norm();
   const detail::OrientedBoxTest test(shape_in_link, 0.0, scale);
   const detail::OrientedBoxTest::PlacedB placed = test.place(own);
@@ -202,7 +168,7 @@ bool shapeIntersectsTriangles(const S& s, const Pose& shape_in_link, const LinkG
     for (std::int32_t slot = n.first; slot < n.first + n.count; ++slot) {
       if (apart(tree.slotBoxes()[slot], std::true_type{})) continue;
       SimplexCache cache;
-      if (gjkIntersect(Padded<S>{s, padding}, shape_in_link, tris[tree.items()[slot]], Pose::identity(), tol, cache)
+      if (gjkIntersect(Margin<S>{s, padding}, shape_in_link, tris[tree.items()[slot]], Pose::identity(), tol, cache)
               .intersecting)
         return true;
     }
@@ -222,7 +188,7 @@ bool shapesIntersect(const Shape& a, const Pose& pa, const Shape& b, const Pose&
       [&](const auto& sa, const auto& sb) {
         using SA = std::decay_t<decltype(sa)>;
         SimplexCache cache;
-        return gjkIntersect(Padded<SA>{sa, padding}, pa, sb, pb, tol, cache).intersecting;
+        return gjkIntersect(Margin<SA>{sa, padding}, pa, sb, pb, tol, cache).intersecting;
       },
       a, b);
 }
@@ -367,6 +333,14 @@ LinkGeometry::LinkGeometry(const std::vector<CollisionElement>& elements, const 
 
 // ---- Queries ------------------------------------------------------------------------------------------
 
+Aabb placedBox(const Shape& shape, const Pose& pose) noexcept {
+  return std::visit([&](const auto& s) { return placedBox(s, pose); }, shape);
+}
+
+double narrowBand(double scale, const Tolerances& tol) noexcept {
+  return std::max(tol.gjk_absolute, 64.0 * std::numeric_limits<double>::epsilon()) * scale;
+}
+
 namespace {
 double partsBound(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
                   const Tolerances& tol, double enough, double relative, SimplexCache* caches) noexcept;
@@ -439,11 +413,11 @@ bool meshesIntersect(const LinkGeometry& a, const Pose& pose_a, const LinkGeomet
     return false;
   const Pose b_in_a = relativePose(pose_a, pose_b);
   const double scale = a.boundingRadius() + b.boundingRadius() + b_in_a.t.norm();
-  const double slack = pairBand(scale, padding, tol).slack;
+  const double slack = padding + narrowBand(scale + padding, tol);
   if (detail::OrientedBoxTest(b_in_a, slack, scale).separated<false>(a.bounds(), b.bounds())) return false;
   SimplexCache scratch;
   SimplexCache& cache = hull_cache ? *hull_cache : scratch;
-  const IntersectResult hulls = gjkIntersect(Padded<ConvexHull>{a.hull(), padding}, pose_a, b.hull(), pose_b, tol, cache);
+  const IntersectResult hulls = gjkIntersect(Margin<ConvexHull>{a.hull(), padding}, pose_a, b.hull(), pose_b, tol, cache);
   if (!hulls.intersecting) return false;
   if (mode == GeometryMode::Hull) return true;
   return exactIntersect(a, b, b_in_a, tol, padding, slack) || linkContained(a, b, b_in_a);
@@ -460,7 +434,7 @@ bool shapeIntersectsLink(const Shape& shape, const Pose& pose_shape, const LinkG
   const bool hulls = std::visit(
       [&](const auto& s) {
         using S = std::decay_t<decltype(s)>;
-        return gjkIntersect(Padded<S>{s, padding}, pose_shape, link.hull(), pose_link, tol, cache).intersecting;
+        return gjkIntersect(Margin<S>{s, padding}, pose_shape, link.hull(), pose_link, tol, cache).intersecting;
       },
       shape);
   if (!hulls) return false;
@@ -468,7 +442,7 @@ bool shapeIntersectsLink(const Shape& shape, const Pose& pose_shape, const LinkG
   // In the link's frame.
   const Pose shape_in_link = relativePose(pose_link, pose_shape);
   const double scale = link.boundingRadius() + shape_in_link.t.norm() + boundingRadius(shape);
-  const double slack = pairBand(scale, padding, tol).slack;
+  const double slack = padding + narrowBand(scale + padding, tol);
   if (shapeIntersectsTriangles(shape, shape_in_link, link, tol, padding, slack)) return true;
   for (const auto& p : link.primitives())
     if (shapesIntersect(shape, shape_in_link, p.shape, p.pose, tol, padding)) return true;
@@ -549,7 +523,7 @@ void shapeTrianglesDistance(const S& s, const Pose& shape_in_link, const LinkGeo
   const std::vector<Triangle>& tris = link.triangles();
   // The tree is in the link's frame; the results go to A's frame (identity when the shape is B's). The
   // shape's own box, turned, prunes far more than its bounds in the link frame (a slab seen askew).
-  link.tree().forEachWithin(shapeBox(s, Pose::identity()), shape_in_link, m.cutoff, [&](std::int32_t i) {
+  link.tree().forEachWithin(placedBox(s, Pose::identity()), shape_in_link, m.cutoff, [&](std::int32_t i) {
     DistanceResult r = shape_is_a ? gjkDistance(s, shape_in_link, tris[i], Pose::identity(), tol)
                                   : gjkDistance(tris[i], Pose::identity(), s, shape_in_link, tol);
     r.point_a = link_in_a * r.point_a;

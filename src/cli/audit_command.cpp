@@ -1,4 +1,5 @@
-// `clearway audit URDF [--srdf S] [--samples N] [--seed N] [--srdf-out FILE] [--report FILE]`.
+// `clearway audit URDF [--srdf S] [--check] [--samples N] [--seed N] [--threads N] [--srdf-out FILE|-]
+// [--report FILE]`.
 #include "scene_commands.h"
 
 #include <clearway/load/robot_loader.h>
@@ -15,16 +16,18 @@
 #include <iostream>
 #include <map>
 #include <sstream>
+#include <stdexcept>
+#include <thread>
 
 namespace clearway::cli {
 
 namespace {
 
-constexpr int kExitOk = 0, kExitUsage = 2;
+constexpr int kExitOk = 0, kExitDisagrees = 1, kExitUsage = 2;
 
 const char* const kAuditUsage =
-    "usage: clearway audit URDF [--srdf SRDF] [--samples N] [--seed N] [--srdf-out FILE] [--report FILE]\n"
-    "                           [--package-path DIR]... [--honour-up-axis]\n"
+    "usage: clearway audit URDF [--srdf SRDF [--check]] [--samples N] [--seed N] [--threads N]\n"
+    "                           [--srdf-out FILE|-] [--report FILE] [--package-path DIR]... [--honour-up-axis]\n"
     "\n"
     "Classifies every pair of links with collision geometry as MoveIt Setup Assistant does: Adjacent,\n"
     "Default (colliding at the default configuration), Always (colliding in >= 95% of N random\n"
@@ -33,11 +36,17 @@ const char* const kAuditUsage =
     "a Never pair that came within 1 mm). Default pairs are sampled too. Prints first the pairs whose\n"
     "verdict may mislead: disabled (Default, or by the --srdf given) yet colliding in more than 1% of the\n"
     "samples, or checked yet colliding in most; then a summary, and with --srdf the pairs where the given SRDF\n"
-    "and the audit disagree. --srdf-out writes disable_collisions for every classified pair; --report a\n"
-    "Markdown table of all pairs and, beside it (REPORT with .png), a heat map of the link-pair matrix\n"
-    "(drawn by gnuplot when installed). A progress bar goes to stderr on a terminal.\n"
-    "Defaults: 10000 samples, seed 1; both cores are used.\n"
-    "Exit status: 0 on success, 2 on a usage error or a robot that does not load.\n";
+    "and the audit disagree; with --check, a disagreement is exit status 1 (a CI guard for the SRDF).\n"
+    "--srdf-out writes an SRDF (- for stdout, the report then going to stderr): the --srdf given, with the\n"
+    "disable_collisions of every audited pair replaced by one per classified pair (link1 < link2, sorted)\n"
+    "and all else kept (groups, group states, end effectors, virtual and passive joints, comments), or a new\n"
+    "one without --srdf; it may be the --srdf file itself. --report writes a Markdown table of all pairs\n"
+    "and, beside it (REPORT with .png), a heat map of the link-pair matrix (drawn by gnuplot when\n"
+    "installed). A progress bar goes to stderr on a terminal.\n"
+    "Defaults: 10000 samples, seed 1, one thread per hardware thread. The same seed and samples give the\n"
+    "same audit whatever the thread count.\n"
+    "Exit status: 0 on success (with --check: the SRDF agrees), 1 with --check when the SRDF disagrees,\n"
+    "2 on a usage error, a robot that does not load or an output that cannot be written.\n";
 
 bool parseCount(const std::string& s, long long& out) {
   char* end = nullptr;
@@ -140,7 +149,9 @@ bool writeHeatmap(const RobotModel& model, const std::vector<PairAudit>& audit, 
 
 int auditCommand(const std::vector<std::string>& args) {
   std::string urdf, srdf, srdf_out, report;
+  bool check = false;
   AuditOptions options;
+  options.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));  // 0 when unknown
   LoadOptions load;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
@@ -154,7 +165,8 @@ int auditCommand(const std::vector<std::string>& args) {
       std::cerr << "clearway audit: " << error << "\n" << kAuditUsage << kLoadOptionsUsage;
       return kExitUsage;
     }
-    const bool valued = a == "--srdf" || a == "--samples" || a == "--seed" || a == "--srdf-out" || a == "--report";
+    const bool valued =
+        a == "--srdf" || a == "--samples" || a == "--seed" || a == "--threads" || a == "--srdf-out" || a == "--report";
     if (valued && i + 1 >= args.size()) {
       std::cerr << "clearway audit: " << a << " needs a value\n" << kAuditUsage;
       return kExitUsage;
@@ -172,6 +184,14 @@ int auditCommand(const std::vector<std::string>& args) {
         return kExitUsage;
       }
       options.samples = static_cast<int>(n);
+    } else if (a == "--check") {
+      check = true;
+    } else if (a == "--threads") {
+      if (!parseCount(args[++i], n) || n < 1 || n > 1024) {
+        std::cerr << "clearway audit: --threads needs a whole number from 1 to 1024, got '" << args[i] << "'\n";
+        return kExitUsage;
+      }
+      options.threads = static_cast<int>(n);
     } else if (a == "--seed") {
       if (!parseCount(args[++i], n) || n < 0) {
         std::cerr << "clearway audit: --seed needs a whole number >= 0, got '" << args[i] << "'\n";
@@ -189,27 +209,44 @@ int auditCommand(const std::vector<std::string>& args) {
     std::cerr << "clearway audit: expected a URDF file\n" << kAuditUsage;
     return kExitUsage;
   }
+  if (check && srdf.empty()) {
+    std::cerr << "clearway audit: --check needs the --srdf to compare with\n" << kAuditUsage;
+    return kExitUsage;
+  }
+  if (report == "-") {
+    std::cerr << "clearway audit: --report needs a file name (its heat map is written beside it), not -\n";
+    return kExitUsage;
+  }
+  // With the SRDF on stdout, the report lines go to stderr.
+  std::ostream& text = srdf_out == "-" ? std::cerr : std::cout;
   std::shared_ptr<const RobotModel> model;
   std::map<std::pair<int, int>, std::string> shipped;  // the given SRDF's disabled pairs
+  std::string srdf_text;                               // the given SRDF, which --srdf-out keeps
   try {
     model = std::make_shared<const RobotModel>(loadRobot(urdf, "", load));
-    for (const std::string& w : model->loadWarnings()) std::cerr << "warning: " << w << "\n";
+    for (const std::string& w : model->loadWarnings()) printWarning(w);
     if (!srdf.empty()) {
       const RobotModel with_srdf = loadRobot(urdf, srdf, load);
       for (const DisabledCollision& d : with_srdf.disabledCollisions())
         shipped[{std::min(d.link_a, d.link_b), std::max(d.link_a, d.link_b)}] = d.reason;
-      // The URDF's own warnings were printed above; those about the SRDF come only from this load.
-      for (const std::string& w : with_srdf.loadWarnings())
-        if (w.rfind(srdf + ":", 0) == 0) std::cerr << "warning: " << w << "\n";
+      // The URDF's own warnings come again, and are printed once (printWarning).
+      for (const std::string& w : with_srdf.loadWarnings()) printWarning(w);
+      std::ifstream in(srdf);
+      std::ostringstream content;
+      content << in.rdbuf();
+      if (!in) throw std::runtime_error(srdf + ": cannot read the file");
+      srdf_text = content.str();
     }
   } catch (const std::exception& e) {
     std::cerr << "clearway audit: " << e.what() << "\n";
     return kExitUsage;
   }
   const auto geometry = std::make_shared<const RobotGeometry>(model);
-  std::cerr << "clearway audit: " << model->name() << ", " << geometry->geometricLinks().size()
-            << " links with geometry, " << options.samples << " samples (seed " << options.seed << ")\n";
-  if (isatty(STDERR_FILENO)) options.progress = progressBar;
+  if (!quiet())
+    std::cerr << "clearway audit: " << model->name() << ", " << geometry->geometricLinks().size()
+              << " links with geometry, " << options.samples << " samples (seed " << options.seed << "), "
+              << options.threads << " threads\n";
+  if (isatty(STDERR_FILENO) && !quiet()) options.progress = progressBar;
   const std::vector<PairAudit> audit = auditSelfCollision(geometry, options);
 
   // The pairs whose verdict may mislead come first, the most often colliding first: the audit's own
@@ -234,7 +271,7 @@ int auditCommand(const std::vector<std::string>& args) {
   std::stable_sort(warnings.begin(), warnings.end(),
                    [](const auto& x, const auto& y) { return collidingFraction(*x.first) > collidingFraction(*y.first); });
   for (const auto& [p, why] : warnings)
-    std::cout << "warning: " << model->link(p->a).name << " " << model->link(p->b).name << ": " << why << "\n";
+    text << "warning: " << model->link(p->a).name << " " << model->link(p->b).name << ": " << why << "\n";
 
   std::map<std::string, int> counts;
   int near = 0;
@@ -242,9 +279,10 @@ int auditCommand(const std::vector<std::string>& args) {
     ++counts[p.reason.empty() ? "checked" : p.reason];
     near += p.near_miss;
   }
-  std::cout << model->name() << ": " << audit.size() << " pairs:";
-  for (const char* r : {"Adjacent", "Default", "Always", "Never", "checked"}) std::cout << " " << counts[r] << " " << r;
-  std::cout << " (" << near << " Never pairs came within 1 mm)\n";
+  text << model->name() << ": " << audit.size() << " pairs:";
+  for (const char* r : {"Adjacent", "Default", "Always", "Never", "checked"}) text << " " << counts[r] << " " << r;
+  text << " (" << near << " Never pairs came within 1 mm)\n";
+  bool disagrees = false;  // the given SRDF and the audit differ on some pair
   if (!srdf.empty()) {
     int differ = 0;
     for (const PairAudit& p : audit) {
@@ -252,18 +290,35 @@ int auditCommand(const std::vector<std::string>& args) {
       const std::string theirs = it == shipped.end() ? "" : it->second;
       if (theirs == p.reason) continue;
       ++differ;
-      std::cout << "differs: " << model->link(p.a).name << " " << model->link(p.b).name << ": SRDF "
-                << (theirs.empty() ? "checked" : theirs) << ", audit " << (p.reason.empty() ? "checked" : p.reason)
-                << evidenceText(p) << "\n";
+      text << "differs: " << model->link(p.a).name << " " << model->link(p.b).name << ": SRDF "
+           << (theirs.empty() ? "checked" : theirs) << ", audit " << (p.reason.empty() ? "checked" : p.reason)
+           << evidenceText(p) << "\n";
     }
-    std::cout << differ << " pairs differ from " << srdf << "\n";
+    text << differ << " pairs differ from " << srdf << "\n";
+    disagrees = differ > 0;
   }
   if (!srdf_out.empty()) {
-    std::ofstream out(srdf_out);
-    out << auditSrdf(*model, audit);
-    if (!out) {
-      std::cerr << "clearway audit: cannot write " << srdf_out << "\n";
+    std::string written;
+    try {
+      written = auditSrdf(*model, audit, srdf_text);
+    } catch (const std::exception& e) {
+      std::cerr << "clearway audit: " << srdf << ": " << e.what() << "\n";
       return kExitUsage;
+    }
+    if (srdf_out == "-") {
+      std::cout << written << std::flush;
+      if (!std::cout) {
+        std::cerr << "clearway audit: error writing the SRDF to stdout\n";
+        return kExitUsage;
+      }
+    } else {
+      std::ofstream out(srdf_out);
+      out << written;
+      out.close();
+      if (!out) {
+        std::cerr << "clearway audit: cannot write " << srdf_out << "\n";
+        return kExitUsage;
+      }
     }
   }
   if (!report.empty()) {
@@ -298,6 +353,10 @@ int auditCommand(const std::vector<std::string>& args) {
       std::cerr << "clearway audit: cannot write " << report << "\n";
       return kExitUsage;
     }
+  }
+  if (check && disagrees) {
+    std::cerr << "clearway audit: --check: " << srdf << " disagrees with the audit\n";
+    return kExitDisagrees;
   }
   return kExitOk;
 }

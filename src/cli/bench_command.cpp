@@ -6,11 +6,10 @@
 // `clearway bench merge` checks that shards 0 … N−1 of one configuration are all there, each once, and
 // writes the same files an unsharded run writes. Rows are copied verbatim and ordered by case, so a
 // merged results.csv equals an unsharded one except for the measured times.
+#include "data_paths.h"
 #include "scene_commands.h"
 
-#ifdef CLEARWAY_HAVE_BENCH_SUITES
 #include "suites.h"  // (the clearway_bench_suites library)
-#endif
 
 #include <algorithm>
 #include <cerrno>
@@ -45,7 +44,9 @@ const char* const kBenchUsage =
     "DIR/plots.gp and its PNG plots (when gnuplot is installed). --count: pairs per shape family, states\n"
     "or motions per problem (default 200); --problems: problems per scene family (default 1);\n"
     "--subjects: only the shape families or problems whose name contains one of the strings.\n"
-    "--shard I/N runs the cases with index I modulo N (0 <= I < N); merge combines shards 0..N-1.\n";
+    "--shard I/N runs the cases with index I modulo N (0 <= I < N); merge combines shards 0..N-1.\n"
+    "--shared DIR: the shared development data, the folder holding scenes/ (states, motions and plan need\n"
+    "it); default $CLEARWAY_SHARED, and for the binary in its build tree ../shared beside the source.\n";
 
 constexpr const char* kColumns =
     "suite,case,subject,engine,mode,tolerance,items,ns_per_item,work_per_item,positives,misses,false_alarms,"
@@ -413,13 +414,8 @@ int benchCommand(const std::vector<std::string>& args) {
     return 0;
   }
   if (!args.empty() && args[0] == "merge") return mergeCommand(std::vector<std::string>(args.begin() + 1, args.end()));
-#ifndef CLEARWAY_HAVE_BENCH_SUITES
-  std::cerr << "clearway bench: this build has no benchmark suites (FCL, libfcl-dev, was not found at build time); "
-               "`clearway bench merge` works\n";
-  return 2;
-#else
   bench::SuiteConfig config;
-  config.shared = CLEARWAY_SOURCE_DIR "/../shared";
+  config.shared = sharedDataDir();
   config.out = "bench-results";
   long shard = -1, shards = 0;
   auto number = [&](std::size_t& i, const char* name, double lo, double& value) {
@@ -458,6 +454,9 @@ int benchCommand(const std::vector<std::string>& args) {
   } catch (const std::exception& e) {
     return usageError(e.what());
   }
+  // Built without FCL: say which comparisons are not made, rather than leave rows silently out.
+  for (const std::string& m : bench::missingComparisons())
+    std::cerr << "clearway bench: built without FCL (libfcl-dev), not measured: " << m << "\n";
   Results res;
   std::string suites;
   for (const std::string& s : bench::suiteNames())
@@ -476,7 +475,8 @@ int benchCommand(const std::vector<std::string>& args) {
   for (std::size_t k = 0; k < cases.size(); ++k) {
     if (shard >= 0 && static_cast<long>(k) % shards != shard) continue;
     const bench::SuiteCase& c = cases[k];
-    std::cerr << "[" << ++done << "/" << mine << "] " << c.suite << " " << c.subject << "\n";
+    ++done;
+    if (!quiet()) std::cerr << "[" << done << "/" << mine << "] " << c.suite << " " << c.subject << "\n";
     std::vector<bench::SuiteRow> rows;
     try {
       bench::runCase(c, config, rows);
@@ -501,7 +501,6 @@ int benchCommand(const std::vector<std::string>& args) {
     return 2;
   }
   return 0;
-#endif
 }
 
 }  // namespace clearway::cli

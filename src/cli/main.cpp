@@ -1,5 +1,5 @@
 // The `clearway` tool: one binary, one subcommand per task (DESIGN.md "The `clearway` tool").
-// Results go to stdout, reasons and progress to stderr. Exit status: 0 success, 1 when some input
+// Results go to stdout, reasons, warnings and progress to stderr (--quiet: no warnings or progress). Exit status: 0 success, 1 when some input
 // line was bad (the others still ran), 2 on a usage error or an unreadable input.
 // A subcommand is a function of its own arguments; adding one is adding a row to kCommands.
 #include "query_file.h"
@@ -86,24 +86,37 @@ const Command kCommands[] = {
 
 void printUsage(std::ostream& os) {
   os << "usage: clearway COMMAND [ARGS...]\n"
-        "       clearway COMMAND --help\n\ncommands:\n";
+        "       clearway COMMAND --help\n"
+        "       clearway --version\n\ncommands:\n";
   for (const Command& c : kCommands) os << "  " << c.name << std::string(10 - std::strlen(c.name), ' ') << c.summary << "\n";
+  os << "\n--quiet (anywhere, any command): no warnings or progress lines on stderr; results and errors stay.\n"
+        "Warnings are printed once each.\n";
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2) {
+  // --quiet is the one option of every command: taken out here, wherever it stands.
+  Args all;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--quiet") == 0) clearway::cli::setQuiet(true);
+    else all.emplace_back(argv[i]);
+  }
+  if (all.empty()) {
     printUsage(std::cerr);
     return kExitUsage;
   }
-  const std::string name = argv[1];
+  const std::string name = all[0];
   if (isHelp(name) || name == "help") {
     printUsage(std::cout);
     return kExitOk;
   }
+  if (name == "--version") {
+    std::cout << "clearway " CLEARWAY_VERSION "\n";
+    return finishOutput(kExitOk);
+  }
   for (const Command& c : kCommands)
-    if (name == c.name) return c.run(Args(argv + 2, argv + argc));
+    if (name == c.name) return c.run(Args(all.begin() + 1, all.end()));
   std::cerr << "clearway: unknown command '" << name << "'\n";
   printUsage(std::cerr);
   return kExitUsage;

@@ -1,6 +1,7 @@
 // `clearway plan [SCENE] [--planner NAME] [--time S] [--seed N] [--no-simplify]`: plans start → goal
 // with OMPL on a scene, simplifies, re-validates the final path with the certified motion check, and
 // prints the path (one state per line) and the checker's statistics.
+#include "data_paths.h"
 #include "scene_commands.h"
 
 #include <clearway/ompl/collision_checking.h>
@@ -29,14 +30,12 @@
 
 #include <chrono>
 #include <cstdio>
-#include <filesystem>
 #include <functional>
 #include <iostream>
 #include <map>
 
-#ifndef CLEARWAY_DEFAULT_SCENE
+// The bundled scene, relative to the tool's data folder (data_paths.h).
 #define CLEARWAY_DEFAULT_SCENE "robots/scenes/arm6_wall.yaml"
-#endif
 
 namespace clearway::cli {
 
@@ -55,7 +54,7 @@ const char* const kPlanUsage =
     "using Clearway's validity checker and certified motion validator; simplifies the path and checks\n"
     "it again, segment by segment, with the certified check. Prints the path, one state per line, on\n"
     "stdout ('path N' then N lines) and the statistics on stderr. Without SCENE it plans on the bundled\n"
-    "scene " CLEARWAY_DEFAULT_SCENE ".\n"
+    "scene " CLEARWAY_DEFAULT_SCENE " of the tool's prefix (BIN/../share/clearway/).\n"
     "Planners: RRTConnect RRT RRTstar LazyRRT BiTRRT pRRT PRM PRMstar LazyPRM KPIECE1 BKPIECE1 LBKPIECE1\n"
     "EST BiEST SBL pSBL.\n"
     "Exit status: 0 with a valid path, 1 when no valid path was found in time, 2 on bad input.\n";
@@ -84,14 +83,10 @@ const std::map<std::string, PlannerMaker>& planners() {
   return m;
 }
 
-// The bundled scene, found from the working directory or from the binary's source tree.
+// The bundled scene beside the tool (data_paths.h), or "" when this tool has no bundled data.
 std::string defaultScene() {
-  if (std::filesystem::exists(CLEARWAY_DEFAULT_SCENE)) return CLEARWAY_DEFAULT_SCENE;
-#ifdef CLEARWAY_SOURCE_DIR
-  const std::string p = std::string(CLEARWAY_SOURCE_DIR) + "/" + CLEARWAY_DEFAULT_SCENE;
-  if (std::filesystem::exists(p)) return p;
-#endif
-  return CLEARWAY_DEFAULT_SCENE;
+  const std::string dir = bundledDataDir();
+  return dir.empty() ? "" : dir + "/" CLEARWAY_DEFAULT_SCENE;
 }
 
 bool parseDouble(const std::string& s, double& out) {
@@ -155,6 +150,12 @@ int planCommand(const std::vector<std::string>& args) {
     return kExitUsage;
   }
   if (scene_path.empty()) scene_path = defaultScene();
+  if (scene_path.empty()) {
+    std::cerr << "clearway plan: no SCENE given, and the bundled scene is not installed: "
+              << installedDataDir() << "/" CLEARWAY_DEFAULT_SCENE " does not exist (install with cmake --install, "
+                 "or give a SCENE)\n";
+    return kExitUsage;
+  }
 
   std::shared_ptr<const Scene> scene;
   try {

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <set>
 
 namespace clearway::cli {
 
@@ -63,10 +64,22 @@ bool parseLoadOption(const std::vector<std::string>& args, std::size_t& i, LoadO
   return true;
 }
 
+namespace {
+bool quiet_mode = false;
+}  // namespace
+
+bool quiet() { return quiet_mode; }
+void setQuiet(bool on) { quiet_mode = on; }
+
+void printWarning(const std::string& text) {
+  static std::set<std::string> printed;  // the tool is one thread while it loads
+  if (!quiet_mode && printed.insert(text).second) std::cerr << "warning: " << text << "\n";
+}
+
 std::shared_ptr<const Scene> loadScene(const char* command, const std::string& path, const SceneOptions& options) {
   try {
     auto scene = Scene::load(path, options);
-    for (const std::string& w : scene->robot().loadWarnings()) std::cerr << "warning: " << w << "\n";
+    for (const std::string& w : scene->robot().loadWarnings()) printWarning(w);
     return scene;
   } catch (const std::exception& e) {
     std::cerr << "clearway " << command << ": " << e.what() << "\n";

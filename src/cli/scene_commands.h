@@ -39,6 +39,15 @@ extern const char* const kLoadOptionsUsage;
 /// (i is then at its last word), with `error` set when it is malformed; false for any other argument.
 bool parseLoadOption(const std::vector<std::string>& args, std::size_t& i, LoadOptions& options, std::string& error);
 
+/// True after `--quiet` (main.cpp takes it from any command's arguments): warnings and progress lines
+/// are not printed; results and errors still are.
+bool quiet();
+void setQuiet(bool on);
+
+/// Prints "warning: TEXT" on stderr, once per distinct text in a run (a robot loaded twice warns once);
+/// nothing when quiet().
+void printWarning(const std::string& text);
+
 /// Scene::load, printing the robot's load warnings; on failure prints "clearway COMMAND: reason" and
 /// returns null.
 std::shared_ptr<const Scene> loadScene(const char* command, const std::string& path, const SceneOptions& options);

@@ -26,22 +26,12 @@
 namespace clearway {
 namespace {
 
-// The world box of a shape placed by `pose`: 6 support queries plus the sweep radius, widened by a
-// few roundings of its coordinates.
+// The world box of a shape placed by `pose`, widened by a few roundings of its coordinates: the trees
+// must never drop what the box only just reaches.
 Aabb shapeWorldBox(const Shape& shape, const Pose& pose) noexcept {
-  return std::visit(
-      [&](const auto& s) {
-        Aabb box;
-        const double r = s.radius();
-        for (int i = 0; i < 3; ++i) {
-          const Vec3 d = pose.R.row(i).transpose();  // world axis i in the shape's frame
-          box.max[i] = (pose * s.support(d))[i] + r;
-          box.min[i] = (pose * s.support(-d))[i] - r;
-        }
-        const double scale = box.min.cwiseAbs().cwiseMax(box.max.cwiseAbs()).maxCoeff();
-        return box.inflated(16.0 * std::numeric_limits<double>::epsilon() * scale);
-      },
-      shape);
+  const Aabb box = placedBox(shape, pose);
+  const double scale = box.min.cwiseAbs().cwiseMax(box.max.cwiseAbs()).maxCoeff();
+  return box.inflated(16.0 * std::numeric_limits<double>::epsilon() * scale);
 }
 
 Aabb obstacleBox(const Obstacle& o, const Pose& pose) noexcept {
@@ -64,9 +54,8 @@ double maxAbs(const Aabb& b) noexcept {
   return b.isEmpty() ? 0.0 : b.min.cwiseAbs().cwiseMax(b.max.cwiseAbs()).maxCoeff();
 }
 
-double bandOf(double scale, const Tolerances& tol) noexcept {
-  return 4.0 * std::max(tol.gjk_absolute, 64.0 * std::numeric_limits<double>::epsilon()) * scale;
-}
+// The culls' band: four times the narrow phase's, for the roundings of placing boxes in the world.
+double bandOf(double scale, const Tolerances& tol) noexcept { return 4.0 * narrowBand(scale, tol); }
 
 bool obstacleIntersects(const Obstacle& o, const Pose& pose_o, const LinkGeometry& link, const Pose& pose,
                         const Tolerances& tol, GeometryMode mode, double padding) noexcept {
@@ -345,8 +334,10 @@ DistanceResult Environment::linkDistance(const LinkGeometry& link, const Pose& p
     if (counters) ++counters->distance_tests;
     if (item.obstacle && item.obstacle->mesh)
       return search.add(meshDistance(link, pose, *item.obstacle->mesh, item.pose, tol, relative_error));
-    const Shape shape = item.obstacle ? item.obstacle->shape : Shape(Box(item.voxel->halfExtents()));
-    return search.add(swapped(shapeLinkDistance(shape, item.pose, link, pose, tol, relative_error)));
+    // (The obstacle's own shape by reference: a copy of a hull would allocate per item.)
+    if (item.obstacle)
+      return search.add(swapped(shapeLinkDistance(item.obstacle->shape, item.pose, link, pose, tol, relative_error)));
+    return search.add(swapped(shapeLinkDistance(Box(item.voxel->halfExtents()), item.pose, link, pose, tol, relative_error)));
   });
   if (walk == Walk::Invalid) search.failed = true;
 
@@ -476,9 +467,12 @@ double Environment::linkPenetration(const LinkGeometry& link, const Pose& pose, 
       if (meshesIntersect(link, pose, *o->mesh, item.pose, tol, GeometryMode::Mesh, padding)) depth(o->mesh->hull(), item.pose);
       return false;
     }
-    const Shape shape = o ? o->shape : Shape(Box(item.voxel->halfExtents()));
-    if (shapeIntersectsLink(shape, item.pose, link, pose, tol, GeometryMode::Mesh, padding))
-      std::visit([&](const auto& s) { depth(s, item.pose); }, shape);
+    const auto visit = [&](const Shape& shape) {  // (by reference: a copied hull would allocate)
+      if (shapeIntersectsLink(shape, item.pose, link, pose, tol, GeometryMode::Mesh, padding))
+        std::visit([&](const auto& s) { depth(s, item.pose); }, shape);
+    };
+    if (o) visit(o->shape);
+    else visit(Box(item.voxel->halfExtents()));
     return false;
   });
   if (walk == Walk::Invalid) return nan;

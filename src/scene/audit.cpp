@@ -2,15 +2,18 @@
 
 #include <clearway/kinematics/forward_kinematics.h>
 
+#include <tinyxml2.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <random>
-#include <sstream>
+#include <set>
 #include <stdexcept>
 #include <thread>
+#include <tuple>
 
 namespace clearway {
 
@@ -246,15 +249,79 @@ std::vector<PairAudit> auditSelfCollision(std::shared_ptr<const RobotGeometry> g
   return result;
 }
 
-std::string auditSrdf(const RobotModel& model, const std::vector<PairAudit>& audit) {
-  std::ostringstream out;
-  out << "<?xml version=\"1.0\"?>\n<!-- Written by clearway audit -->\n<robot name=\"" << model.name() << "\">\n";
-  for (const PairAudit& p : audit)
-    if (!p.reason.empty())
-      out << "  <disable_collisions link1=\"" << model.link(p.a).name << "\" link2=\"" << model.link(p.b).name
-          << "\" reason=\"" << p.reason << "\"/>\n";
-  out << "</robot>\n";
-  return out.str();
+namespace {
+
+// tinyxml2's printer with two spaces per level (it has four), as MoveIt's SRDFs are indented, so that an
+// SRDF written over its input changes only where the audit changed it.
+class SrdfPrinter : public tinyxml2::XMLPrinter {
+ protected:
+  void PrintSpace(int depth) override {
+    for (int i = 0; i < depth; ++i) Write("  ");
+  }
+};
+
+}  // namespace
+
+std::string auditSrdf(const RobotModel& model, const std::vector<PairAudit>& audit, const std::string& input_srdf) {
+  using tinyxml2::XMLElement;
+  using tinyxml2::XMLNode;
+  // The pairs the audit decides, by name, link1 < link2; those with a reason are written, sorted.
+  std::set<std::pair<std::string, std::string>> decided;
+  std::vector<std::tuple<std::string, std::string, std::string>> written;
+  for (const PairAudit& p : audit) {
+    const auto names = std::minmax(model.link(p.a).name, model.link(p.b).name);  // references into the model
+    decided.emplace(names.first, names.second);
+    if (!p.reason.empty()) written.emplace_back(names.first, names.second, p.reason);
+  }
+  std::sort(written.begin(), written.end());
+
+  tinyxml2::XMLDocument doc;
+  XMLElement* robot = nullptr;
+  if (input_srdf.empty()) {
+    doc.InsertEndChild(doc.NewDeclaration());
+    doc.InsertEndChild(doc.NewComment(" Written by clearway audit "));
+    robot = doc.NewElement("robot");
+    robot->SetAttribute("name", model.name().c_str());
+    doc.InsertEndChild(robot);
+  } else {
+    if (doc.Parse(input_srdf.data(), input_srdf.size()) != tinyxml2::XML_SUCCESS)
+      throw std::invalid_argument(std::string("auditSrdf: the input SRDF is not well-formed XML: ") + doc.ErrorStr());
+    robot = doc.RootElement();
+    if (robot == nullptr || std::string(robot->Name()) != "robot")
+      throw std::invalid_argument("auditSrdf: the input SRDF's root element is not <robot>");
+  }
+
+  // Remove the decided pairs' disable_collisions, remembering what stood before the first of them: the
+  // new ones go there (after the comment that introduces them in MoveIt's files), else at the end.
+  bool replaced = false;
+  XMLNode* before = nullptr;  // null with replaced: at the start
+  for (XMLElement* e = robot->FirstChildElement("disable_collisions"); e != nullptr;) {
+    XMLElement* next = e->NextSiblingElement("disable_collisions");
+    const char* link1 = e->Attribute("link1");
+    const char* link2 = e->Attribute("link2");
+    if (link1 != nullptr && link2 != nullptr &&
+        decided.count(std::string(link1) < link2 ? std::make_pair<std::string, std::string>(link1, link2)
+                                                 : std::make_pair<std::string, std::string>(link2, link1))) {
+      if (!replaced) before = e->PreviousSibling();
+      replaced = true;
+      robot->DeleteChild(e);
+    }
+    e = next;
+  }
+  for (const auto& [link1, link2, reason] : written) {
+    XMLElement* e = doc.NewElement("disable_collisions");
+    e->SetAttribute("link1", link1.c_str());
+    e->SetAttribute("link2", link2.c_str());
+    e->SetAttribute("reason", reason.c_str());
+    if (!replaced) robot->InsertEndChild(e);
+    else if (before == nullptr) robot->InsertFirstChild(e);
+    else robot->InsertAfterChild(before, e);
+    before = e;
+    replaced = true;
+  }
+  SrdfPrinter printer;
+  doc.Print(&printer);
+  return printer.CStr();
 }
 
 }  // namespace clearway

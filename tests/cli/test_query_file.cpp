@@ -528,7 +528,7 @@ TEST(QueryTool, ExitCodes) {
 std::string bundledScene() { return std::string("'") + CLEARWAY_SOURCE_DIR + "/robots/scenes/arm6_wall.yaml'"; }
 
 TEST(PlanTool, PlansTheBundledSceneWithoutArguments) {
-  // From any working directory: the default scene is found through the source tree.
+  // From any working directory: the build-tree binary finds the default scene in the source tree.
   const ToolRun r = runTool("plan --seed 3 --time 30");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::istringstream out(r.out);

@@ -5,10 +5,13 @@
 #include <clearway/scene/audit.h>
 
 #include "load/robot_files.h"
+#include "srdf_reader.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <tuple>
 
 namespace clearway {
 namespace {
@@ -163,6 +166,63 @@ TEST(Audit, KnownFractionAndAlwaysThreshold) {
   int classified = 0;
   for (const PairAudit& q : one) classified += !q.reason.empty();
   EXPECT_EQ(static_cast<int>(again.disabledCollisions().size()), classified);
+}
+
+TEST(Audit, SrdfKeepsTheInputAndReplacesTheDecidedPairs) {
+  TempDir dir;
+  auto model = std::make_shared<const RobotModel>(loadRobot(dir.write("a.urdf", kAuditUrdf)));
+  AuditOptions options;
+  options.samples = 2000;
+  const auto audit = auditSelfCollision(std::make_shared<const RobotGeometry>(model), options);
+  // A pair the audit decides (link1/base, written link2 > link1 and with the wrong reason), one it does
+  // not (a link the URDF lacks), and around them every other kind of element srdfdom reads.
+  const std::string input = R"(<?xml version="1.0"?>
+<!-- the robot's SRDF -->
+<robot name="audited">
+  <virtual_joint name="world_joint" type="fixed" parent_frame="world" child_link="base"/>
+  <group name="arm"><joint name="shoulder"/><joint name="elbow"/></group>
+  <group name="tip"><link name="cap"/></group>
+  <group_state name="home" group="arm"><joint name="shoulder" value="0"/><joint name="elbow" value="0"/></group_state>
+  <!-- disabled pairs -->
+  <disable_collisions link1="link1" link2="base" reason="Never"/>
+  <disable_collisions link1="ghost" link2="base" reason="User"/>
+  <passive_joint name="cap_joint"/>
+  <disable_collisions link1="link2" link2="base" reason="Default"/>
+  <end_effector name="tip" group="tip" parent_link="link2" parent_group="arm"/>
+  <link_sphere_approximation link="cap"><sphere center="0 0 0" radius="0.12"/></link_sphere_approximation>
+  <joint_property joint_name="shoulder" property_name="speed" value="1"/>
+</robot>
+)";
+  const std::string written = auditSrdf(*model, audit, input);
+  const test::SrdfContent in = test::readSrdfText(input), out = test::readSrdfText(written);
+  ASSERT_TRUE(in.errors.empty()) << in.errors.front();
+  for (const std::string& e : out.errors) ADD_FAILURE() << e << "\n" << written;
+  EXPECT_EQ(out.semantic, in.semantic) << written;
+  EXPECT_EQ(out.semantic.size(), 8u);
+  EXPECT_EQ(out.comments, 2);
+  // The audited pairs with a reason, by name, link1 < link2, sorted; then the pair naming "ghost", kept.
+  std::vector<std::tuple<std::string, std::string, std::string>> expected;
+  for (const PairAudit& p : audit)
+    if (!p.reason.empty()) {
+      const auto names = std::minmax(model->link(p.a).name, model->link(p.b).name);
+      expected.emplace_back(names.first, names.second, p.reason);
+    }
+  std::sort(expected.begin(), expected.end());
+  expected.emplace_back("ghost", "base", "User");
+  std::vector<std::tuple<std::string, std::string, std::string>> got;
+  for (const auto& d : out.disabled) got.emplace_back(d.link1, d.link2, d.reason);
+  EXPECT_EQ(got, expected) << written;
+  EXPECT_NE(std::find(got.begin(), got.end(), std::make_tuple("base", "link1", "Adjacent")), got.end());
+  // Where the first replaced pair stood: after the comment that introduced it.
+  EXPECT_NE(written.find("<!-- disabled pairs -->\n  <disable_collisions link1=\"" + std::get<0>(expected[0])), std::string::npos)
+      << written;
+  // Without an input, a new document naming the robot, with the same pairs.
+  const test::SrdfContent fresh = test::readSrdfText(auditSrdf(*model, audit));
+  EXPECT_EQ(fresh.robot_name, "audited");
+  EXPECT_TRUE(fresh.semantic.empty());
+  EXPECT_EQ(fresh.disabled.size(), expected.size() - 1);
+  EXPECT_THROW(auditSrdf(*model, audit, "<robot name=\"audited\">"), std::invalid_argument);
+  EXPECT_THROW(auditSrdf(*model, audit, "<urdf/>"), std::invalid_argument);
 }
 
 TEST(Audit, RobotsWithoutJoints) {

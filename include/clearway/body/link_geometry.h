@@ -113,6 +113,26 @@ class LinkGeometry {
   std::vector<Vec3> probes_;
 };
 
+/// The box, in the frame `pose` is given in, of a convex shape placed by it: 6 support queries plus its
+/// sweep radius. Tight: callers add the rounding and padding their culls must keep.
+template <class S>
+Aabb placedBox(const S& s, const Pose& pose) noexcept {
+  Aabb box;
+  const double r = s.radius();
+  for (int i = 0; i < 3; ++i) {
+    const Vec3 d = pose.R.row(i).transpose();  // the parent's axis i in the shape's frame
+    box.max[i] = (pose * s.support(d))[i] + r;
+    box.min[i] = (pose * s.support(-d))[i] - r;
+  }
+  return box;
+}
+Aabb placedBox(const Shape& shape, const Pose& pose) noexcept;
+
+/// The narrow phase's band for a query whose coordinates and sizes are at most `scale` metres: GJK calls
+/// bodies this near touching (tol.gjk_absolute of their size, never below 64 ulps), so a cull by boxes or
+/// axes must keep at least this much.
+double narrowBand(double scale, const Tolerances& tol) noexcept;
+
 /// True when a piece of one link lies inside a closed mesh of the other (b placed in a's frame by b_in_a).
 /// Meaningful once their surfaces are known not to meet: then it decides whether the solids overlap.
 bool linkContained(const LinkGeometry& a, const LinkGeometry& b, const Pose& b_in_a) noexcept;

@@ -57,7 +57,11 @@ double clopperPearsonUpper(int k, int n);
 /// warn_fraction or most_fraction is not in [0, 1].
 std::vector<PairAudit> auditSelfCollision(std::shared_ptr<const RobotGeometry> geometry, const AuditOptions& options = {});
 
-/// SRDF text with one disable_collisions element per pair that has a reason, for robot `name`.
-std::string auditSrdf(const RobotModel& model, const std::vector<PairAudit>& audit);
+/// The SRDF of an audit: input_srdf (SRDF text; "" for a new document naming the model) with the
+/// disable_collisions of every audited pair replaced by one per pair that has a reason (link1 < link2,
+/// sorted by name), where the first replaced one stood or else at the end; every other element and
+/// comment is kept. Written through an XML printer, so any link name is well-formed. Throws
+/// std::invalid_argument when input_srdf is not XML with a <robot> root.
+std::string auditSrdf(const RobotModel& model, const std::vector<PairAudit>& audit, const std::string& input_srdf = "");
 
 }  // namespace clearway

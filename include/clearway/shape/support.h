@@ -11,26 +11,6 @@
 
 namespace clearway {
 
-/// A shape seen through a pose: support and center in the pose's parent frame.
-template <class S>
-struct Posed {
-  const S& shape;
-  Pose pose;
-  Vec3 support(const Vec3& d) const noexcept { return pose * shape.support(pose.R.transpose() * d); }
-  double radius() const noexcept { return shape.radius(); }
-  Vec3 center() const noexcept { return pose * shape.center(); }
-};
-
-/// A shape with a sphere-swept skin of `margin` metres added (padding): same core, larger radius.
-template <class S>
-struct Margin {
-  const S& shape;
-  double margin;
-  Vec3 support(const Vec3& d) const noexcept { return shape.support(d); }
-  double radius() const noexcept { return shape.radius() + margin; }
-  Vec3 center() const noexcept { return shape.center(); }
-};
-
 namespace detail {
 // Shapes that can resume a support search from a previous answer (ConvexHull) expose
 // support(d, hint); for the others the hint is ignored.
@@ -46,6 +26,29 @@ Vec3 supportWithHint(const S& s, const Vec3& d, std::int32_t& hint) noexcept {
   else return s.support(d);
 }
 }  // namespace detail
+
+/// A shape seen through a pose: support and center in the pose's parent frame.
+template <class S>
+struct Posed {
+  const S& shape;
+  Pose pose;
+  Vec3 support(const Vec3& d) const noexcept { return pose * shape.support(pose.R.transpose() * d); }
+  double radius() const noexcept { return shape.radius(); }
+  Vec3 center() const noexcept { return pose * shape.center(); }
+};
+
+/// A shape with a sphere-swept skin of `margin` metres added (padding): same core, larger radius. A hull
+/// keeps its warm-started support search.
+template <class S>
+struct Margin {
+  const S& shape;
+  double margin;
+  Vec3 support(const Vec3& d) const noexcept { return shape.support(d); }
+  Vec3 support(const Vec3& d, std::int32_t& hint) const noexcept { return detail::supportWithHint(shape, d, hint); }
+  double radius() const noexcept { return shape.radius() + margin; }
+  Vec3 center() const noexcept { return shape.center(); }
+};
+
 
 /// A support point of A − B with its witnesses on A's and B's cores (all in A's frame).
 struct SupportPoint {
