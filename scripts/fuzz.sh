@@ -3,6 +3,7 @@
 # SECONDS (default 20) on a copy of its seeds: fuzz/corpus/<target>/, our own robots, meshes and scenes
 # of that kind, and ../shared/bad-inputs/ ($CLEARWAY_SHARED/bad-inputs) when it is there.
 #   bash scripts/fuzz.sh [SECONDS] [TARGET...]      e.g.  bash scripts/fuzz.sh 3600 mesh_dae
+# FUZZ_SEED=N fixes libFuzzer's random seed (CI does, so that a run can be replayed; 0: a new one).
 # A crash, sanitizer report, undocumented exception, timeout (10 s) or memory blow-up (2 GB) is a
 # finding: the input is kept as build-fuzz/crashes/<target>-crash-* (or -timeout-, -oom-, -leak-),
 # the log as build-fuzz/logs/<target>.log, and the script exits 1 after running the other targets.
@@ -61,7 +62,7 @@ for target in "${targets[@]}"; do
   cp fuzz/corpus/"$target"/* "$corpus/" 2>/dev/null || true
   seed "$target" "$corpus"
   log=$BUILD/logs/$target.log
-  if "$exe" "$corpus" -max_total_time="$SECONDS_PER_TARGET" -timeout=10 -rss_limit_mb=2048 \
+  if "$exe" "$corpus" -seed="${FUZZ_SEED:-0}" -max_total_time="$SECONDS_PER_TARGET" -timeout=10 -rss_limit_mb=2048 \
        -artifact_prefix="$BUILD/crashes/$target-" -print_final_stats=1 >"$log" 2>&1; then
     echo "fuzz $target: $(grep -oE 'Done [0-9]+ runs in [0-9]+ second' "$log" | tail -n 1 | sed 's/ second/ s/'), no finding"
   else

@@ -45,6 +45,7 @@ class Checker {
     }
     if (name == "accessor") accessors_.push_back(e);
     if (name == "polylist") polylist(e);
+    if (name == "triangles" || name == "polylist" || name == "polygons") primitiveCount(e);
     for (const XMLElement* c = e->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) visit(c);
   }
 
@@ -79,6 +80,20 @@ class Checker {
     if (given < count)
       fail(e, "count=\"" + std::to_string(count) + "\" polygons, but <vcount> gives " + std::to_string(given) +
                   " corner counts");
+  }
+
+  // Assimp asserts (aborts) unless it reads exactly count="N" primitives: for <triangles> and <polylist>
+  // all of them from one <p>, for <polygons> one per <p>.
+  void primitiveCount(const XMLElement* e) const {
+    const std::uint64_t count = wholeNumber(e, "count");
+    std::uint64_t ps = 0;
+    for (const XMLElement* p = e->FirstChildElement("p"); p != nullptr; p = p->NextSiblingElement("p")) ++ps;
+    const bool polygons = std::strcmp(e->Name(), "polygons") == 0;
+    const std::uint64_t read = polygons ? ps : ps * count;
+    if (read != count)
+      fail(e, "count=\"" + std::to_string(count) + "\" primitives, but " +
+                  (polygons ? "it has " + std::to_string(ps) + " <p> elements (one per polygon)"
+                            : "it has " + std::to_string(ps) + " <p> elements (one holds them all)"));
   }
 
   // No cycle through <instance_node>, and a bounded hierarchy once instances are expanded.

@@ -214,17 +214,21 @@ void checkPlyHeader(const std::string& path) {
   throw LoadError(path, "", "the PLY header has no 'end_header' line");
 }
 
-// Assimp's PLY reader passes face indices on unchecked, and its post-processing (triangulation) reads
-// through them: check them in the scene as read, before any step runs.
+// Assimp's PLY reader passes faces on unchecked, and its post-processing (triangulation) reads through
+// their indices and aborts on an empty one: check them in the scene as read, before any step runs.
 void checkFaceIndices(const aiScene& scene, const std::string& path) {
   for (unsigned i = 0; i < scene.mNumMeshes; ++i) {
     const aiMesh& m = *scene.mMeshes[i];
-    for (unsigned f = 0; f < m.mNumFaces; ++f)
+    for (unsigned f = 0; f < m.mNumFaces; ++f) {
+      // A face without vertices (a PLY list of length 0) aborts assimp's triangulation.
+      if (m.mFaces[f].mNumIndices == 0)
+        throw LoadError(path, "", "face " + std::to_string(f) + " of mesh '" + m.mName.C_Str() + "' has no vertices");
       for (unsigned k = 0; k < m.mFaces[f].mNumIndices; ++k)
         if (m.mFaces[f].mIndices[k] >= m.mNumVertices)
           throw LoadError(path, "", "face " + std::to_string(f) + " of mesh '" + m.mName.C_Str() + "' uses vertex " +
                                         std::to_string(m.mFaces[f].mIndices[k]) + ", but the mesh has " +
                                         std::to_string(m.mNumVertices) + " vertices");
+    }
   }
 }
 

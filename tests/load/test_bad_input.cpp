@@ -302,10 +302,14 @@ TEST_F(BadInput, MeshFormatsAndPlyIndices) {
   EXPECT_LOAD_ERROR(loadMesh(bad, Vec3::Ones()), bad, "", "uses vertex 1000000000, but the mesh has 4 vertices");
   // Found by fuzz_mesh_ply: one vertex fewer than the faces use aborted inside assimp's post-processing,
   // before the check above ran.
-  std::string short_header = header;
-  short_header.replace(short_header.find("element vertex 4"), 16, "element vertex 3");
-  const std::string short_list = dir.write("short.ply", short_header + "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
+  std::string three = header;
+  three.replace(three.find("element vertex 4"), 16, "element vertex 3");
+  three.replace(three.find("0 0 1\n"), 6, "");
+  const std::string short_list = dir.write("short.ply", three + "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
   EXPECT_LOAD_ERROR(loadMesh(short_list, Vec3::Ones()), short_list, "", "uses vertex 3, but the mesh has 3 vertices");
+  // Found by fuzz_mesh_ply: a face of length 0 aborted assimp's triangulation.
+  const std::string empty_face = dir.write("empty_face.ply", header + "0\n3 0 2 1\n3 0 1 3\n3 0 3 2\n");
+  EXPECT_LOAD_ERROR(loadMesh(empty_face, Vec3::Ones()), empty_face, "", "face 0 of mesh '' has no vertices");
   // Formats other than these four are refused, by the name the error gives them.
   for (const std::string name : {"garbage.x", "model.3ds", "archive.zae", "scene.fbx"}) {
     const std::string path = dir.write(name, "xof 0302txt 0064\ngarbage");
@@ -428,4 +432,23 @@ TEST_F(BadInput, ColladaThatAssimpCannotSurvive) {
     const std::string path = dir.write(c.name, c.text);
     EXPECT_LOAD_ERROR(loadMesh(path, Vec3::Ones()), path, c.element, c.reason);
   }
+  // Found by fuzz_mesh_dae: primitives whose count="N" their <p> elements do not hold; assimp asserted
+  // (abort) after reading them.
+  const auto without_p = [](std::string text) {
+    const std::size_t a = text.find("<p>"), b = text.find("</p>");
+    return text.erase(a, b + 4 - a);
+  };
+  const auto twice_p = [](std::string text) {
+    const std::size_t a = text.find("<p>"), b = text.find("</p>");
+    return text.insert(b + 4, text.substr(a, b + 4 - a));
+  };
+  const std::string no_p = dir.write("no_p.dae", without_p(polylist("<vcount>3 3 3 3</vcount>")));
+  EXPECT_LOAD_ERROR(loadMesh(no_p, Vec3::Ones()), no_p, "<polylist>", "count=\"4\" primitives, but it has 0 <p> elements");
+  const std::string two_p = dir.write("two_p.dae", twice_p(collada(kTetP, kTetNode, "<node id=\"n\"/>")));
+  EXPECT_LOAD_ERROR(loadMesh(two_p, Vec3::Ones()), two_p, "<triangles>", "count=\"4\" primitives, but it has 2 <p> elements");
+  std::string polygons = collada(kTetP, kTetNode, "<node id=\"n\"/>");
+  polygons.replace(polygons.find("<triangles count=\"4\">"), 21, "<polygons count=\"2\">");
+  polygons.replace(polygons.find("</triangles>"), 12, "</polygons>");
+  const std::string one_polygon = dir.write("polygons.dae", polygons);
+  EXPECT_LOAD_ERROR(loadMesh(one_polygon, Vec3::Ones()), one_polygon, "<polygons>", "count=\"2\" primitives, but it has 1 <p> elements (one per polygon)");
 }
