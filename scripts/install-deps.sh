@@ -15,6 +15,7 @@ packages=(
   python3-dev pybind11-dev python3-numpy python3-pytest  # the Python module and its tests
   libfcl-dev                         # benchmarks only: FCL side by side
   gnuplot-nox                        # benchmark plots (PNG)
+  clang libfuzzer-14-dev             # scripts/fuzz.sh: the libFuzzer targets in fuzz/
   slurmd slurmctld slurm-client munge parallel  # clearway bench shards: the one-node Slurm test (GNU parallel without root)
 )
 missing=()

@@ -44,6 +44,8 @@ class Checker {
       if (const char* n = e->Attribute("name")) names_.emplace(n, e);
     }
     if (name == "accessor") accessors_.push_back(e);
+    if (name == "polylist") polylist(e);
+    if (name == "triangles" || name == "polylist" || name == "polygons") primitiveCount(e);
     for (const XMLElement* c = e->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) visit(c);
   }
 
@@ -58,13 +60,40 @@ class Checker {
                           offset = wholeNumber(a, "offset");
       std::uint64_t params = 0;
       for (const XMLElement* p = a->FirstChildElement("param"); p != nullptr; p = p->NextSiblingElement("param")) ++params;
-      const std::uint64_t length = countTokens(it->second);
+      // Assimp reads as many values as the array's count="N" says (none when it is missing), at most
+      // the values written.
+      const std::uint64_t length = std::min(countTokens(it->second), wholeNumber(it->second, "count"));
       // Each of these is at most the file size (wholeNumber), so the sum cannot overflow 64 bits.
       const std::uint64_t needed = offset + (count - 1) * stride + params;
       if (count > 0 && params > 0 && needed > length)
         fail(a, "reaches value " + std::to_string(needed) + " of '" + (source + 1) + "', which holds " +
                     std::to_string(length));
     }
+  }
+
+  // A <polylist> of N polygons: assimp takes each polygon's corner count from <vcount> unchecked (a null
+  // read when <vcount> is missing, past its end when it is short).
+  void polylist(const XMLElement* e) const {
+    const std::uint64_t count = wholeNumber(e, "count");
+    const XMLElement* vcount = e->FirstChildElement("vcount");
+    const std::uint64_t given = vcount != nullptr ? countTokens(vcount) : 0;
+    if (given < count)
+      fail(e, "count=\"" + std::to_string(count) + "\" polygons, but <vcount> gives " + std::to_string(given) +
+                  " corner counts");
+  }
+
+  // Assimp asserts (aborts) unless it reads exactly count="N" primitives: for <triangles> and <polylist>
+  // all of them from one <p>, for <polygons> one per <p>.
+  void primitiveCount(const XMLElement* e) const {
+    const std::uint64_t count = wholeNumber(e, "count");
+    std::uint64_t ps = 0;
+    for (const XMLElement* p = e->FirstChildElement("p"); p != nullptr; p = p->NextSiblingElement("p")) ++ps;
+    const bool polygons = std::strcmp(e->Name(), "polygons") == 0;
+    const std::uint64_t read = polygons ? ps : ps * count;
+    if (read != count)
+      fail(e, "count=\"" + std::to_string(count) + "\" primitives, but " +
+                  (polygons ? "it has " + std::to_string(ps) + " <p> elements (one per polygon)"
+                            : "it has " + std::to_string(ps) + " <p> elements (one holds them all)"));
   }
 
   // No cycle through <instance_node>, and a bounded hierarchy once instances are expanded.

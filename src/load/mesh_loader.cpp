@@ -19,6 +19,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <system_error>
 #include <unordered_map>
@@ -135,14 +136,7 @@ class Merger {
         continue;
       }
       std::array<std::int32_t, 3> t{};
-      for (int k = 0; k < 3; ++k) {
-        // Assimp's PLY reader passes face indices on unchecked.
-        if (face.mIndices[k] >= m.mNumVertices)
-          throw LoadError(path_, "", "face " + std::to_string(f) + " of mesh '" + m.mName.C_Str() + "' uses vertex " +
-                                         std::to_string(face.mIndices[k]) + ", but the mesh has " +
-                                         std::to_string(m.mNumVertices) + " vertices");
-        t[k] = vertex(m, face.mIndices[k], world);
-      }
+      for (int k = 0; k < 3; ++k) t[k] = vertex(m, face.mIndices[k], world);  // in range: checkFaceIndices
       if (mirrored) std::swap(t[1], t[2]);
       if (isDegenerate(t)) {
         ++degenerate;
@@ -207,6 +201,37 @@ void countBadEdges(const TriangleMesh& mesh, std::size_t* open, std::size_t* non
   }
 }
 
+// Assimp's PLY reader reads header lines until `end_header` without looking for the end of the file:
+// a header without that line never ends. The PLY header is text, one keyword per line.
+void checkPlyHeader(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw LoadError(path, "", "cannot open the file");
+  std::string line;
+  while (std::getline(in, line)) {
+    const std::size_t end = line.find_last_not_of(" \t\r");
+    if (end != std::string::npos && line.compare(0, end + 1, "end_header") == 0) return;
+  }
+  throw LoadError(path, "", "the PLY header has no 'end_header' line");
+}
+
+// Assimp's PLY reader passes faces on unchecked, and its post-processing (triangulation) reads through
+// their indices and aborts on an empty one: check them in the scene as read, before any step runs.
+void checkFaceIndices(const aiScene& scene, const std::string& path) {
+  for (unsigned i = 0; i < scene.mNumMeshes; ++i) {
+    const aiMesh& m = *scene.mMeshes[i];
+    for (unsigned f = 0; f < m.mNumFaces; ++f) {
+      // A face without vertices (a PLY list of length 0) aborts assimp's triangulation.
+      if (m.mFaces[f].mNumIndices == 0)
+        throw LoadError(path, "", "face " + std::to_string(f) + " of mesh '" + m.mName.C_Str() + "' has no vertices");
+      for (unsigned k = 0; k < m.mFaces[f].mNumIndices; ++k)
+        if (m.mFaces[f].mIndices[k] >= m.mNumVertices)
+          throw LoadError(path, "", "face " + std::to_string(f) + " of mesh '" + m.mName.C_Str() + "' uses vertex " +
+                                        std::to_string(m.mFaces[f].mIndices[k]) + ", but the mesh has " +
+                                        std::to_string(m.mNumVertices) + " vertices");
+    }
+  }
+}
+
 }  // namespace
 
 bool isClosed(const TriangleMesh& mesh) {
@@ -232,6 +257,7 @@ TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<st
   if (std::none_of(std::begin(kFormats), std::end(kFormats), [&](const char* f) { return ext == f; }))
     throw LoadError(path, "", "unsupported mesh format '" + ext + "' (Clearway reads " + kFormatList + ")");
   if (ext == "dae") detail::checkCollada(path);
+  if (ext == "ply") checkPlyHeader(path);
 
   // Only positions matter. Vertices are joined below by exact position, not by assimp's
   // JoinIdenticalVertices: on every mesh of ../shared/robots both give the same vertices, ours in a
@@ -241,8 +267,11 @@ TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<st
                                   aiComponent_TEXCOORDS | aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS |
                                   aiComponent_TEXTURES | aiComponent_LIGHTS | aiComponent_CAMERAS |
                                   aiComponent_MATERIALS);
-  const aiScene* scene = importer.ReadFile(
-      path, aiProcess_Triangulate | aiProcess_RemoveComponent);
+  const aiScene* scene = importer.ReadFile(path, 0);
+  if (scene == nullptr || scene->mRootNode == nullptr)
+    throw LoadError(path, "", std::string("assimp cannot read it: ") + importer.GetErrorString());
+  checkFaceIndices(*scene, path);
+  scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_RemoveComponent);
   if (scene == nullptr || scene->mRootNode == nullptr)
     throw LoadError(path, "", std::string("assimp cannot read it: ") + importer.GetErrorString());
 

@@ -300,6 +300,16 @@ TEST_F(BadInput, MeshFormatsAndPlyIndices) {
   EXPECT_EQ(loadMesh(ok, Vec3::Ones()).triangles.size(), 4u);
   const std::string bad = dir.write("bad.ply", header + "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 1000000000\n");
   EXPECT_LOAD_ERROR(loadMesh(bad, Vec3::Ones()), bad, "", "uses vertex 1000000000, but the mesh has 4 vertices");
+  // Found by fuzz_mesh_ply: one vertex fewer than the faces use aborted inside assimp's post-processing,
+  // before the check above ran.
+  std::string three = header;
+  three.replace(three.find("element vertex 4"), 16, "element vertex 3");
+  three.replace(three.find("0 0 1\n"), 6, "");
+  const std::string short_list = dir.write("short.ply", three + "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
+  EXPECT_LOAD_ERROR(loadMesh(short_list, Vec3::Ones()), short_list, "", "uses vertex 3, but the mesh has 3 vertices");
+  // Found by fuzz_mesh_ply: a face of length 0 aborted assimp's triangulation.
+  const std::string empty_face = dir.write("empty_face.ply", header + "0\n3 0 2 1\n3 0 1 3\n3 0 3 2\n");
+  EXPECT_LOAD_ERROR(loadMesh(empty_face, Vec3::Ones()), empty_face, "", "face 0 of mesh '' has no vertices");
   // Formats other than these four are refused, by the name the error gives them.
   for (const std::string name : {"garbage.x", "model.3ds", "archive.zae", "scene.fbx"}) {
     const std::string path = dir.write(name, "xof 0302txt 0064\ngarbage");
@@ -309,6 +319,17 @@ TEST_F(BadInput, MeshFormatsAndPlyIndices) {
   const std::string two = dir.write("two_verts.stl", "solid x\n facet normal 0 0 1\n outer loop\n vertex 0 0 0\n vertex 1 0 0\n"
                                                      " endloop\n endfacet\nendsolid x\n");
   EXPECT_LOAD_ERROR(loadMesh(two, Vec3::Ones()), two, "", "assimp cannot read it");
+}
+
+TEST_F(BadInput, PlyHeaderWithoutEndHeader) {
+  // Found by fuzz_mesh_ply: assimp read header lines forever, looking for end_header past the end of file.
+  const std::string header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                             "property float z\nelement face 1\nproperty list uchar int vertex_indices\n";
+  const std::string body = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const std::string none = dir.write("no_end.ply", header + body);
+  EXPECT_LOAD_ERROR(loadMesh(none, Vec3::Ones()), none, "", "the PLY header has no 'end_header' line");
+  // The same header closed loads, also with a CR LF line end.
+  EXPECT_EQ(loadMesh(dir.write("end.ply", header + "end_header\r\n" + body), Vec3::Ones()).triangles.size(), 1u);
 }
 
 namespace {
@@ -332,6 +353,23 @@ std::string collada(const std::string& geometry_p, const std::string& nodes, con
 }
 
 const char* const kTetP = "0 2 1 0 1 3 0 3 2 1 2 3";
+
+// The tetrahedron with a <float_array> that does not say its count.
+std::string uncounted() {
+  std::string text = collada(kTetP, "", "<node id=\"n\"><instance_geometry url=\"#g\"/></node>");
+  const std::string counted = "<float_array id=\"pa\" count=\"12\">";
+  text.replace(text.find(counted), counted.size(), "<float_array id=\"pa\">");
+  return text;
+}
+
+// The tetrahedron as a <polylist> of four triangles, with the given <vcount> element.
+std::string polylist(const std::string& vcount) {
+  std::string text = collada(kTetP, "", "<node id=\"n\"><instance_geometry url=\"#g\"/></node>");
+  const std::string triangles = "<triangles count=\"4\">";
+  text.replace(text.find(triangles), triangles.size(), "<polylist count=\"4\">" + vcount);
+  text.replace(text.find("</triangles>"), std::string("</triangles>").size(), "</polylist>");
+  return text;
+}
 const char* const kTetNode = "<node id=\"tet\"><instance_geometry url=\"#g\"/></node>";
 
 }  // namespace
@@ -340,6 +378,7 @@ TEST_F(BadInput, ColladaThatAssimpCannotSurvive) {
   // The reference: a tetrahedron through a library node loads.
   const std::string good = dir.write("good.dae", collada(kTetP, kTetNode, "<node id=\"n\"><instance_node url=\"#tet\"/></node>"));
   EXPECT_EQ(loadMesh(good, Vec3::Ones()).triangles.size(), 4u);
+  EXPECT_EQ(loadMesh(dir.write("polylist_ok.dae", polylist("<vcount>3 3 3 3</vcount>")), Vec3::Ones()).triangles.size(), 4u);
 
   struct Case {
     std::string name, text, element, reason;
@@ -380,6 +419,11 @@ TEST_F(BadInput, ColladaThatAssimpCannotSurvive) {
        "<accessor> (line 6)", "count=\"99999999999\" exceeds the size of the file"},
       {"accessor.dae", collada(kTetP, kTetNode, "<node id=\"n\"/>", "0 0 0 1 0 0 0 1 0 0 0 1", 4, "count=\"5\" stride=\"3\""),
        "<accessor> (line 6)", "reaches value 15 of 'pa', which holds 12"},
+      // Found by fuzz_mesh_dae: a <polylist> without <vcount>, which assimp read through a null pointer.
+      {"polylist.dae", polylist(""), "<polylist> (line 8)", "count=\"4\" polygons, but <vcount> gives 0 corner counts"},
+      {"short_vcount.dae", polylist("<vcount>3 3 3</vcount>"), "<polylist>", "<vcount> gives 3 corner counts"},
+      // Found by fuzz_mesh_dae: a <float_array> without count="N", of which assimp reads no value.
+      {"uncounted.dae", uncounted(), "<accessor> (line 6)", "reaches value 12 of 'pa', which holds 0"},
       {"stride.dae", collada(kTetP, kTetNode, "<node id=\"n\"/>", "0 0 0 1 0 0 0 1 0 0 0 1", 4, "count=\"4\" stride=\"-3\""),
        "<accessor>", "stride=\"-3\" is not a whole number"},
   };
@@ -388,4 +432,23 @@ TEST_F(BadInput, ColladaThatAssimpCannotSurvive) {
     const std::string path = dir.write(c.name, c.text);
     EXPECT_LOAD_ERROR(loadMesh(path, Vec3::Ones()), path, c.element, c.reason);
   }
+  // Found by fuzz_mesh_dae: primitives whose count="N" their <p> elements do not hold; assimp asserted
+  // (abort) after reading them.
+  const auto without_p = [](std::string text) {
+    const std::size_t a = text.find("<p>"), b = text.find("</p>");
+    return text.erase(a, b + 4 - a);
+  };
+  const auto twice_p = [](std::string text) {
+    const std::size_t a = text.find("<p>"), b = text.find("</p>");
+    return text.insert(b + 4, text.substr(a, b + 4 - a));
+  };
+  const std::string no_p = dir.write("no_p.dae", without_p(polylist("<vcount>3 3 3 3</vcount>")));
+  EXPECT_LOAD_ERROR(loadMesh(no_p, Vec3::Ones()), no_p, "<polylist>", "count=\"4\" primitives, but it has 0 <p> elements");
+  const std::string two_p = dir.write("two_p.dae", twice_p(collada(kTetP, kTetNode, "<node id=\"n\"/>")));
+  EXPECT_LOAD_ERROR(loadMesh(two_p, Vec3::Ones()), two_p, "<triangles>", "count=\"4\" primitives, but it has 2 <p> elements");
+  std::string polygons = collada(kTetP, kTetNode, "<node id=\"n\"/>");
+  polygons.replace(polygons.find("<triangles count=\"4\">"), 21, "<polygons count=\"2\">");
+  polygons.replace(polygons.find("</triangles>"), 12, "</polygons>");
+  const std::string one_polygon = dir.write("polygons.dae", polygons);
+  EXPECT_LOAD_ERROR(loadMesh(one_polygon, Vec3::Ones()), one_polygon, "<polygons>", "count=\"2\" primitives, but it has 1 <p> elements (one per polygon)");
 }
