@@ -14,8 +14,9 @@
 namespace clearway {
 namespace {
 
-// Candidate centres per axis in each closed piece's box, and the hill climb's halvings of its step.
-constexpr int kGrid = 6;
+// Candidate centres per link, shared among its closed pieces by the volume of their boxes (at least 2 per
+// axis in each), and the hill climb's halvings of its step.
+constexpr double kCandidates = 216;
 constexpr int kClimbSteps = 6;
 // A candidate is kept only when at least this fraction of its radius reaches beyond every kept core, and
 // only while it is at least kSmallest of the largest core: tiny balls cost a comparison and decide little.
@@ -86,22 +87,28 @@ void LinkGeometry::findCores() {
     });
     return cutoff;
   };
+  double volume = 0.0;
+  for (const Aabb& box : solid_boxes_) volume += box.extents().prod();
   for (int s = 0; s < solidCount(); ++s) {
     const Aabb& box = solid_boxes_[s];
+    const double share = volume > 0.0 ? box.extents().prod() / volume : 1.0;
+    const int grid = std::clamp(static_cast<int>(std::cbrt(kCandidates * share)), 2, 6);
     const auto inside = [&](const Vec3& p) { return surelyInside(s, p); };
     std::vector<Ball> mine;
-    for (int i = 0; i < kGrid; ++i)
-      for (int j = 0; j < kGrid; ++j)
-        for (int k = 0; k < kGrid; ++k) {
-          const Vec3 f((i + 0.5) / kGrid, (j + 0.5) / kGrid, (k + 0.5) / kGrid);
+    for (int i = 0; i < grid; ++i)
+      for (int j = 0; j < grid; ++j)
+        for (int k = 0; k < grid; ++k) {
+          const Vec3 f((i + 0.5) / grid, (j + 0.5) / grid, (k + 0.5) / grid);
           const Vec3 p = box.min + f.cwiseProduct(box.extents());
           if (inside(p)) mine.push_back({p, clearance(p)});
         }
     std::sort(mine.begin(), mine.end(), [](const Ball& x, const Ball& y) { return x.radius > y.radius; });
-    if (mine.size() > static_cast<std::size_t>(2 * kMaxCores)) mine.resize(2 * kMaxCores);
+    // The best few climb (as many as the piece's share of the link allows, up to twice the cores kept).
+    const std::size_t climbers = std::clamp(static_cast<int>(2 * kMaxCores * share) + 1, 1, 2 * kMaxCores);
+    if (mine.size() > climbers) mine.resize(climbers);
     // Climb: move each centre along the axes while its clearance grows (a bounded number of halvings).
     for (Ball& b : mine) {
-      double step = 0.5 * box.extents().maxCoeff() / kGrid;
+      double step = 0.5 * box.extents().maxCoeff() / grid;
       for (int h = 0; h < kClimbSteps; ++h, step *= 0.5)
         for (int d = 0; d < 6; ++d) {
           Vec3 p = b.center;
