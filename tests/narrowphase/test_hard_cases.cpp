@@ -12,8 +12,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <random>
+#include <string>
 #include <vector>
 
 using namespace clearway;
@@ -670,4 +672,54 @@ TEST(HardCases, BadInput) {
   EXPECT_NO_THROW(Segment(Vec3::Zero(), Vec3::Zero()));
   EXPECT_NEAR(gjkDistance(Capsule(0.5, 0.0), Pose(), Box(Vec3(1, 0, 1)), Pose::translation(Vec3(0, 2, 0))).distance, 1.5,
               1e-12);
+}
+
+// Issue 18, part 6: the families that were conservative but not exact.
+
+namespace {
+std::string num(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", x);
+  return buf;
+}
+}  // namespace
+
+// A 1e-3 box on a 1e3 box (face on face in a tilted frame, and on an edge of it), and unit shapes of
+// every curved kind, at gaps down to where the coordinates' own rounding is. The band of gjkIntersect
+// is 1e-10 of the size of A − B, 2e-7 here, so gaps of 1e-7 … 1e-9 of the small box came out
+// intersecting; a pair in the band now gets an exact look along GJK's last axes with a margin of the
+// computation's rounding (gjk.h). Bound: separated for every gap ≥ 1e-10 (1e-7 of the small box,
+// 1e-13 of the big one; its coordinates round at ~1e-13), intersecting at 0 and at −1e-10.
+TEST(HardCases, SmallBoxOnABigOneAndCurvedShapesNearTouching) {
+  const Shape huge = Box(Vec3(1e3, 1e3, 1e3)), tiny = Box(Vec3(1e-3, 1e-3, 1e-3));
+  const Pose pa = posed(kTilt, Vec3(10, 20, 30));
+  for (const double gap : {1e-4, 1e-6, 1e-8, 1e-9, 1e-10, 0.0, -1e-10}) {
+    SCOPED_TRACE("gap " + num(gap));
+    const Pose face = posed(kTilt, pa.t + kTilt * Vec3(1e3 + 1e-3 + gap, 3.7, -12.1));
+    const Pose plain = Pose::translation(Vec3(0.3, -0.2, 1e3 + 1e-3 + gap));
+    // The tiny box turned 45° about x, its edge down onto the big box's top face.
+    const Pose edge = posed(rotation(M_PI / 4, Vec3::UnitX()), Vec3(-0.4, 0.25, 1e3 + std::sqrt(2.0) * 1e-3 + gap));
+    const bool apart = gap > 0.0;
+    EXPECT_EQ(isIntersecting(huge, pa, tiny, face), !apart);
+    EXPECT_EQ(isIntersecting(tiny, face, huge, pa), !apart);
+    EXPECT_EQ(isIntersecting(huge, Pose(), tiny, plain), !apart);
+    if (gap != 0.0) {  // √2·1e-3 is not exact
+      EXPECT_EQ(isIntersecting(huge, Pose(), tiny, edge), !apart);
+    }
+  }
+  // Unit-sized curved shapes against a box face, at gaps of 1e-7 … 1e-9 of their size (and 0).
+  for (const double L : {1e-2, 1.0, 1e2}) {
+    const Shape box = Box(L * Vec3(1, 0.7, 0.4));
+    const Shape cyl = Cylinder(0.5 * L, 0.8 * L), cone = Cone(0.6 * L, 0.7 * L), ball = Sphere(0.5 * L);
+    const Pose pb = posed(kTilt, L * Vec3(3, -1, 2));
+    for (int k = 7; k <= 10; ++k) {
+      const double gap = k == 10 ? 0.0 : L * std::pow(10.0, -k);
+      SCOPED_TRACE("L " + num(L) + " gap " + num(gap));
+      const auto at = [&](const Mat3& R, double reach) { return posed(kTilt * R, pb.t + kTilt * Vec3(L + reach + gap, 0.1 * L, 0.1 * L)); };
+      EXPECT_EQ(isIntersecting(box, pb, cyl, at(rotation(M_PI / 2, Vec3::UnitX()), 0.5 * L)), gap == 0.0);  // side
+      EXPECT_EQ(isIntersecting(box, pb, cyl, at(rotation(M_PI / 2, Vec3::UnitY()), 0.8 * L)), gap == 0.0);  // cap
+      EXPECT_EQ(isIntersecting(box, pb, cone, at(rotation(-M_PI / 2, Vec3::UnitY()), 0.7 * L)), gap == 0.0);  // apex
+      EXPECT_EQ(isIntersecting(box, pb, ball, at(Mat3::Identity(), 0.5 * L)), gap == 0.0);
+    }
+  }
 }
