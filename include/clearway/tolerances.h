@@ -13,9 +13,11 @@ struct Tolerances {
   /// GJK: iteration cap; reaching it yields Status::NotConverged (treated as a collision).
   int gjk_max_iterations = 128;
 
-  /// Ray / shape cast: a hit when the ray point is within cast_relative · max‖yᵢ‖ of the shape (relative to its size).
+  /// Ray / shape cast: the GJK cast hands over to conservative advancement once the ray point is within
+  /// cast_relative · max‖yᵢ‖ of the shape; the answer is then exact to the band of gjk_absolute (hits and t).
   double cast_relative = 1e-6;
-  /// Ray / shape cast: iteration cap; reaching it reports a hit at the certified lower bound of the time of impact.
+  /// Ray / shape cast: iteration cap (GJK cast steps, at most half of it when above 8, plus advancement
+  /// steps); reaching it reports a hit at the certified lower bound of the time of impact.
   int cast_max_iterations = 128;
 
   /// EPA: stop when upper − lower bound of the depth ≤ epa_relative · depth.

@@ -137,8 +137,9 @@ TEST(IterationCaps, CastsReportAHitAtALowerBoundWhenCapped) {
         ++capped_casts;
         EXPECT_TRUE(c.hit) << "cap " << cap;
       }
-      // The reference gets room: a cone cast against a cylinder can stall at the default cap of 128
-      // (issue 18, part 6). Should even this stall, it is only a lower bound, and not compared.
+      // The reference gets room: a cone cast against a cylinder used to stall at the default cap of 128
+      // (issue 18, part 6; HardCases.ShapeCastsOfCylindersAndCones). Should even this stall, it is only a
+      // lower bound, and not compared.
       const CastResult exact_cast = gjkShapeCast(other, from, ray.direction, shape, pose, 2.0, roomy);
       if (!isFailure(exact_cast.status) && exact_cast.hit) {
         EXPECT_TRUE(c.hit) << "cap " << cap << " " << statusName(c.status);

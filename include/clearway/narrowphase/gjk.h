@@ -12,6 +12,8 @@
 #include <clearway/shape/shape.h>
 #include <clearway/tolerances.h>
 
+#include <limits>
+
 namespace clearway {
 
 /// Result of a distance query. Points and normal are in the world frame (the frame of the poses).
@@ -140,7 +142,8 @@ DistanceResult gjkDistance(const A& a, const Pose& pose_a, const B& b, const Pos
 
 /// Boolean intersection that stops at the first separating axis; the axis goes back into `cache`
 /// and starts the next query of the same pair, so smoothly moving pairs take about one iteration.
-/// Shapes within a band of gjk_absolute·(their size) of touching count as intersecting.
+/// Shapes within the rounding of the computation (a few ulps of every length involved) of touching count
+/// as intersecting; so do pairs GJK cannot tell apart within the cap.
 template <class A, class B>
 IntersectResult gjkIntersect(const A& a, const Pose& pose_a, const B& b, const Pose& pose_b,
                              const Tolerances& tol, SimplexCache& cache) noexcept {
@@ -159,12 +162,26 @@ IntersectResult gjkIntersect(const A& a, const Pose& pose_a, const B& b, const P
   double vv = v.squaredNorm();
   double lower = -INFINITY;
   IntersectResult r;
+  // The band of gjk_absolute is 1e-10 of the size of A − B, which for a 1e-3 box on a 1e3 one is 2e-7,
+  // a million times the rounding of coordinates near 1e3 (~1e-13). It ends GJK near contact; what decides
+  // is the rounding of the whole computation relative to the shapes as given (the relative pose, the
+  // support points, the dot products): a few ulps of every length involved, world translations
+  // included, and 64 ulps of their sum (L1 norms: no square roots, never smaller) is generous. A plane
+  // clearing A − B by more than that separates them, and a pair that reaches the band goes on with the
+  // rounding as its band (to the cap at most, where it counts as intersecting), so pairs 1e-10 apart
+  // are told from touching ones at any size ratio.
+  constexpr double kUlps = 64 * std::numeric_limits<double>::epsilon();
+  const double world = pose_a.t.cwiseAbs().sum() + pose_b.t.cwiseAbs().sum() + md.b_in_a.t.cwiseAbs().sum() + rsum;
+  double rounding = 0.0;
+  bool in_band = false;
   for (int it = 1; it <= tol.gjk_max_iterations; ++it) {
     r.iterations = it;
     const SupportPoint p = md.support(-v);
     const double vlen = std::sqrt(vv);
+    rounding = std::max(rounding, kUlps * (world + p.a.cwiseAbs().sum() + (p.b - md.b_in_a.t).cwiseAbs().sum()));
     // The band keeps exactly touching shapes (rounding either way) on the colliding side.
-    const double band = tol.gjk_absolute * (std::sqrt(std::max(simplexScale(s), p.w.squaredNorm())) + rsum);
+    const double band = in_band ? rounding
+                                : std::max(rounding, tol.gjk_absolute * (std::sqrt(std::max(simplexScale(s), p.w.squaredNorm())) + rsum));
     const double vw = v.dot(p.w);
     if (vw > (rsum + band) * vlen) {
       cache.axis = v;
@@ -175,9 +192,9 @@ IntersectResult gjkIntersect(const A& a, const Pose& pose_a, const B& b, const P
     }
     lower = std::max(lower, vw / vlen);
     if (s.n > 0 && (inSimplex(s, p.w) || vv - vw <= tol.gjk_relative * vv)) {
-      // The distance is known to rounding (or to the tolerance) and is not above the band: decide
-      // by the certified lower bound, colliding when in doubt.
-      r.intersecting = !(lower > rsum + band);
+      // The distance is known to rounding (or to the tolerance): decide by the certified lower bound,
+      // colliding when in doubt.
+      r.intersecting = !(lower > rsum + rounding);
       r.status = inSimplex(s, p.w) ? Status::RepeatedSupport : Status::Converged;
       if (!r.intersecting) { cache.axis = v; cache.valid = true; }
       return r;
@@ -202,7 +219,11 @@ IntersectResult gjkIntersect(const A& a, const Pose& pose_a, const B& b, const P
     }
     const double vv_next = v_next.squaredNorm();
     if (s.n == 4) { r.status = Status::Overlapping; return r; }
-    if (vv_next <= (rsum + band) * (rsum + band)) { r.status = Status::Touching; return r; }
+    if (vv_next <= (rsum + band) * (rsum + band)) {
+      r.status = Status::Touching;
+      if (in_band || !(vv_next > (rsum + rounding) * (rsum + rounding))) return r;
+      in_band = true;  // within gjk_absolute: go on with the rounding as the band
+    }
     if (!(vv_next < vv) && it > 1) { r.status = Status::NoProgress; return r; }  // intersecting, conservatively
     if (!std::isfinite(vv_next)) { r.status = Status::NotConverged; return r; }
     v = v_next;
