@@ -2,6 +2,7 @@
 
 #include <clearway/detail/per_thread.h>
 
+#include <clearway/kinematics/attached_body.h>
 #include <clearway/kinematics/forward_kinematics.h>
 #include <clearway/load/robot_loader.h>
 
@@ -20,7 +21,39 @@ namespace {
 std::shared_ptr<const RobotGeometry> loadRobotGeometry(const SceneDescription& d, const LoadOptions& options) {
   LoadOptions load = options;
   load.package_paths.insert(load.package_paths.end(), d.package_paths.begin(), d.package_paths.end());
-  auto model = std::make_shared<const RobotModel>(loadRobot(d.urdf, d.srdf, load));
+  RobotModel robot = loadRobot(d.urdf, d.srdf, load);
+  if (!d.attached.empty()) {
+    std::vector<AttachedBody> bodies;
+    std::vector<TriangleMesh> meshes;
+    for (std::size_t i = 0; i < d.attached.size(); ++i) {
+      const SceneDescription::AttachedSpec& a = d.attached[i];
+      const std::string key = "robot.attached[" + std::to_string(i) + "]";
+      const auto link = [&](const std::string& name, const std::string& k) {
+        const int l = robot.linkIndex(name);
+        if (l < 0) throw LoadError(d.file, "key '" + k + "'", "link '" + name + "' is not in robot '" + robot.name() + "'");
+        return l;
+      };
+      AttachedBody b;
+      b.name = a.body.name;
+      b.link = link(a.link, key + ".link");
+      b.pose = a.body.pose;
+      for (std::size_t t = 0; t < a.touch_links.size(); ++t)
+        b.touch_links.push_back(link(a.touch_links[t], key + ".touch_links[" + std::to_string(t) + "]"));
+      if (a.body.mesh_file.empty()) {
+        b.element.primitive = a.body.shape;
+      } else {
+        b.element.mesh = static_cast<int>(meshes.size());
+        meshes.push_back(loadMesh(a.body.mesh_file, a.body.mesh_scale, nullptr, options.mesh));
+      }
+      bodies.push_back(std::move(b));
+    }
+    try {
+      robot = attachBodies(robot, bodies, meshes);
+    } catch (const std::invalid_argument& e) {
+      throw LoadError(d.file, "key 'robot.attached'", e.what());
+    }
+  }
+  auto model = std::make_shared<const RobotModel>(std::move(robot));
   return std::make_shared<const RobotGeometry>(std::move(model));
 }
 
@@ -74,6 +107,11 @@ void Scene::init() {
   auto fail = [&](const std::string& key, const std::string& reason) {
     throw LoadError(file, "key '" + key + "'", reason);
   };
+
+  for (std::size_t i = 0; i < description_.attached.size(); ++i)
+    if (model.linkIndex(description_.attached[i].body.name) < 0)
+      fail("robot.attached[" + std::to_string(i) + "]", "the robot given has no link '" + description_.attached[i].body.name +
+                                                          "' (loadRobotGeometry makes each attached body a link)");
 
   // Group and held joints → entries of the robot's joint vector.
   const int nv = model.variableCount();

@@ -130,8 +130,13 @@ class Parser {
     return Pose::fromQuaternion(q[0], q[1], q[2], q[3], t);
   }
 
-  void obstacle(const YAML::Node& n, const std::string& key, SceneDescription& d) const {
-    requireMap(n, key, {"name", "box", "sphere", "cylinder", "capsule", "mesh", "pose", "velocity"});
+  // A body's name, geometry (one of box, sphere, cylinder, capsule, mesh) and pose: an obstacle or an
+  // attached body, whose other keys are `extra`.
+  SceneDescription::ObstacleSpec body(const YAML::Node& n, const std::string& key,
+                                      const std::vector<std::string>& extra) const {
+    std::set<std::string> allowed{"name", "box", "sphere", "cylinder", "capsule", "mesh", "pose"};
+    allowed.insert(extra.begin(), extra.end());
+    requireMap(n, key, allowed);
     SceneDescription::ObstacleSpec o;
     o.name = n["name"] ? text(n["name"], key + ".name") : key;
     int kinds = 0;
@@ -173,10 +178,25 @@ class Parser {
     } catch (const ShapeError& e) {
       fail(key, e.what() + where(n));
     }
-    if (kinds != 1) fail(key, "an obstacle needs exactly one of box, sphere, cylinder, capsule, mesh" + where(n));
+    if (kinds != 1) fail(key, "a body needs exactly one of box, sphere, cylinder, capsule, mesh" + where(n));
     if (n["pose"]) o.pose = pose(n["pose"], key + ".pose");
+    return o;
+  }
+
+  void obstacle(const YAML::Node& n, const std::string& key, SceneDescription& d) const {
+    SceneDescription::ObstacleSpec o = body(n, key, {"velocity"});
     if (n["velocity"]) o.velocity = lengths(n["velocity"], key + ".velocity", true);  // m/s
     d.obstacles.push_back(std::move(o));
+  }
+
+  void attached(const YAML::Node& n, const std::string& key, SceneDescription& d) const {
+    SceneDescription::AttachedSpec a;
+    a.body = body(n, key, {"link", "touch_links"});
+    if (!n["name"]) fail(key + ".name", "missing: an attached body is named in reports");
+    if (!n["link"]) fail(key + ".link", "missing: the link it is fixed to");
+    a.link = text(n["link"], key + ".link");
+    if (const YAML::Node t = n["touch_links"]; t && !t.IsNull()) a.touch_links = names(t, key + ".touch_links");
+    d.attached.push_back(std::move(a));
   }
 
   SceneDescription parse() const {
@@ -203,7 +223,7 @@ class Parser {
 
     const YAML::Node robot = root["robot"];
     if (!robot) fail("robot", "missing");
-    requireMap(robot, "robot", {"urdf", "srdf", "group", "hold", "allow", "padding", "bounds"});
+    requireMap(robot, "robot", {"urdf", "srdf", "group", "hold", "allow", "padding", "bounds", "attached"});
     if (!robot["urdf"]) fail("robot.urdf", "missing");
     d.urdf = path(robot["urdf"], "robot.urdf");
     if (robot["srdf"] && !robot["srdf"].IsNull()) d.srdf = path(robot["srdf"], "robot.srdf");
@@ -231,6 +251,10 @@ class Parser {
         if (p.size() != 2) fail(k, "expected 2 link names, got " + std::to_string(p.size()) + where(a[i]));
         d.allow.emplace_back(p[0], p[1]);
       }
+    }
+    if (const YAML::Node a = robot["attached"]; a && !a.IsNull()) {
+      if (!a.IsSequence()) fail("robot.attached", "expected a list of bodies" + where(a));
+      for (std::size_t i = 0; i < a.size(); ++i) attached(a[i], "robot.attached[" + std::to_string(i) + "]", d);
     }
     if (robot["padding"]) {
       d.padding = number(robot["padding"], "robot.padding");

@@ -81,6 +81,14 @@ struct SceneDescription {
     Vec3 velocity = Vec3::Zero();
   };
   std::vector<ObstacleSpec> obstacles;
+  /// A body fixed to a robot link (robot.attached): named, shaped and posed (relative to the link) as an
+  /// obstacle is; it may touch its touch_links and its link. loadRobotGeometry makes each a link.
+  struct AttachedSpec {
+    std::string link;
+    ObstacleSpec body;
+    std::vector<std::string> touch_links;
+  };
+  std::vector<AttachedSpec> attached;
   Effects effects;
   std::vector<double> start, goal;  ///< empty when the file gives none
 };
@@ -90,8 +98,8 @@ struct SceneDescription {
 /// unknown check, or a file that is missing or not YAML.
 SceneDescription parseSceneFile(const std::string& path);
 
-/// The robot a description names (URDF, SRDF, meshes → trees and hulls); options.package_paths are
-/// searched before the description's. Throws LoadError.
+/// The robot a description names (URDF, SRDF, meshes → trees and hulls), with its attached bodies as links
+/// of their own; options.package_paths are searched before the description's. Throws LoadError.
 std::shared_ptr<const RobotGeometry> loadRobotGeometry(const SceneDescription& description,
                                                        const LoadOptions& options = {});
 /// The environment a description names (obstacles, meshes read with options.mesh, OctoMap). Throws LoadError.

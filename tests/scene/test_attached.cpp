@@ -1,0 +1,134 @@
+// Attached bodies (robot.attached): a stick held by our arm collides with a wall the bare arm clears;
+// it may touch its touch links and its link, nothing else; the certified motion check catches it
+// sweeping through a post thinner than a 1% sampling step, which the sampling misses; bad
+// declarations name the file and key.
+#include <clearway/motion/motion.h>
+#include <clearway/scene/scene.h>
+
+#include "load/robot_files.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace clearway {
+namespace {
+
+using test::TempDir;
+
+// Our arm (robots/arm6) holding `attached` (YAML list items, indented 4), among `obstacles`.
+std::string armScene(const std::string& attached, const std::string& obstacles) {
+  return "format: 1\nname: held\nrobot:\n  urdf: " + test::sourceRobot("arm6/arm6.urdf") + "\n  srdf: " +
+         test::sourceRobot("arm6/arm6.srdf") +
+         "\n  group: [shoulder_pan_joint, shoulder_lift_joint, elbow_joint, wrist_1_joint, wrist_2_joint, wrist_3_joint]\n" +
+         (attached.empty() ? "" : "  attached:\n" + attached) + "environment:\n  obstacles:\n" + obstacles +
+         "checks: [self, environment, continuous]\n";
+}
+
+const char* const kStick =
+    "    - {name: stick, link: tool0, box: {size: [0.6, 0.02, 0.02]}, pose: {position: [0.3, 0, 0]},"
+    " touch_links: [wrist_3_link]}\n";
+const char* const kWall = "    - {name: wall, box: {size: [0.004, 1.0, 3.0]}, pose: {position: [0.3, 0, 1.5]}}\n";
+
+TEST(Attached, CollidesWhereTheBareArmDoesNot) {
+  TempDir dir;
+  const auto held = Scene::load(dir.write("held.yaml", armScene(kStick, kWall)));
+  const auto bare = Scene::load(dir.write("bare.yaml", armScene("", kWall)));
+  const std::vector<double> upright(6, 0.0), turned{1.57, 0, 0, 0, 0, 0};
+  EXPECT_TRUE(bare->isFree(upright));
+  CollisionReport report;
+  ASSERT_FALSE(held->isFree(upright, &report));
+  ASSERT_EQ(report.kind, CollisionReport::Kind::Environment);
+  EXPECT_EQ(held->robot().link(report.link).name, "stick");
+  EXPECT_EQ(held->environment().obstacles()[report.hit.index].name, "wall");
+  EXPECT_TRUE(held->isFree(turned));  // pointing along y, away from the wall
+  EXPECT_EQ(held->dimension(), bare->dimension());  // the state is the arm's alone
+}
+
+TEST(Attached, TouchesOnlyItsTouchLinksAndItsLink) {
+  TempDir dir;
+  // A ball fixed to the base where the upright stick passes: a self collision between two held bodies.
+  const std::string ball = "    - {name: ball, link: base_link, sphere: {radius: 0.05}, pose: {position: [0.3, 0, 0]}}\n";
+  const auto plain = Scene::load(dir.write("plain.yaml", armScene(kStick, "")));
+  const RobotModel& m = plain->robot();
+  const int stick = m.linkIndex("stick");
+  ASSERT_GE(stick, 0);
+  EXPECT_FALSE(plain->filter().enabled(stick, m.linkIndex("wrist_3_link")));  // a touch link
+  EXPECT_FALSE(plain->filter().enabled(stick, m.linkIndex("tool0")));         // its link (no geometry here)
+  EXPECT_TRUE(plain->filter().enabled(stick, m.linkIndex("forearm_link")));
+  EXPECT_TRUE(plain->filter().enabled(stick, m.linkIndex("base_link")));
+  // Where the ball sits at the stick's height, the two held bodies meet.
+  SceneContext ctx = plain->makeContext();
+  plain->computePoses(std::vector<double>(6, 0.0).data(), ctx);
+  const double height = ctx.poses[stick].t.z();
+  std::string at_height = ball;
+  at_height.replace(at_height.find("[0.3, 0, 0]"), 11, "[0.3, 0, " + std::to_string(height) + "]");
+  const auto both = Scene::load(dir.write("both.yaml", armScene(std::string(kStick) + at_height, "")));
+  CollisionReport report;
+  ASSERT_FALSE(both->isFree(std::vector<double>(6, 0.0), &report));
+  ASSERT_EQ(report.kind, CollisionReport::Kind::Self);
+  EXPECT_EQ(both->robot().link(report.link).name == "stick" ? both->robot().link(report.other_link).name
+                                                               : both->robot().link(report.link).name,
+            "ball");
+}
+
+TEST(Attached, CertifiedCatchesASweepThroughAPostThatSamplingMisses) {
+  TempDir dir;
+  // A 2 mm stick, and a 2 mm post half a metre from the pan axis, midway between two states of the 1%
+  // sampling of the pan sweep −0.5 → 0.5: every sampled state clears it by 0.5 mm.
+  const std::string thin = "    - {name: stick, link: tool0, box: {size: [0.6, 0.002, 0.002]}, pose: {position: [0.3, 0, 0]}}\n";
+  const auto probe = Scene::load(dir.write("probe.yaml", armScene(thin, "")));
+  const double a = -0.5, b = 0.5, resolution = 0.01;
+  const double n = std::ceil((b - a) / resolution);  // as the sampled check counts its steps
+  const double mid = a + (b - a) * (std::floor(n / 2) + 0.5) / n;
+  SceneContext ctx = probe->makeContext();
+  probe->computePoses(std::vector<double>{mid, 0, 0, 0, 0, 0}.data(), ctx);
+  const Vec3 post = ctx.poses[probe->robot().linkIndex("stick")] * Vec3(0.2, 0, 0);  // 0.5 m out along the stick
+  const std::string obstacles = "    - {name: post, cylinder: {radius: 0.001, length: 0.1}, pose: {position: [" +
+                                std::to_string(post.x()) + ", " + std::to_string(post.y()) + ", " +
+                                std::to_string(post.z()) + "]}}\n";
+  const auto scene = Scene::load(dir.write("post.yaml", armScene(thin, obstacles)));
+  const std::vector<double> q0{a, 0, 0, 0, 0, 0}, q1{b, 0, 0, 0, 0, 0};
+  ASSERT_TRUE(scene->isFree(q0));
+  ASSERT_TRUE(scene->isFree(q1));
+  ASSERT_FALSE(scene->isFree(std::vector<double>{mid, 0, 0, 0, 0, 0}));  // the post is on the stick's path
+  MotionChecker certified(scene);
+  MotionContext cctx = certified.makeContext();
+  const MotionResult c = certified.check(q0.data(), q1.data(), cctx, true);
+  EXPECT_FALSE(c.free);
+  EXPECT_EQ(scene->robot().link(c.report.link).name, "stick");
+  MotionOptions sampled;
+  sampled.mode = MotionMode::Sampled;
+  sampled.resolution = resolution;
+  MotionChecker one_percent(scene, sampled);
+  MotionContext sctx = one_percent.makeContext();
+  EXPECT_TRUE(one_percent.check(q0.data(), q1.data(), sctx).free) << "the 1% sampling was to step over the post";
+}
+
+TEST(Attached, BadDeclarationsNameTheKey) {
+  TempDir dir;
+  struct Case {
+    std::string attached, key, reason;
+  };
+  const Case cases[] = {
+      {"    - {name: stick, link: hand, sphere: {radius: 0.1}}\n", "key 'robot.attached[0].link'", "link 'hand' is not in robot"},
+      {"    - {name: stick, link: tool0, sphere: {radius: 0.1}, touch_links: [claw]}\n",
+       "key 'robot.attached[0].touch_links[0]'", "link 'claw' is not in robot"},
+      {"    - {name: forearm_link, link: tool0, sphere: {radius: 0.1}}\n", "key 'robot.attached'", "already a link"},
+      {"    - {link: tool0, sphere: {radius: 0.1}}\n", "key 'robot.attached[0].name'", "missing"},
+      {"    - {name: stick, sphere: {radius: 0.1}}\n", "key 'robot.attached[0].link'", "missing"},
+      {"    - {name: stick, link: tool0, sphere: {radius: 0.1}, box: {size: [1, 1, 1]}}\n", "key 'robot.attached[0]'",
+       "exactly one of box, sphere"},
+      {"    - {name: stick, link: tool0, sphere: {radius: 0.1}, velocity: [1, 0, 0]}\n", "key 'robot.attached[0].velocity'", "unknown key"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.attached);
+    const std::string path = dir.write("bad.yaml", armScene(c.attached, kWall));
+    EXPECT_LOAD_ERROR(Scene::load(path), path, c.key, c.reason);
+  }
+}
+
+}  // namespace
+}  // namespace clearway
