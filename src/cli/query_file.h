@@ -1,5 +1,5 @@
 #pragma once
-// Narrow-phase query files (JSON Lines, format in DESIGN.md "Narrow-phase query files"): one case
+// Narrow-phase query files (JSON Lines, format in docs/query-format.md): one case
 // per line in, one JSON result per line out. Parsing checks every key once, up front, and names the
 // key in its error; running a parsed case cannot fail (the narrow phase reports through its status).
 #include <clearway/math.h>

@@ -1,4 +1,4 @@
-// The scene file (DESIGN.md, "Scene files"): YAML in, a SceneDescription out, every error naming the
+// The scene file (docs/scene-format.md): YAML in, a SceneDescription out, every error naming the
 // file and the key. Strict: an unknown key is an error, because a misspelt `padding` silently ignored
 // is a collision silently missed.
 #include <clearway/load/input_limits.h>

@@ -85,7 +85,7 @@ struct SceneDescription {
   std::vector<double> start, goal;  ///< empty when the file gives none
 };
 
-/// Parses a scene file (DESIGN.md, "Scene files"). Throws LoadError(file, "key 'a.b'", reason) for an
+/// Parses a scene file (docs/scene-format.md). Throws LoadError(file, "key 'a.b'", reason) for an
 /// unknown key, a missing required key, a value of the wrong type or length, a non-finite number, an
 /// unknown check, or a file that is missing or not YAML.
 SceneDescription parseSceneFile(const std::string& path);
