@@ -32,6 +32,10 @@ std::string verdict(const Scene& scene, const std::vector<double>& q, SceneConte
 }
 
 int runCheck(const CheckSettings& s) {
+  if (s.scene == "-" && s.states == "-") {
+    std::cerr << "clearway check: SCENE and --states cannot both be - (one stdin)\n";
+    return kExitUsage;
+  }
   const std::shared_ptr<const Scene> scene = loadScene("check", s.scene, s.options);
   if (!scene) return kExitUsage;
   SceneContext ctx = scene->makeContext();
@@ -78,7 +82,8 @@ int runCheck(const CheckSettings& s) {
 Subcommand addCheckCommand(CLI::App& root) {
   auto s = std::make_shared<CheckSettings>();
   CLI::App* app = root.add_subcommand("check", "classify joint vectors of a scene: free or which links collide");
-  app->add_option("SCENE", s->scene, "the scene file (YAML)")->required();
+  app->add_option("SCENE", s->scene, "the scene file (YAML; - for stdin, its paths then from the working directory)")
+      ->required();
   app->add_option("--states", s->states, "joint vectors, one per line (- for stdin)")->type_name("FILE|-");
   addGeometryOption(*app, s->options.mode, /*mode_alias=*/true);
   addLoadOptions(*app, s->options.load);

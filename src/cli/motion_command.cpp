@@ -52,6 +52,10 @@ int runMotion(const MotionSettings& s) {
   const std::string& motions_path = s.motions;
   const SceneOptions& options = s.options;
   const MotionOptions& motion = s.motion;
+  if (scene_path == "-" && motions_path == "-") {
+    std::cerr << "clearway motion: SCENE and --motions cannot both be - (one stdin)\n";
+    return kExitUsage;
+  }
   const std::shared_ptr<const Scene> scene = loadScene("motion", scene_path, options);
   if (!scene) return kExitUsage;
   std::unique_ptr<MotionChecker> checker;
@@ -117,7 +121,8 @@ int runMotion(const MotionSettings& s) {
 Subcommand addMotionCommand(CLI::App& root) {
   auto s = std::make_shared<MotionSettings>();
   CLI::App* app = root.add_subcommand("motion", "check joint-space segments of a scene: free, or the last valid fraction");
-  app->add_option("SCENE", s->scene, "the scene file (YAML)")->required();
+  app->add_option("SCENE", s->scene, "the scene file (YAML; - for stdin, its paths then from the working directory)")
+      ->required();
   app->add_option("--motions", s->motions, "segments, two joint vectors per line (- for stdin)")->type_name("FILE|-");
   addMotionOption(*app, s->motion, /*mode_alias=*/true);
   addGeometryOption(*app, s->options.mode, /*mode_alias=*/false);

@@ -116,7 +116,7 @@ int runPlan(const PlanSettings& s) {
 
   std::shared_ptr<const Scene> scene;
   try {
-    scene = Scene::load(scene_path, options);
+    scene = openScene(scene_path, options);
   } catch (const std::exception& e) {
     std::cerr << "clearway plan: " << e.what() << "\n";
     return kExitUsage;
@@ -230,7 +230,9 @@ int runPlan(const PlanSettings& s) {
 Subcommand addPlanCommand(CLI::App& root) {
   auto s = std::make_shared<PlanSettings>();
   CLI::App* app = root.add_subcommand("plan", "plan start -> goal on a scene with OMPL (a bundled scene when none is given)");
-  app->add_option("SCENE", s->scene, "the scene file (YAML); default: the bundled " CLEARWAY_DEFAULT_SCENE);
+  app->add_option("SCENE", s->scene,
+                  "the scene file (YAML; - for stdin, its paths then from the working directory); default: the "
+                  "bundled " CLEARWAY_DEFAULT_SCENE);
   app->add_option("--planner", s->planner, "an OMPL geometric planner (listed below)")->capture_default_str();
   app->add_option("--time", s->time, "seconds the planner may take")->check(numberAbove(0))->type_name("SECONDS")
       ->capture_default_str();

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iostream>
 #include <set>
+#include <sstream>
 
 namespace clearway::cli {
 
@@ -27,9 +28,16 @@ void printWarning(const std::string& text) {
   if (!quiet_mode && printed.insert(text).second) std::cerr << "warning: " << text << "\n";
 }
 
+std::shared_ptr<const Scene> openScene(const std::string& path, const SceneOptions& options) {
+  if (path != "-") return Scene::load(path, options);
+  std::ostringstream text;
+  text << std::cin.rdbuf();
+  return std::make_shared<const Scene>(parseSceneText(text.str(), "<stdin>", std::filesystem::current_path().string()), options);
+}
+
 std::shared_ptr<const Scene> loadScene(const char* command, const std::string& path, const SceneOptions& options) {
   try {
-    auto scene = Scene::load(path, options);
+    auto scene = openScene(path, options);
     for (const std::string& w : scene->robot().loadWarnings()) printWarning(w);
     return scene;
   } catch (const std::exception& e) {

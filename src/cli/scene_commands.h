@@ -24,7 +24,11 @@ void setQuiet(bool on);
 /// nothing when quiet().
 void printWarning(const std::string& text);
 
-/// Scene::load, printing the robot's load warnings; on failure prints "clearway COMMAND: reason" and
+/// Scene::load, or for "-" the scene read from stdin (its relative paths from the working directory).
+/// Throws LoadError.
+std::shared_ptr<const Scene> openScene(const std::string& path, const SceneOptions& options);
+
+/// openScene, printing the robot's load warnings; on failure prints "clearway COMMAND: reason" and
 /// returns null.
 std::shared_ptr<const Scene> loadScene(const char* command, const std::string& path, const SceneOptions& options);
 

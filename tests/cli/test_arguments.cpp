@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <fstream>
+#include <iterator>
 #include <string>
 
 using clearway_test::runTool;
@@ -99,6 +100,24 @@ TEST(Arguments, DashIsStdinAndStdout) {
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.out.rfind("<?xml", 0), 0u) << r.out.substr(0, 200);
   EXPECT_MENTIONS(r.err, "pairs differ");  // the report goes to stderr beside it
+  // A scene from stdin: its relative paths start at the working directory (absolute here).
+  std::ifstream in(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/arm6_wall.yaml");
+  std::string yaml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (std::size_t p; (p = yaml.find(": ../arm6/")) != std::string::npos;)
+    yaml.replace(p, 10, std::string(": ") + CLEARWAY_SOURCE_DIR + "/robots/arm6/");
+  const std::string scene = writeTemp("stdin_scene.yaml", yaml);
+  r = runTool("check - <'" + scene + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, runTool("check " + kScene).out);
+  r = runTool("motion - --motion sampled:0.01 <'" + scene + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("start -> goal: collision", 0), 0u) << r.out;
+  r = runTool("plan - --seed 3 --time 30 <'" + scene + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("path ", 0), 0u) << r.out;
+  r = runTool("check - --states - <'" + scene + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_MENTIONS(r.err, "cannot both be -");
   // A folder is not an input file, - or not.
   r = runTool("check " + kScene + " --states '" + testing::TempDir() + "'");
   EXPECT_EQ(r.exit_code, 2);

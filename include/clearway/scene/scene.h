@@ -90,6 +90,9 @@ struct SceneDescription {
 /// unknown check, or a file that is missing or not YAML.
 SceneDescription parseSceneFile(const std::string& path);
 
+/// parseSceneFile on text read elsewhere (stdin): `name` names it in errors, relative paths start at `base_dir`.
+SceneDescription parseSceneText(const std::string& yaml, const std::string& name, const std::string& base_dir);
+
 /// The robot a description names (URDF, SRDF, meshes → trees and hulls); options.package_paths are
 /// searched before the description's. Throws LoadError.
 std::shared_ptr<const RobotGeometry> loadRobotGeometry(const SceneDescription& description,
