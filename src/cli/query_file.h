@@ -59,8 +59,8 @@ struct QueryLineResult {
 QueryLineResult runQueryLine(const std::string& line, long line_number);
 
 /// Runs every non-blank line of `in`, writing one compact JSON object per line to `out` in input
-/// order; flushes after each line when `flush_each_line`. Returns 0 when every case ran, 1 when any
-/// line was an error.
+/// order; flushes after each line when `flush_each_line`. Returns kExitOk when every case ran, kExitNo
+/// when any line was an error (exit_codes.h).
 int runQueryStream(std::istream& in, std::ostream& out, bool flush_each_line = false);
 
 }  // namespace clearway
