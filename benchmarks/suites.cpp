@@ -219,7 +219,7 @@ void statesCase(const SuiteCase& c, const SuiteConfig& config, std::vector<Suite
 ob::StateValidityCheckerPtr validity(const char* engine, const ob::SpaceInformationPtr& si,
                                      const std::shared_ptr<const Scene>& scene) {
 #ifdef CLEARWAY_HAVE_FCL
-  if (!std::strcmp(engine, "fcl")) return std::make_shared<FclValidity>(si, *scene);
+  if (!std::strcmp(engine, "fcl")) return std::make_shared<FclValidity>(si, scene);
 #endif
   (void)engine;
   return std::make_shared<ValidityChecker>(si, scene);
@@ -348,6 +348,16 @@ double median(std::vector<double> v) {
   return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
+// The checkers a planning problem is run with, each a "planner" of the problem's one OMPL experiment
+// (RRTConnect[certified], ...), so that Planner Arena plots them side by side.
+struct PlanChecker {
+  const char* engine;
+  const char* mode;
+  std::string planner;  // the name in the log
+  ob::StateValidityCheckerPtr validity;
+  ob::MotionValidatorPtr motion;
+};
+
 void planCase(const SuiteCase& c, const SuiteConfig& config, std::vector<SuiteRow>& rows) {
   const SceneDescription d = parseSceneFile(c.file);
   const auto scene = robots().scene(d);
@@ -365,59 +375,92 @@ void planCase(const SuiteCase& c, const SuiteConfig& config, std::vector<SuiteRo
   const StateMap map(*scene);
   const std::string logs = config.out + "/plan";
   std::filesystem::create_directories(logs);
-  struct Checker {
-    const char* engine;
-    const char* mode;
-  };
-  for (const Checker& k : {Checker{"clearway", "certified"}, Checker{"clearway", "sampled"}, Checker{"fcl", "sampled"}}) {
-    if (!kFcl && !std::strcmp(k.engine, "fcl")) continue;
-    const bool certified = !std::strcmp(k.mode, "certified");
-    og::SimpleSetup setup(makeStateSpace(*scene));
-    const ob::SpaceInformationPtr si = setup.getSpaceInformation();
-    if (certified) {
-      setupCollisionChecking(si, scene);
-    } else {
-      si->setStateValidityChecker(validity(k.engine, si, scene));
-      si->setMotionValidator(std::make_shared<ob::DiscreteMotionValidator>(si));
-      si->setStateValidityCheckingResolution(0.01);  // OMPL's default
-    }
-    ob::ScopedState<> start(setup.getStateSpace()), goal(setup.getStateSpace());
-    map.fromVector(d.start.data(), start.get());
-    map.fromVector(d.goal.data(), goal.get());
-    setup.setStartAndGoalStates(start, goal);
-    setup.setup();
-    const std::string name = c.subject + "_" + k.engine + "-" + k.mode;
-    ompl::tools::Benchmark bench(setup, name);
-    bench.addPlanner(std::make_shared<og::RRTConnect>(si));
-    std::vector<double> q0(scene->dimension()), q1(scene->dimension());
-    // Every solution is re-checked: certified ("certified": free, never within 1 mm) and densely sampled
-    // at 1e-3 rad ("collides_dense": a collision the sampling sees).
-    bench.setPostRunEvent([&](const ob::PlannerPtr& planner, ompl::tools::Benchmark::RunProperties& run) {
-      bool certified_path = false, collides = false;
-      const ob::ProblemDefinitionPtr& pdef = planner->getProblemDefinition();
-      if (pdef->hasExactSolution()) {
-        certified_path = true;
-        const auto* path = pdef->getSolutionPath()->as<og::PathGeometric>();
-        for (std::size_t i = 0; i + 1 < path->getStateCount(); ++i) {
-          map.toVector(path->getState(i), q0.data());
-          map.toVector(path->getState(i + 1), q1.data());
-          map.unwrap(q0.data(), q1.data());
-          certified_path = certified_path && certify.check(q0.data(), q1.data(), certify_ctx).free;
-          collides = collides || !dense.check(q0.data(), q1.data(), dense_ctx).free;
-        }
-      }
-      run["certified BOOLEAN"] = certified_path ? "1" : "0";
-      run["collides_dense BOOLEAN"] = collides ? "1" : "0";
-    });
-    const ompl::tools::Benchmark::Request request(config.plan_time, 4096.0, config.plan_runs, 0.05, false, false, false);
-    bench.benchmark(request);
-    bench.saveResultsToFile((logs + "/" + name + ".log").c_str());
 
+  og::SimpleSetup setup(makeStateSpace(*scene));
+  const ob::SpaceInformationPtr si = setup.getSpaceInformation();
+  std::vector<PlanChecker> checkers;
+  for (const auto& [engine, mode] : {std::pair{"clearway", "certified"}, {"clearway", "sampled"}, {"fcl", "sampled"}}) {
+    if (!kFcl && !std::strcmp(engine, "fcl")) continue;
+    PlanChecker k{engine, mode, "", nullptr, nullptr};
+    if (!std::strcmp(mode, "certified")) {
+      const CollisionChecking cc = setupCollisionChecking(si, scene);
+      k.planner = "RRTConnect[certified]";
+      k.validity = cc.validity, k.motion = cc.motion;
+    } else {
+      k.planner = std::string("RRTConnect[") + engine + "-sampled]";
+      k.validity = validity(engine, si, scene);
+      k.motion = std::make_shared<ob::DiscreteMotionValidator>(si);
+    }
+    checkers.push_back(k);
+  }
+  ob::ScopedState<> start(setup.getStateSpace()), goal(setup.getStateSpace());
+  map.fromVector(d.start.data(), start.get());
+  map.fromVector(d.goal.data(), goal.get());
+  setup.setStartAndGoalStates(start, goal);
+  setup.setStateValidityChecker(checkers.front().validity);  // (replaced before every run)
+  setup.setup();
+
+  ompl::tools::Benchmark bench(setup, c.subject);
+  bench.addExperimentParameter("problem", "STRING", c.subject);
+  bench.addExperimentParameter("sampled resolution", "REAL", "0.01");  // OMPL's default, of the extent
+  bench.addExperimentParameter("certified contact distance", "REAL", std::to_string(MotionOptions{}.contact_distance));
+  auto checkerOf = [&](const ob::PlannerPtr& planner) -> const PlanChecker& {
+    for (const PlanChecker& k : checkers)
+      if (k.planner == planner->getName()) return k;
+    throw std::logic_error("no checker for planner " + planner->getName());
+  };
+  for (const PlanChecker& k : checkers) {
+    auto planner = std::make_shared<og::RRTConnect>(si);
+    planner->setName(k.planner);
+    bench.addPlanner(planner);
+  }
+  // Each run plans with its planner's checker on the one SpaceInformation the benchmark reads its
+  // counters from (valid segment fraction, clearance), the counters zeroed.
+  bench.setPreRunEvent([&](const ob::PlannerPtr& planner) {
+    const PlanChecker& k = checkerOf(planner);
+    si->setStateValidityChecker(k.validity);
+    si->setMotionValidator(k.motion);
+    si->setStateValidityCheckingResolution(0.01);
+    si->setup();
+    k.motion->resetMotionCounter();
+  });
+  std::vector<double> q0(scene->dimension()), q1(scene->dimension());
+  // Every solution is re-checked: certified ("certified": free, never within 1 mm) and densely sampled
+  // at 1e-3 rad ("collides_dense": a collision the sampling sees). Clearance is logged only where the
+  // scene declares it: elsewhere OMPL's 0 would read as a measurement.
+  bench.setPostRunEvent([&](const ob::PlannerPtr& planner, ompl::tools::Benchmark::RunProperties& run) {
+    bool certified_path = false, collides = false;
+    const ob::ProblemDefinitionPtr& pdef = planner->getProblemDefinition();
+    if (pdef->hasExactSolution()) {
+      certified_path = true;
+      const auto* path = pdef->getSolutionPath()->as<og::PathGeometric>();
+      for (std::size_t i = 0; i + 1 < path->getStateCount(); ++i) {
+        map.toVector(path->getState(i), q0.data());
+        map.toVector(path->getState(i + 1), q1.data());
+        map.unwrap(q0.data(), q1.data());
+        certified_path = certified_path && certify.check(q0.data(), q1.data(), certify_ctx).free;
+        collides = collides || !dense.check(q0.data(), q1.data(), dense_ctx).free;
+      }
+    }
+    run["certified BOOLEAN"] = certified_path ? "1" : "0";
+    run["collides_dense BOOLEAN"] = collides ? "1" : "0";
+    if (!scene->effects().clearance) {
+      run.erase("solution clearance REAL");
+      run.erase("simplified solution clearance REAL");
+    }
+  });
+  const ompl::tools::Benchmark::Request request(config.plan_time, 4096.0, config.plan_runs, 0.05, false, false, false);
+  bench.benchmark(request);
+  bench.saveResultsToFile((logs + "/" + c.subject + ".log").c_str());
+
+  const auto& planners = bench.getRecordedExperimentData().planners;
+  for (std::size_t p = 0; p < checkers.size(); ++p) {
+    const PlanChecker& k = checkers[p];
     SuiteRow r;
     r.suite = "plan", r.subject = c.subject, r.engine = k.engine, r.mode = k.mode;
-    r.tolerance = certified ? MotionOptions{}.contact_distance : 0.01;
+    r.tolerance = !std::strcmp(k.mode, "certified") ? MotionOptions{}.contact_distance : 0.01;
     std::vector<double> times;
-    for (const auto& run : bench.getRecordedExperimentData().planners.at(0).runs) {
+    for (const auto& run : planners.at(p).runs) {
       ++r.items;
       const bool solved = run.count("solved BOOLEAN") && run.at("solved BOOLEAN") == "1";
       const bool exact = !run.count("approximate solution BOOLEAN") || run.at("approximate solution BOOLEAN") == "0";

@@ -11,6 +11,7 @@ packages=(
   liboctomap-dev                     # environment: OctoMap
   libompl-dev libboost-serialization-dev libboost-filesystem-dev libboost-system-dev  # OMPL plugin
   libyaml-cpp-dev nlohmann-json3-dev # scene files, query files
+  libcli11-dev                       # the clearway tool's argument parser
   libgtest-dev libgmock-dev libbenchmark-dev  # tests and benchmarks
   python3-dev pybind11-dev python3-numpy python3-pytest  # the Python module and its tests
   libfcl-dev                         # benchmarks only: FCL side by side

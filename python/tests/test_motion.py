@@ -33,7 +33,7 @@ def test_check_motions_equals_the_tool_on_arm6(arm6, tool, tmp_path, mode):
     free, last_valid, pairs = arm6.check_motions(q0, q1, mode=mode, report=True)
     assert free.dtype == np.bool_ and last_valid.dtype == np.float64
     motions = write_rows(tmp_path / "motions.txt", np.hstack([q0, q1]))
-    assert as_tool_prints(free, last_valid, pairs) == tool("motion", ARM6_WALL, "--motions", motions, "--mode", mode)
+    assert as_tool_prints(free, last_valid, pairs) == tool("motion", ARM6_WALL, "--motions", motions, "--motion", mode)
     assert 10 < free.sum() < 140  # both verdicts occur
     assert (last_valid[free] == 1).all() and (last_valid[~free] < 1).all() and (last_valid >= 0).all()
 

@@ -1,5 +1,7 @@
 // `clearway audit URDF [--srdf S] [--check] [--samples N] [--seed N] [--threads N] [--srdf-out FILE|-]
 // [--report FILE]`.
+#include "commands.h"
+#include "exit_codes.h"
 #include "scene_commands.h"
 
 #include <clearway/load/robot_loader.h>
@@ -23,12 +25,7 @@ namespace clearway::cli {
 
 namespace {
 
-constexpr int kExitOk = 0, kExitDisagrees = 1, kExitUsage = 2;
-
-const char* const kAuditUsage =
-    "usage: clearway audit URDF [--srdf SRDF [--check]] [--samples N] [--seed N] [--threads N]\n"
-    "                           [--srdf-out FILE|-] [--report FILE] [--package-path DIR]... [--honour-up-axis]\n"
-    "\n"
+const char* const kAuditHelp =
     "Classifies every pair of links with collision geometry as MoveIt Setup Assistant does: Adjacent,\n"
     "Default (colliding at the default configuration), Always (colliding in >= 95% of N random\n"
     "configurations), Never (never seen colliding), or checked; with the evidence (samples, colliding count,\n"
@@ -47,12 +44,6 @@ const char* const kAuditUsage =
     "same audit whatever the thread count.\n"
     "Exit status: 0 on success (with --check: the SRDF agrees), 1 with --check when the SRDF disagrees,\n"
     "2 on a usage error, a robot that does not load or an output that cannot be written.\n";
-
-bool parseCount(const std::string& s, long long& out) {
-  char* end = nullptr;
-  out = std::strtoll(s.c_str(), &end, 10);
-  return !s.empty() && *end == '\0';
-}
 
 std::string clearanceText(double c) {
   char buf[32];
@@ -145,72 +136,21 @@ bool writeHeatmap(const RobotModel& model, const std::vector<PairAudit>& audit, 
   return runGnuplot(script, why);
 }
 
-}  // namespace
-
-int auditCommand(const std::vector<std::string>& args) {
+struct AuditSettings {
   std::string urdf, srdf, srdf_out, report;
   bool check = false;
   AuditOptions options;
-  options.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));  // 0 when unknown
   LoadOptions load;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "-h" || a == "--help") {
-      std::cout << kAuditUsage << kLoadOptionsUsage;
-      return kExitOk;
-    }
-    std::string error;
-    if (parseLoadOption(args, i, load, error)) {
-      if (error.empty()) continue;
-      std::cerr << "clearway audit: " << error << "\n" << kAuditUsage << kLoadOptionsUsage;
-      return kExitUsage;
-    }
-    const bool valued =
-        a == "--srdf" || a == "--samples" || a == "--seed" || a == "--threads" || a == "--srdf-out" || a == "--report";
-    if (valued && i + 1 >= args.size()) {
-      std::cerr << "clearway audit: " << a << " needs a value\n" << kAuditUsage;
-      return kExitUsage;
-    }
-    long long n = 0;
-    if (a == "--srdf") {
-      srdf = args[++i];
-    } else if (a == "--srdf-out") {
-      srdf_out = args[++i];
-    } else if (a == "--report") {
-      report = args[++i];
-    } else if (a == "--samples") {
-      if (!parseCount(args[++i], n) || n < 1 || n > 100000000) {
-        std::cerr << "clearway audit: --samples needs a whole number from 1 to 1e8, got '" << args[i] << "'\n";
-        return kExitUsage;
-      }
-      options.samples = static_cast<int>(n);
-    } else if (a == "--check") {
-      check = true;
-    } else if (a == "--threads") {
-      if (!parseCount(args[++i], n) || n < 1 || n > 1024) {
-        std::cerr << "clearway audit: --threads needs a whole number from 1 to 1024, got '" << args[i] << "'\n";
-        return kExitUsage;
-      }
-      options.threads = static_cast<int>(n);
-    } else if (a == "--seed") {
-      if (!parseCount(args[++i], n) || n < 0) {
-        std::cerr << "clearway audit: --seed needs a whole number >= 0, got '" << args[i] << "'\n";
-        return kExitUsage;
-      }
-      options.seed = static_cast<std::uint64_t>(n);
-    } else if (urdf.empty() && !a.empty() && a[0] != '-') {
-      urdf = a;
-    } else {
-      std::cerr << "clearway audit: unexpected argument '" << a << "'\n" << kAuditUsage;
-      return kExitUsage;
-    }
-  }
-  if (urdf.empty()) {
-    std::cerr << "clearway audit: expected a URDF file\n" << kAuditUsage;
-    return kExitUsage;
-  }
+};
+
+int runAudit(AuditSettings& settings) {
+  const std::string &urdf = settings.urdf, &srdf = settings.srdf, &srdf_out = settings.srdf_out,
+                    &report = settings.report;
+  const bool check = settings.check;
+  AuditOptions& options = settings.options;
+  const LoadOptions& load = settings.load;
   if (check && srdf.empty()) {
-    std::cerr << "clearway audit: --check needs the --srdf to compare with\n" << kAuditUsage;
+    std::cerr << "clearway audit: --check needs the --srdf to compare with\n";
     return kExitUsage;
   }
   if (report == "-") {
@@ -356,9 +296,33 @@ int auditCommand(const std::vector<std::string>& args) {
   }
   if (check && disagrees) {
     std::cerr << "clearway audit: --check: " << srdf << " disagrees with the audit\n";
-    return kExitDisagrees;
+    return kExitNo;
   }
   return kExitOk;
+}
+
+}  // namespace
+
+Subcommand addAuditCommand(CLI::App& root) {
+  auto s = std::make_shared<AuditSettings>();
+  s->options.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));  // 0 when unknown
+  CLI::App* app = root.add_subcommand(
+      "audit", "self-collision audit of a URDF: Adjacent, Default, Always, Never pairs with evidence; SRDF out");
+  app->add_option("URDF", s->urdf, "the robot (a file: its meshes are found relative to it)")->required();
+  app->add_option("--srdf", s->srdf, "an SRDF to compare with, and to keep all but its disable_collisions of")
+      ->type_name("SRDF");
+  app->add_flag("--check", s->check, "exit 1 when the --srdf disagrees with the audit (a CI guard)");
+  app->add_option("--samples", s->options.samples, "random configurations")->check(wholeNumber(1, 100000000))
+      ->capture_default_str();
+  addSeedOption(*app, s->options.seed, "the sampler's seed")->capture_default_str();
+  app->add_option("--threads", s->options.threads, "threads (default: one per hardware thread)")
+      ->check(wholeNumber(1, 1024));
+  app->add_option("--srdf-out", s->srdf_out, "write the SRDF here (- for stdout)")->type_name("FILE|-");
+  app->add_option("--report", s->report, "write a Markdown report here, and its heat map beside it")
+      ->type_name("FILE");
+  addLoadOptions(*app, s->load);
+  app->footer(std::string(kAuditHelp) + kFormatsHelp);
+  return {app, [s] { return runAudit(*s); }};
 }
 
 }  // namespace clearway::cli

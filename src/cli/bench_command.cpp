@@ -6,7 +6,9 @@
 // `clearway bench merge` checks that shards 0 … N−1 of one configuration are all there, each once, and
 // writes the same files an unsharded run writes. Rows are copied verbatim and ordered by case, so a
 // merged results.csv equals an unsharded one except for the measured times.
+#include "commands.h"
 #include "data_paths.h"
+#include "exit_codes.h"
 #include "scene_commands.h"
 
 #include "suites.h"  // (the clearway_bench_suites library)
@@ -31,22 +33,17 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const char* const kBenchUsage =
-    "usage: clearway bench [SUITE...] [--out DIR] [--shard I/N] [--count N] [--problems K]\n"
-    "                      [--plan-runs R] [--plan-time S] [--seed N] [--subjects S1,S2] [--shared DIR]\n"
-    "       clearway bench merge --out DIR SHARD_DIR...\n"
-    "\n"
+const char* const kBenchHelp =
     "SUITE: narrowphase (GJK distance by tolerance, Clearway and FCL's two solvers), states (one state:\n"
     "exact meshes, convex hulls, FCL OBBRSS), motions (certified by contact distance, OMPL's sampling by\n"
     "resolution over Clearway and over FCL, against a dense reference), plan (RRTConnect with each\n"
-    "checker; OMPL benchmark logs in DIR/plan), or all. Default: narrowphase states motions.\n"
+    "checker: one OMPL benchmark log per problem in DIR/plan, the checkers as planners side by side for\n"
+    "Planner Arena), or all. Default: narrowphase states motions.\n"
     "Writes DIR/results.csv; unsharded runs and merges also DIR/summary.csv, DIR/table.txt (printed),\n"
-    "DIR/plots.gp and its PNG plots (when gnuplot is installed). --count: pairs per shape family, states\n"
-    "or motions per problem (default 200); --problems: problems per scene family (default 1);\n"
-    "--subjects: only the shape families or problems whose name contains one of the strings.\n"
-    "--shard I/N runs the cases with index I modulo N (0 <= I < N); merge combines shards 0..N-1.\n"
-    "--shared DIR: the shared development data, the folder holding scenes/ (states, motions and plan need\n"
-    "it); default $CLEARWAY_SHARED, and for the binary in its build tree ../shared beside the source.\n";
+    "DIR/plots.gp and its PNG plots (when gnuplot is installed). --shard I/N runs the cases with index I\n"
+    "modulo N; `clearway bench merge --out DIR SHARD_DIR...` combines shards 0..N-1.\n"
+    "Exit status: 0 when every case ran, 1 when a case failed, 2 on a usage error, missing shared data or\n"
+    "an output that cannot be written.\n";
 
 constexpr const char* kColumns =
     "suite,case,subject,engine,mode,tolerance,items,ns_per_item,work_per_item,positives,misses,false_alarms,"
@@ -355,18 +352,10 @@ void finish(const std::string& dir, const Results& res) {
 
 int usageError(const std::string& why) {
   std::cerr << "clearway bench: " << why << " (clearway bench --help shows the usage)\n";
-  return 2;
+  return kExitUsage;
 }
 
-int mergeCommand(const std::vector<std::string>& args) {
-  std::string out;
-  std::vector<std::string> dirs;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    if (args[i] == "--out" && i + 1 < args.size()) out = args[++i];
-    else if (args[i].rfind("--", 0) == 0) return usageError("merge: unknown option " + args[i]);
-    else dirs.push_back(args[i]);
-  }
-  if (out.empty() || dirs.empty()) return usageError("merge: needs --out DIR and at least one shard folder");
+int runMerge(const std::string& out, const std::vector<std::string>& dirs) {
   try {
     Results merged;
     std::vector<int> seen;
@@ -401,52 +390,28 @@ int mergeCommand(const std::vector<std::string>& args) {
     finish(out, merged);
   } catch (const std::exception& e) {
     std::cerr << "clearway bench merge: " << e.what() << "\n";
-    return 2;
+    return kExitUsage;
   }
-  return 0;
+  return kExitOk;
 }
 
-}  // namespace
-
-int benchCommand(const std::vector<std::string>& args) {
-  if (args.size() == 1 && (args[0] == "-h" || args[0] == "--help")) {
-    std::cout << kBenchUsage;
-    return 0;
-  }
-  if (!args.empty() && args[0] == "merge") return mergeCommand(std::vector<std::string>(args.begin() + 1, args.end()));
+struct BenchSettings {
   bench::SuiteConfig config;
-  config.shared = sharedDataDir();
-  config.out = "bench-results";
+  std::string shard;  // "I/N", checked by the parser
+  std::vector<std::string> subjects;
+  std::string merge_out;
+  std::vector<std::string> merge_dirs;
+};
+
+int runBench(BenchSettings& settings) {
+  bench::SuiteConfig& config = settings.config;
   long shard = -1, shards = 0;
-  auto number = [&](std::size_t& i, const char* name, double lo, double& value) {
-    if (i + 1 >= args.size() || !parseDouble(args[i + 1], value) || !(value >= lo))
-      throw std::runtime_error(std::string(name) + " needs a number >= " + fmt("%g", lo));
-    ++i;
-  };
-  try {
-    for (std::size_t i = 0; i < args.size(); ++i) {
-      double v = 0;
-      if (args[i] == "--out" && i + 1 < args.size()) config.out = args[++i];
-      else if (args[i] == "--shared" && i + 1 < args.size()) config.shared = args[++i];
-      else if (args[i] == "--subjects" && i + 1 < args.size()) {
-        for (const std::string& s : split(args[++i], ','))
-          if (!s.empty()) config.subjects.push_back(s);
-      }
-      else if (args[i] == "--shard" && i + 1 < args.size()) {
-        std::string why;
-        if (!parseShard(args[++i], shard, shards, why)) throw std::runtime_error("--shard " + args[i] + ": " + why);
-      } else if (args[i] == "--count") number(i, "--count", 1, v), config.count = static_cast<int>(v);
-      else if (args[i] == "--problems") number(i, "--problems", 1, v), config.problems = static_cast<int>(v);
-      else if (args[i] == "--plan-runs") number(i, "--plan-runs", 1, v), config.plan_runs = static_cast<int>(v);
-      else if (args[i] == "--plan-time") number(i, "--plan-time", 1e-3, v), config.plan_time = v;
-      else if (args[i] == "--seed") number(i, "--seed", 0, v), config.seed = static_cast<std::uint64_t>(v);
-      else if (args[i] == "all") config.suites = bench::suiteNames();
-      else if (args[i].rfind("--", 0) == 0) throw std::runtime_error("unknown option " + args[i]);
-      else config.suites.push_back(args[i]);
-    }
-  } catch (const std::exception& e) {
-    return usageError(e.what());
-  }
+  std::string why;
+  if (!settings.shard.empty()) parseShard(settings.shard, shard, shards, why);
+  for (const std::string& list : settings.subjects)
+    for (const std::string& s : split(list, ','))
+      if (!s.empty()) config.subjects.push_back(s);
+  if (std::find(config.suites.begin(), config.suites.end(), "all") != config.suites.end()) config.suites = bench::suiteNames();
   if (config.suites.empty()) config.suites = {"narrowphase", "states", "motions"};
   std::vector<bench::SuiteCase> cases;
   try {
@@ -482,7 +447,7 @@ int benchCommand(const std::vector<std::string>& args) {
       bench::runCase(c, config, rows);
     } catch (const std::exception& e) {
       std::cerr << "clearway bench: " << c.suite << " " << c.subject << ": " << e.what() << "\n";
-      return 1;
+      return kExitNo;
     }
     for (const bench::SuiteRow& r : rows) {
       std::ostringstream line;
@@ -498,9 +463,53 @@ int benchCommand(const std::vector<std::string>& args) {
     else finish(config.out, res);
   } catch (const std::exception& e) {
     std::cerr << "clearway bench: " << e.what() << "\n";
-    return 2;
+    return kExitUsage;
   }
-  return 0;
+  return kExitOk;
+}
+
+}  // namespace
+
+Subcommand addBenchCommand(CLI::App& root) {
+  auto s = std::make_shared<BenchSettings>();
+  s->config.shared = sharedDataDir();
+  s->config.out = "bench-results";
+  CLI::App* app = root.add_subcommand(
+      "bench", "accuracy against time per suite, mode and tolerance, FCL side by side: CSV, table, plots; shards");
+  app->add_option("SUITE", s->config.suites, "narrowphase, states, motions, plan or all")
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  app->add_option("--out", s->config.out, "the output folder")->type_name("DIR")->capture_default_str();
+  app->add_option("--shard", s->shard, "run the cases whose index is I modulo N (results.csv only)")
+      ->type_name("I/N")
+      ->check(CLI::Validator(
+          [](std::string& v) {
+            long i = 0, n = 0;
+            std::string why;
+            return parseShard(v, i, n, why) ? std::string() : "'" + v + "': " + why;
+          },
+          ""));
+  const CLI::Validator count = wholeNumber(1, 1000000000);
+  app->add_option("--count", s->config.count, "pairs per shape family, states or motions per problem")
+      ->check(count)->capture_default_str();
+  app->add_option("--problems", s->config.problems, "problems per scene family")->check(count)->capture_default_str();
+  app->add_option("--plan-runs", s->config.plan_runs, "planning runs per problem and checker")->check(count)
+      ->capture_default_str();
+  app->add_option("--plan-time", s->config.plan_time, "seconds per planning run")->check(numberAbove(0))
+      ->type_name("SECONDS")->capture_default_str();
+  addSeedOption(*app, s->config.seed, "inputs depend only on the seed and the case")->capture_default_str();
+  app->add_option("--subjects", s->subjects, "only the shape families or problems whose name contains one of these")
+      ->type_name("S1,S2")->allow_extra_args(false)->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  app->add_option("--shared", s->config.shared,
+                  "the shared development data, the folder holding scenes/ (states, motions and plan need it); "
+                  "default $CLEARWAY_SHARED, and for the binary in its build tree ../shared beside the source")
+      ->type_name("DIR");
+  app->footer(kBenchHelp);
+  CLI::App* merge = app->add_subcommand("merge", "combine the results of shards 0..N-1 into one run's files");
+  merge->add_option("--out", s->merge_out, "the output folder")->type_name("DIR")->required();
+  merge->add_option("SHARD_DIR", s->merge_dirs, "the shards' output folders")->required()
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  merge->footer(kExitCodesHelp);
+  return {app, [s, merge] { return merge->parsed() ? runMerge(s->merge_out, s->merge_dirs) : runBench(*s); }};
 }
 
 }  // namespace clearway::cli

@@ -1,123 +1,79 @@
-// The `clearway` tool: one binary, one subcommand per task (DESIGN.md "The `clearway` tool").
-// Results go to stdout, reasons, warnings and progress to stderr (--quiet: no warnings or progress). Exit status: 0 success, 1 when some input
-// line was bad (the others still ran), 2 on a usage error or an unreadable input.
-// A subcommand is a function of its own arguments; adding one is adding a row to kCommands.
-#include "query_file.h"
+// The `clearway` tool: one binary, one subcommand per task, one argument parser (CLI11) for them all.
+// Results go to stdout; reasons, warnings and progress to stderr (--quiet: no warnings or progress).
+// Exit statuses are those of exit_codes.h. Adding a command is adding an add*Command (commands.h).
+#include "commands.h"
+#include "exit_codes.h"
 #include "scene_commands.h"
 
-#include <cerrno>
-#include <cstring>
-#include <filesystem>
-#include <fstream>
+#include <CLI/CLI.hpp>
+
 #include <iostream>
 #include <string>
 #include <vector>
 
 namespace {
 
-using Args = std::vector<std::string>;
+using namespace clearway::cli;
 
-constexpr int kExitOk = 0;
-constexpr int kExitUsage = 2;
-
-bool isHelp(const std::string& a) { return a == "-h" || a == "--help"; }
-
-const char* const kQueryUsage =
-    "usage: clearway query FILE.jsonl   (FILE may be - for stdin)\n"
-    "\n"
-    "Runs narrow-phase queries on shape pairs, one JSON case per line, and prints one JSON result\n"
-    "per line in input order. A bad line yields {\"id\", \"line\", \"status\": \"error\", \"error\"} and\n"
-    "the next line still runs. Exit status: 0 when every case ran, 1 when any line was an error,\n"
-    "2 on a usage error or an unreadable file.\n";
-
-// Results that never reached stdout (a closed pipe, a full disk) must not pass for success.
-int finishOutput(int status) {
-  std::cout.flush();
-  if (!std::cout) {
-    std::cerr << "clearway: error writing results to stdout\n";
-    return kExitUsage;
+// "clearway plan", "clearway bench merge": the deepest command the parser reached, for messages.
+std::string commandName(const CLI::App& root) {
+  std::string name = "clearway";
+  const CLI::App* app = &root;
+  while (!app->get_subcommands().empty()) {
+    app = app->get_subcommands().front();
+    name += " " + app->get_name();
   }
-  return status;
-}
-
-int queryCommand(const Args& args) {
-  if (args.size() == 1 && isHelp(args[0])) {
-    std::cout << kQueryUsage;
-    return kExitOk;
-  }
-  if (args.size() != 1) {
-    std::cerr << "clearway query: expected exactly one FILE argument\n" << kQueryUsage;
-    return kExitUsage;
-  }
-  const std::string& file = args[0];
-  if (file == "-") return finishOutput(clearway::runQueryStream(std::cin, std::cout, /*flush_each_line=*/true));
-  std::error_code ec;
-  if (std::filesystem::is_directory(file, ec)) {
-    std::cerr << "clearway query: cannot read " << file << ": is a directory\n";
-    return kExitUsage;
-  }
-  std::ifstream in(file);
-  if (!in) {
-    std::cerr << "clearway query: cannot open " << file << ": " << std::strerror(errno) << "\n";
-    return kExitUsage;
-  }
-  const int status = clearway::runQueryStream(in, std::cout);
-  if (in.bad()) {
-    std::cerr << "clearway query: error while reading " << file << "\n";
-    return kExitUsage;
-  }
-  return finishOutput(status);
-}
-
-struct Command {
-  const char* name;
-  const char* summary;
-  int (*run)(const Args& args);
-};
-
-const Command kCommands[] = {
-    {"plan", "plan start -> goal on a scene with OMPL (a bundled scene when none is given)", clearway::cli::planCommand},
-    {"check", "classify joint vectors of a scene: free or which links collide", clearway::cli::checkCommand},
-    {"motion", "check joint-space segments of a scene: free, or the last valid fraction", clearway::cli::motionCommand},
-    {"audit", "self-collision audit of a URDF: Adjacent, Default, Always, Never pairs with evidence; SRDF out", clearway::cli::auditCommand},
-    {"bench", "accuracy against time per suite, mode and tolerance, FCL side by side: CSV, table, plots; shards", clearway::cli::benchCommand},
-    {"query", "narrow-phase queries on shape pairs from a JSON Lines file", queryCommand},
-};
-
-void printUsage(std::ostream& os) {
-  os << "usage: clearway COMMAND [ARGS...]\n"
-        "       clearway COMMAND --help\n"
-        "       clearway --version\n\ncommands:\n";
-  for (const Command& c : kCommands) os << "  " << c.name << std::string(10 - std::strlen(c.name), ' ') << c.summary << "\n";
-  os << "\n--quiet (anywhere, any command): no warnings or progress lines on stderr; results and errors stay.\n"
-        "Warnings are printed once each.\n";
+  return name;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  // --quiet is the one option of every command: taken out here, wherever it stands.
-  Args all;
-  for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--quiet") == 0) clearway::cli::setQuiet(true);
-    else all.emplace_back(argv[i]);
-  }
-  if (all.empty()) {
-    printUsage(std::cerr);
+  CLI::App root("Clearway: certified collision checking for motion planning.", "clearway");
+  // Set before the subcommands are added, which inherit it: the root's --quiet and --version are then
+  // accepted after any command too.
+  root.fallthrough();
+  // An option given twice takes its last value, as the hand-written parsers did: scripts that append
+  // "$@" after their defaults (scripts/main.sh) may override them. Lists opt out (TakeAll).
+  root.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+  root.set_version_flag("--version", "clearway " CLEARWAY_VERSION, "print the version and exit");
+  bool quiet_flag = false;
+  root.add_flag("--quiet", quiet_flag, "no warnings or progress lines on stderr (results and errors stay)");
+  root.require_subcommand(1);
+  root.footer(std::string("Run 'clearway COMMAND --help' for a command's options and input formats.\n"
+                          "Options take their value as --opt VALUE or --opt=VALUE; a FILE given as - is stdin\n"
+                          "(stdout for an output). Warnings are printed once each.\n") +
+              kFormatsHelp + kExitCodesHelp);
+  const std::vector<Subcommand> commands = {addPlanCommand(root),  addCheckCommand(root), addMotionCommand(root),
+                                            addAuditCommand(root), addBenchCommand(root), addQueryCommand(root)};
+  if (argc < 2) {
+    std::cerr << root.help();
     return kExitUsage;
   }
-  const std::string name = all[0];
-  if (isHelp(name) || name == "help") {
-    printUsage(std::cout);
-    return kExitOk;
+  try {
+    root.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return root.exit(e);  // help on stdout, status 0
+  } catch (const CLI::CallForAllHelp& e) {
+    return root.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    std::cout << e.what() << std::endl;
+    return std::cout ? kExitOk : kExitUsage;
+  } catch (const CLI::ParseError& e) {
+    const std::string name = commandName(root);
+    // A first word that is no command reaches the parser as an extra argument: say which.
+    const std::vector<std::string> rest = root.remaining();
+    if (name == "clearway" && !rest.empty() && rest.front().rfind("-", 0) != 0)
+      std::cerr << "clearway: unknown command '" << rest.front() << "'\n";
+    else
+      std::cerr << name << ": " << e.what() << "\n";
+    std::cerr << "usage: " << name << (name == "clearway" ? " COMMAND" : "") << " [OPTIONS]...; run '" << name
+              << " --help' for more\n";
+    return kExitUsage;
   }
-  if (name == "--version") {
-    std::cout << "clearway " CLEARWAY_VERSION "\n";
-    return finishOutput(kExitOk);
-  }
-  for (const Command& c : kCommands)
-    if (name == c.name) return c.run(Args(all.begin() + 1, all.end()));
-  std::cerr << "clearway: unknown command '" << name << "'\n";
-  printUsage(std::cerr);
-  return kExitUsage;
+  setQuiet(quiet_flag);
+  printDeprecations();
+  for (const Subcommand& c : commands)
+    if (c.app->parsed()) return c.run();
+  return kExitUsage;  // (require_subcommand makes this unreachable)
 }

@@ -1,4 +1,6 @@
-// `clearway motion SCENE [--motions FILE] [--mode certified|cast|sampled:RES]`: checks joint-space segments.
+// `clearway motion SCENE [--motions FILE|-] [--motion certified|cast|sampled:RES]`: checks joint-space segments.
+#include "commands.h"
+#include "exit_codes.h"
 #include "scene_commands.h"
 
 #include <clearway/motion/motion.h>
@@ -12,12 +14,7 @@ namespace clearway::cli {
 
 namespace {
 
-constexpr int kExitOk = 0, kExitBadLine = 1, kExitUsage = 2;
-
-const char* const kMotionUsage =
-    "usage: clearway motion SCENE [--motions FILE] [--mode certified|cast|sampled:RES] [--geometry mesh|hull]\n"
-    "                        [--package-path DIR]... [--honour-up-axis]\n"
-    "\n"
+const char* const kMotionHelp =
     "Checks straight joint-space segments. Each line holds two joint vectors (the group's joints in order,\n"
     "2n numbers separated by spaces or commas; '#' starts a comment); each output line is 'free',\n"
     "'collision F WHAT' (F: the last valid fraction of the segment; WHAT: the links, obstacle or\n"
@@ -25,10 +22,7 @@ const char* const kMotionUsage =
     "'error REASON'. Without --motions it checks the scene's start -> goal.\n"
     "In a scene with moving obstacles (checks: moving) a line may also hold each state's time, 2n + 2\n"
     "numbers 't0 q0... t1 q1...' (seconds): the obstacles are where they are at each moment of the segment.\n"
-    "Modes: certified (default: conservative advancement, never steps over an obstacle, contact within\n"
-    "1 mm), cast (certified, with one GJK shape cast for what only translates: prismatic joints),\n"
-    "sampled:RES (states every RES in the Euclidean joint norm, as OMPL's DiscreteMotionValidator;\n"
-    "may tunnel). FILE may be - for stdin.\n"
+    "--mode is the old spelling of --motion (deprecated).\n"
     "Exit status: 0 when every line was a segment, 1 when some line was an error, 2 on a usage error or\n"
     "a scene that does not load.\n";
 
@@ -47,66 +41,19 @@ std::string verdict(const MotionChecker& checker, const double* q0, const double
   return std::string("collision ") + fraction + " " + checker.scene().describe(r.report);
 }
 
-}  // namespace
-
-int motionCommand(const std::vector<std::string>& args) {
-  std::string scene_path, motions_path;
+struct MotionSettings {
+  std::string scene, motions;
   SceneOptions options;
   MotionOptions motion;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "-h" || a == "--help") {
-      std::cout << kMotionUsage << kLoadOptionsUsage;
-      return kExitOk;
-    }
-    std::string error;
-    if (parseLoadOption(args, i, options.load, error)) {
-      if (error.empty()) continue;
-      std::cerr << "clearway motion: " << error << "\n" << kMotionUsage << kLoadOptionsUsage;
-      return kExitUsage;
-    }
-    if ((a == "--motions" || a == "--mode" || a == "--geometry") && i + 1 >= args.size()) {
-      std::cerr << "clearway motion: " << a << " needs a value\n" << kMotionUsage;
-      return kExitUsage;
-    }
-    if (a == "--motions") {
-      motions_path = args[++i];
-    } else if (a == "--mode") {
-      const std::string m = args[++i];
-      if (m == "certified") {
-        motion.mode = MotionMode::Certified;
-      } else if (m.rfind("sampled:", 0) == 0) {
-        char* end = nullptr;
-        const std::string res = m.substr(8);
-        motion.mode = MotionMode::Sampled;
-        motion.resolution = std::strtod(res.c_str(), &end);
-        if (res.empty() || *end != '\0' || !(motion.resolution > 0.0) || !std::isfinite(motion.resolution)) {
-          std::cerr << "clearway motion: sampled:RES needs a resolution > 0, got '" << res << "'\n";
-          return kExitUsage;
-        }
-      } else if (m == "cast") {
-        motion.mode = MotionMode::Cast;
-      } else {
-        std::cerr << "clearway motion: unknown mode '" << m << "' (certified, cast or sampled:RES)\n";
-        return kExitUsage;
-      }
-    } else if (a == "--geometry") {
-      const std::string g = args[++i];
-      if (g == "mesh") options.mode = GeometryMode::Mesh;
-      else if (g == "hull") options.mode = GeometryMode::Hull;
-      else {
-        std::cerr << "clearway motion: unknown geometry '" << g << "' (mesh or hull)\n";
-        return kExitUsage;
-      }
-    } else if (scene_path.empty() && (a.empty() || a[0] != '-')) {
-      scene_path = a;
-    } else {
-      std::cerr << "clearway motion: unexpected argument '" << a << "'\n" << kMotionUsage;
-      return kExitUsage;
-    }
-  }
-  if (scene_path.empty()) {
-    std::cerr << "clearway motion: expected a SCENE file\n" << kMotionUsage;
+};
+
+int runMotion(const MotionSettings& s) {
+  const std::string& scene_path = s.scene;
+  const std::string& motions_path = s.motions;
+  const SceneOptions& options = s.options;
+  const MotionOptions& motion = s.motion;
+  if (scene_path == "-" && motions_path == "-") {
+    std::cerr << "clearway motion: SCENE and --motions cannot both be - (one stdin)\n";
     return kExitUsage;
   }
   const std::shared_ptr<const Scene> scene = loadScene("motion", scene_path, options);
@@ -138,7 +85,7 @@ int motionCommand(const std::vector<std::string>& args) {
   for (int line_no = 1; std::getline(*input, line); ++line_no) {
     if (!parseNumbers(line, q, why)) {
       std::cout << "error line " << line_no << ": " << why << "\n";
-      status = kExitBadLine;
+      status = kExitNo;
       continue;
     }
     if (q.empty()) continue;
@@ -146,7 +93,7 @@ int motionCommand(const std::vector<std::string>& args) {
     if (static_cast<int>(q.size()) != 2 * n && !timed) {
       std::cout << "error line " << line_no << ": " << q.size() << " values for two states of " << n
                 << " group joints (2n, or 2n + 2 with their times)\n";
-      status = kExitBadLine;
+      status = kExitNo;
       continue;
     }
     const double* q0 = q.data() + (timed ? 1 : 0);
@@ -155,18 +102,33 @@ int motionCommand(const std::vector<std::string>& args) {
     std::string bad;
     if (!scene->validState(q0, &bad) || !scene->validState(q1, &bad)) {
       std::cout << "error line " << line_no << ": " << bad << "\n";
-      status = kExitBadLine;
+      status = kExitNo;
       continue;
     }
     if (!std::isfinite(t0) || !std::isfinite(t1)) {
       std::cout << "error line " << line_no << ": a time is not finite\n";
-      status = kExitBadLine;
+      status = kExitNo;
       continue;
     }
     std::cout << verdict(*checker, q0, q1, ctx, t0, t1) << "\n";
   }
   std::cout.flush();
   return std::cout ? status : kExitUsage;
+}
+
+}  // namespace
+
+Subcommand addMotionCommand(CLI::App& root) {
+  auto s = std::make_shared<MotionSettings>();
+  CLI::App* app = root.add_subcommand("motion", "check joint-space segments of a scene: free, or the last valid fraction");
+  app->add_option("SCENE", s->scene, "the scene file (YAML; - for stdin, its paths then from the working directory)")
+      ->required();
+  app->add_option("--motions", s->motions, "segments, two joint vectors per line (- for stdin)")->type_name("FILE|-");
+  addMotionOption(*app, s->motion, /*mode_alias=*/true);
+  addGeometryOption(*app, s->options.mode, /*mode_alias=*/false);
+  addLoadOptions(*app, s->options.load);
+  app->footer(std::string(kMotionHelp) + kFormatsHelp);
+  return {app, [s] { return runMotion(*s); }};
 }
 
 }  // namespace clearway::cli

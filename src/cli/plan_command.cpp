@@ -1,7 +1,9 @@
 // `clearway plan [SCENE] [--planner NAME] [--time S] [--seed N] [--no-simplify]`: plans start → goal
 // with OMPL on a scene, simplifies, re-validates the final path with the certified motion check, and
 // prints the path (one state per line) and the checker's statistics.
+#include "commands.h"
 #include "data_paths.h"
+#include "exit_codes.h"
 #include "scene_commands.h"
 
 #include <clearway/ompl/collision_checking.h>
@@ -44,12 +46,7 @@ namespace {
 namespace ob = ompl::base;
 namespace og = ompl::geometric;
 
-constexpr int kExitOk = 0, kExitNoPath = 1, kExitUsage = 2;
-
-const char* const kPlanUsage =
-    "usage: clearway plan [SCENE] [--planner NAME] [--time SECONDS] [--seed N] [--mode mesh|hull]\n"
-    "                     [--no-simplify] [--package-path DIR]... [--honour-up-axis]\n"
-    "\n"
+const char* const kPlanHelp =
     "Plans from the scene's start to its goal with an OMPL geometric planner (RRTConnect by default)\n"
     "using Clearway's validity checker and certified motion validator; simplifies the path and checks\n"
     "it again, segment by segment, with the certified check. Prints the path, one state per line, on\n"
@@ -57,7 +54,9 @@ const char* const kPlanUsage =
     "scene " CLEARWAY_DEFAULT_SCENE " of the tool's prefix (BIN/../share/clearway/).\n"
     "Planners: RRTConnect RRT RRTstar LazyRRT BiTRRT pRRT PRM PRMstar LazyPRM KPIECE1 BKPIECE1 LBKPIECE1\n"
     "EST BiEST SBL pSBL.\n"
-    "Exit status: 0 with a valid path, 1 when no valid path was found in time, 2 on bad input.\n";
+    "--mode is the old spelling of --geometry (deprecated).\n"
+    "Exit status: 0 with a certified path, 1 when no certified path was found in time (or the start or\n"
+    "goal is in collision), 2 on bad input.\n";
 
 using PlannerMaker = std::function<ob::PlannerPtr(const ob::SpaceInformationPtr&)>;
 
@@ -89,64 +88,22 @@ std::string defaultScene() {
   return dir.empty() ? "" : dir + "/" CLEARWAY_DEFAULT_SCENE;
 }
 
-bool parseDouble(const std::string& s, double& out) {
-  char* end = nullptr;
-  out = std::strtod(s.c_str(), &end);
-  return !s.empty() && *end == '\0' && std::isfinite(out);
-}
-
-}  // namespace
-
-int planCommand(const std::vector<std::string>& args) {
-  std::string scene_path, planner_name = "RRTConnect";
-  double time_limit = 10.0, seed = -1;
-  bool simplify = true;
+struct PlanSettings {
+  std::string scene, planner = "RRTConnect";
+  double time = 10.0;
+  std::uint64_t seed = 0;
+  bool seeded = false, simplify = true;
   SceneOptions options;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    const bool has_value = i + 1 < args.size();
-    if (a == "-h" || a == "--help") {
-      std::cout << kPlanUsage << kLoadOptionsUsage;
-      return kExitOk;
-    }
-    std::string error;
-    if (parseLoadOption(args, i, options.load, error)) {
-      if (error.empty()) continue;
-      std::cerr << "clearway plan: " << error << "\n" << kPlanUsage << kLoadOptionsUsage;
-      return kExitUsage;
-    }
-    if (a == "--planner" && has_value) {
-      planner_name = args[++i];
-    } else if (a == "--time" && has_value) {
-      if (!parseDouble(args[++i], time_limit) || time_limit <= 0) {
-        std::cerr << "clearway plan: --time needs a positive number of seconds, got '" << args[i] << "'\n";
-        return kExitUsage;
-      }
-    } else if (a == "--seed" && has_value) {
-      if (!parseDouble(args[++i], seed) || seed < 0 || seed != std::floor(seed)) {
-        std::cerr << "clearway plan: --seed needs a non-negative integer, got '" << args[i] << "'\n";
-        return kExitUsage;
-      }
-    } else if (a == "--mode" && has_value) {
-      const std::string m = args[++i];
-      if (m == "mesh") options.mode = GeometryMode::Mesh;
-      else if (m == "hull") options.mode = GeometryMode::Hull;
-      else {
-        std::cerr << "clearway plan: unknown mode '" << m << "' (mesh or hull)\n";
-        return kExitUsage;
-      }
-    } else if (a == "--no-simplify") {
-      simplify = false;
-    } else if (scene_path.empty() && !a.empty() && a[0] != '-') {
-      scene_path = a;
-    } else {
-      std::cerr << "clearway plan: unexpected argument '" << a << "'\n" << kPlanUsage;
-      return kExitUsage;
-    }
-  }
+};
+
+int runPlan(const PlanSettings& s) {
+  std::string scene_path = s.scene;
+  const std::string& planner_name = s.planner;
+  const double time_limit = s.time;
+  const SceneOptions& options = s.options;
   const auto maker = planners().find(planner_name);
   if (maker == planners().end()) {
-    std::cerr << "clearway plan: unknown planner '" << planner_name << "'\n" << kPlanUsage;
+    std::cerr << "clearway plan: --planner: unknown planner '" << planner_name << "' (clearway plan --help lists them)\n";
     return kExitUsage;
   }
   if (scene_path.empty()) scene_path = defaultScene();
@@ -159,7 +116,7 @@ int planCommand(const std::vector<std::string>& args) {
 
   std::shared_ptr<const Scene> scene;
   try {
-    scene = Scene::load(scene_path, options);
+    scene = openScene(scene_path, options);
   } catch (const std::exception& e) {
     std::cerr << "clearway plan: " << e.what() << "\n";
     return kExitUsage;
@@ -179,11 +136,11 @@ int planCommand(const std::vector<std::string>& args) {
     }
     if (!scene->isFree(*q, &r)) {
       std::cerr << "clearway plan: " << scene_path << ": " << which << " is in collision: " << scene->describe(r) << "\n";
-      return kExitNoPath;
+      return kExitNo;
     }
   }
 
-  if (seed >= 0) ompl::RNG::setSeed(static_cast<std::uint_fast32_t>(seed));
+  if (s.seeded) ompl::RNG::setSeed(static_cast<std::uint_fast32_t>(s.seed));
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
   const ob::StateSpacePtr space = makeStateSpace(*scene);
   og::SimpleSetup setup(space);
@@ -208,7 +165,7 @@ int planCommand(const std::vector<std::string>& args) {
       std::cerr << "clearway plan: " << scene_path << ": the " << (s == &start ? "start" : "goal")
                 << " cannot be left (a motion of length zero from it is not certified free): "
                 << scene->describe(r.report) << "\n";
-      return kExitNoPath;
+      return kExitNo;
     }
   }
   setup.setPlanner(maker->second(setup.getSpaceInformation()));
@@ -224,12 +181,12 @@ int planCommand(const std::vector<std::string>& args) {
   if (status != ob::PlannerStatus::EXACT_SOLUTION) {
     std::cerr << "clearway plan: " << planner_name << " found no path in " << time_limit << " s (" << status.asString()
               << ")\n";
-    return kExitNoPath;
+    return kExitNo;
   }
   const auto states_before = checking.validity->counters().states.load();
   const auto motions_before = checking.motion->counters().motions.load();
   double simplify_s = 0.0;
-  if (simplify) {
+  if (s.simplify) {
     const auto t1 = std::chrono::steady_clock::now();
     setup.simplifySolution();
     simplify_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
@@ -265,7 +222,29 @@ int planCommand(const std::vector<std::string>& args) {
                static_cast<unsigned long long>(vc.states.load() - states_before),
                static_cast<unsigned long long>(mc.motions.load() - motions_before));
   std::fflush(stdout);
-  return certified ? kExitOk : kExitNoPath;
+  return certified ? kExitOk : kExitNo;
+}
+
+}  // namespace
+
+Subcommand addPlanCommand(CLI::App& root) {
+  auto s = std::make_shared<PlanSettings>();
+  CLI::App* app = root.add_subcommand("plan", "plan start -> goal on a scene with OMPL (a bundled scene when none is given)");
+  app->add_option("SCENE", s->scene,
+                  "the scene file (YAML; - for stdin, its paths then from the working directory); default: the "
+                  "bundled " CLEARWAY_DEFAULT_SCENE);
+  app->add_option("--planner", s->planner, "an OMPL geometric planner (listed below)")->capture_default_str();
+  app->add_option("--time", s->time, "seconds the planner may take")->check(numberAbove(0))->type_name("SECONDS")
+      ->capture_default_str();
+  CLI::Option* seed = addSeedOption(*app, s->seed, "OMPL's random seed (default: from the clock)");
+  app->add_flag_callback("--no-simplify", [s] { s->simplify = false; }, "print the path as the planner found it");
+  addGeometryOption(*app, s->options.mode, /*mode_alias=*/true);
+  addLoadOptions(*app, s->options.load);
+  app->footer(std::string(kPlanHelp) + kFormatsHelp);
+  return {app, [s, seed] {
+            s->seeded = seed->count() > 0;
+            return runPlan(*s);
+          }};
 }
 
 }  // namespace clearway::cli

@@ -1,5 +1,7 @@
 #include "query_file.h"
 
+#include "exit_codes.h"
+
 #include <clearway/narrowphase/epa.h>
 #include <clearway/narrowphase/gjk.h>
 #include <clearway/narrowphase/ray_cast.h>
@@ -447,7 +449,7 @@ int runQueryStream(std::istream& in, std::ostream& out, bool flush_each_line) {
     out << r.json.dump(-1, ' ', false, ordered_json::error_handler_t::replace) << '\n';
     if (flush_each_line) out.flush();
   }
-  return any_error ? 1 : 0;
+  return any_error ? cli::kExitNo : cli::kExitOk;
 }
 
 }  // namespace clearway

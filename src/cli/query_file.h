@@ -1,5 +1,5 @@
 #pragma once
-// Narrow-phase query files (JSON Lines, format in DESIGN.md "Narrow-phase query files"): one case
+// Narrow-phase query files (JSON Lines, format in docs/query-format.md): one case
 // per line in, one JSON result per line out. Parsing checks every key once, up front, and names the
 // key in its error; running a parsed case cannot fail (the narrow phase reports through its status).
 #include <clearway/math.h>
@@ -59,8 +59,8 @@ struct QueryLineResult {
 QueryLineResult runQueryLine(const std::string& line, long line_number);
 
 /// Runs every non-blank line of `in`, writing one compact JSON object per line to `out` in input
-/// order; flushes after each line when `flush_each_line`. Returns 0 when every case ran, 1 when any
-/// line was an error.
+/// order; flushes after each line when `flush_each_line`. Returns kExitOk when every case ran, kExitNo
+/// when any line was an error (exit_codes.h).
 int runQueryStream(std::istream& in, std::ostream& out, bool flush_each_line = false);
 
 }  // namespace clearway

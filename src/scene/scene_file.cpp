@@ -1,4 +1,4 @@
-// The scene file (DESIGN.md, "Scene files"): YAML in, a SceneDescription out, every error naming the
+// The scene file (docs/scene-format.md): YAML in, a SceneDescription out, every error naming the
 // file and the key. Strict: an unknown key is an error, because a misspelt `padding` silently ignored
 // is a collision silently missed.
 #include <clearway/load/input_limits.h>
@@ -19,7 +19,10 @@ namespace fs = std::filesystem;
 
 class Parser {
  public:
-  explicit Parser(std::string file) : file_(std::move(file)) {}
+  explicit Parser(std::string file) : file_(std::move(file)), base_(fs::path(file_).parent_path()) {}
+  // Text not read from a file (stdin): `name` names it in errors, paths are relative to `base`.
+  Parser(std::string name, const std::string* text, fs::path base)
+      : file_(std::move(name)), base_(std::move(base)), text_(text) {}
 
   [[noreturn]] void fail(const std::string& key, const std::string& reason) const {
     throw LoadError(file_, key.empty() ? "" : "key '" + key + "'", reason);
@@ -110,7 +113,7 @@ class Parser {
   // A path relative to the scene file's folder.
   std::string path(const YAML::Node& n, const std::string& key, bool folder = false) const {
     const fs::path p = text(n, key);
-    const fs::path full = p.is_absolute() ? p : fs::path(file_).parent_path() / p;
+    const fs::path full = p.is_absolute() ? p : base_ / p;
     std::error_code ec;
     if (folder && !fs::is_directory(full, ec)) fail(key, "folder not found: " + full.string() + where(n));
     if (!folder && !fs::is_regular_file(full, ec)) fail(key, "file not found: " + full.string() + where(n));
@@ -202,9 +205,9 @@ class Parser {
   SceneDescription parse() const {
     YAML::Node root;
     std::error_code ec;
-    if (!fs::is_regular_file(file_, ec)) fail("", "scene file not found");
+    if (!text_ && !fs::is_regular_file(file_, ec)) fail("", "scene file not found");
     try {
-      root = YAML::LoadFile(file_);
+      root = text_ ? YAML::Load(*text_) : YAML::LoadFile(file_);
     } catch (const YAML::Exception& e) {
       fail("", std::string("not valid YAML: ") + e.what());
     }
@@ -213,7 +216,7 @@ class Parser {
     requireMap(root, "", {"format", "name", "source", "package_paths", "robot", "environment", "checks", "start", "goal"});
     if (!root["format"]) fail("format", "missing (this reader knows format 1)");
     if (number(root["format"], "format") != 1.0) fail("format", "unsupported format " + root["format"].Scalar() + " (this reader knows 1)");
-    d.name = root["name"] ? text(root["name"], "name") : fs::path(file_).stem().string();
+    d.name = root["name"] ? text(root["name"], "name") : text_ ? std::string("scene") : fs::path(file_).stem().string();
 
     if (const YAML::Node p = root["package_paths"]; p && !p.IsNull()) {
       if (!p.IsSequence()) fail("package_paths", "expected a list of folders" + where(p));
@@ -304,6 +307,8 @@ class Parser {
 
  private:
   std::string file_;
+  fs::path base_;
+  const std::string* text_ = nullptr;
 };
 
 }  // namespace
@@ -314,6 +319,14 @@ SceneDescription parseSceneFile(const std::string& path) {
   } catch (const YAML::Exception& e) {
     // Every read above checks its node first; this is the net for anything yaml-cpp still refuses.
     throw LoadError(path, "", std::string("yaml-cpp: ") + e.what());
+  }
+}
+
+SceneDescription parseSceneText(const std::string& yaml, const std::string& name, const std::string& base_dir) {
+  try {
+    return Parser(name, &yaml, base_dir).parse();
+  } catch (const YAML::Exception& e) {
+    throw LoadError(name, "", std::string("yaml-cpp: ") + e.what());
   }
 }
 

@@ -129,7 +129,7 @@ TEST(AuditTool, ThreadsAndUsageErrors) {
   EXPECT_MENTIONS(r.err, std::to_string(std::max(1u, std::thread::hardware_concurrency())) + " threads");
   r = runTool("audit " + q(urdf) + " --threads 0");
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_MENTIONS(r.err, "--threads needs a whole number from 1 to 1024, got '0'");
+  EXPECT_MENTIONS(r.err, "--threads: needs a whole number from 1 to 1024, got '0'");
   r = runTool("audit " + q(urdf) + " --check");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_MENTIONS(r.err, "--check needs the --srdf to compare with");

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -127,37 +128,111 @@ TEST(BenchTool, ResultsParseBackAndAccuracyFollowsTheTolerance) {
   fs::remove_all(dir);
 }
 
-TEST(BenchTool, PlanningWritesOmplBenchmarkLogs) {
+// One OMPL benchmark log as ompl_benchmark_statistics.py reads it (OMPL's Benchmark::saveResultsToStream
+// format): header lines, "K experiment properties", "P planners", then per planner its name, "C common
+// properties" and C lines, "N properties for each run" and N names, "R runs" and R lines of N
+// "; "-terminated values, optional progress properties, and ".".
+struct OmplLog {
+  std::map<std::string, std::string> experiment;  // "name TYPE" -> value
+  struct Planner {
+    std::string name;
+    std::vector<std::string> properties;
+    std::vector<std::map<std::string, std::string>> runs;
+  };
+  std::vector<Planner> planners;
+};
+
+OmplLog readOmplLog(const std::string& file) {
+  std::ifstream in(file);
+  std::vector<std::string> lines;
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  OmplLog log;
+  std::size_t k = 0;
+  auto expect = [&](bool ok, const std::string& what) {
+    if (!ok) throw std::runtime_error(file + ":" + std::to_string(k + 1) + ": expected " + what);
+  };
+  auto number = [&](const std::string& suffix) {
+    expect(k < lines.size() && lines[k].size() > suffix.size() &&
+               lines[k].compare(lines[k].size() - suffix.size(), suffix.size(), suffix) == 0,
+           "'N" + suffix + "'");
+    return std::stoi(lines[k++]);
+  };
+  expect(lines.size() > 3 && lines[0].rfind("OMPL version", 0) == 0 && lines[1].rfind("Experiment ", 0) == 0, "the header");
+  // "N SUFFIX" alone on its line (other lines, such as "Properties of benchmarked planners:", hold the words too).
+  auto counts = [&](const std::string& suffix) {
+    const std::string& l = lines[k];
+    return l.size() > suffix.size() && l.compare(l.size() - suffix.size(), suffix.size(), suffix) == 0 &&
+           l.find_first_not_of("0123456789") == l.size() - suffix.size();
+  };
+  while (k < lines.size() && !counts(" experiment properties")) ++k;
+  for (int n = number(" experiment properties"); n > 0; --n, ++k) {
+    const auto eq = lines[k].find(" = ");
+    expect(eq != std::string::npos, "NAME TYPE = VALUE");
+    log.experiment[lines[k].substr(0, eq)] = lines[k].substr(eq + 3);
+  }
+  while (k < lines.size() && !counts(" planners")) ++k;
+  for (int p = number(" planners"); p > 0; --p) {
+    OmplLog::Planner planner;
+    planner.name = lines.at(k++);
+    k += number(" common properties");
+    for (int n = number(" properties for each run"); n > 0; --n) planner.properties.push_back(lines.at(k++));
+    for (int r = number(" runs"); r > 0; --r) {
+      const std::string& values = lines.at(k++);
+      std::map<std::string, std::string> run;
+      std::size_t from = 0;
+      for (const std::string& name : planner.properties) {
+        const auto semi = values.find("; ", from);
+        expect(semi != std::string::npos, "as many values as properties");
+        run[name] = values.substr(from, semi - from);
+        from = semi + 2;
+      }
+      expect(from == values.size(), "no more values than properties");
+      planner.runs.push_back(run);
+    }
+    if (k < lines.size() && lines[k].find(" progress properties for each run") != std::string::npos) {
+      k += number(" progress properties for each run");
+      k += number(" runs");
+    }
+    expect(k < lines.size() && lines[k] == ".", "the planner's closing '.'");
+    ++k;
+    log.planners.push_back(planner);
+  }
+  return log;
+}
+
+TEST(BenchTool, PlanningWritesOneOmplExperimentPerProblem) {
   CLEARWAY_REQUIRE_SHARED("scenes");
   const std::string dir = tempDir("plan");
-  const ToolRun r = runTool("bench plan --subjects box_panda --plan-runs 2 --plan-time 20" + sharedArg() + " --out '" + dir + "'");
+  const ToolRun r = runTool("bench plan --subjects box_panda --plan-runs 2 --plan-time=20" + sharedArg() + " --out '" + dir + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   int logs = 0;
   for (const auto& entry : fs::directory_iterator(dir + "/plan")) {
     ++logs;
-    // OMPL's benchmark log, as ompl_benchmark_statistics.py reads it: the planner block ends with the
-    // run-property names, "N runs", N lines of as many "; "-separated values, and ".".
-    std::ifstream in(entry.path());
-    std::vector<std::string> lines;
-    for (std::string l; std::getline(in, l);) lines.push_back(l);
-    ASSERT_GT(lines.size(), 10u);
-    EXPECT_EQ(lines[1].rfind("Experiment ", 0), 0u) << entry.path();
-    std::size_t k = 0;
-    while (k < lines.size() && lines[k].find(" properties for each run") == std::string::npos) ++k;
-    ASSERT_LT(k, lines.size()) << entry.path();
-    const int properties = std::stoi(lines[k]);
-    std::vector<std::string> names(lines.begin() + k + 1, lines.begin() + k + 1 + properties);
-    EXPECT_NE(std::find(names.begin(), names.end(), "collides_dense BOOLEAN"), names.end());
-    EXPECT_NE(std::find(names.begin(), names.end(), "certified BOOLEAN"), names.end());
-    k += 1 + properties;
-    ASSERT_EQ(lines[k], "2 runs") << entry.path();
-    for (int run = 0; run < 2; ++run) {
-      const std::string& values = lines[k + 1 + run];
-      EXPECT_EQ(static_cast<int>(std::count(values.begin(), values.end(), ';')), properties) << values;
+    EXPECT_EQ(entry.path().filename().string(), "box_panda_0001.log");
+    OmplLog log;
+    ASSERT_NO_THROW(log = readOmplLog(entry.path().string()));
+    EXPECT_EQ(log.experiment["problem STRING"], "box_panda_0001");
+    // The checkers are the planners of the one experiment: Planner Arena plots them side by side.
+    ASSERT_EQ(log.planners.size(), 3u);
+    EXPECT_EQ(log.planners[0].name, "geometric_RRTConnect[certified]");  // (OMPL adds "geometric_")
+    EXPECT_EQ(log.planners[1].name, "geometric_RRTConnect[clearway-sampled]");
+    EXPECT_EQ(log.planners[2].name, "geometric_RRTConnect[fcl-sampled]");
+    for (const OmplLog::Planner& p : log.planners) {
+      ASSERT_EQ(p.runs.size(), 2u) << p.name;
+      for (const auto& run : p.runs) {
+        EXPECT_TRUE(run.count("collides_dense BOOLEAN") && run.count("certified BOOLEAN")) << p.name;
+        // No shared scene declares `clearance`: no clearance is logged (OMPL's 0 would read as measured).
+        EXPECT_EQ(run.count("solution clearance REAL"), 0u) << p.name;
+        // Every checker counts its segments, the certified one too.
+        if (run.at("solved BOOLEAN") == "1") {
+          const double fraction = std::stod(run.at("valid segment fraction REAL"));
+          EXPECT_GT(fraction, 0.0) << p.name;
+          EXPECT_LE(fraction, 1.0) << p.name;
+        }
+      }
     }
-    EXPECT_EQ(lines[k + 3], ".");
   }
-  EXPECT_EQ(logs, 3);  // certified, sampled over Clearway, sampled over FCL
+  EXPECT_EQ(logs, 1);
   // The certified checker's paths re-check as free under the dense reference.
   std::ifstream in(dir + "/results.csv");
   int plan_rows = 0;
@@ -174,11 +249,40 @@ TEST(BenchTool, PlanningWritesOmplBenchmarkLogs) {
   fs::remove_all(dir);
 }
 
+TEST(BenchTool, PlanningLogsClearanceWhereTheSceneDeclaresIt) {
+  CLEARWAY_REQUIRE_SHARED("scenes");
+  // box_panda_0001 declaring `clearance`, in a shared folder of its own (the robot by absolute path).
+  const std::string dir = tempDir("clearance");
+  const std::string shared = clearway::test::sharedDir();
+  fs::create_directories(dir + "/shared/scenes/box_panda");
+  std::ifstream in(shared + "/scenes/box_panda/box_panda_0001.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  for (std::size_t p; (p = yaml.find("../../robots/")) != std::string::npos;) yaml.replace(p, 13, shared + "/robots/");
+  const auto checks = yaml.find("checks: [self, environment]");
+  ASSERT_NE(checks, std::string::npos);
+  yaml.replace(checks, 27, "checks: [self, environment, clearance]");
+  std::ofstream(dir + "/shared/scenes/box_panda/box_panda_0001.yaml") << yaml;
+  const ToolRun r = runTool("bench plan --plan-runs 1 --plan-time 20 --shared '" + dir + "/shared' --out '" + dir + "/out'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const OmplLog log = readOmplLog(dir + "/out/plan/box_panda_0001.log");
+  ASSERT_FALSE(log.planners.empty());
+  for (const OmplLog::Planner& p : log.planners)
+    for (const auto& run : p.runs) {
+      if (run.at("solved BOOLEAN") != "1") continue;
+      ASSERT_EQ(run.count("solution clearance REAL"), 1u) << p.name;
+      // Measured by Clearway for every checker, FCL's too: a free path keeps a positive clearance.
+      EXPECT_GT(std::stod(run.at("solution clearance REAL")), 0.0) << p.name;
+    }
+  fs::remove_all(dir);
+}
+
 TEST(BenchTool, BadInputIsAClearError) {
   const std::string dir = tempDir("bad");
   ToolRun r = runTool("bench narrowphase --shard 3/3 --out '" + dir + "/x'");
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_MENTIONS(r.err, "--shard 3/3");
+  EXPECT_MENTIONS(r.err, "--shard: '3/3'");
   EXPECT_EQ(runTool("bench narrowphase --shard 1 --out '" + dir + "/x'").exit_code, 2);
   EXPECT_EQ(runTool("bench narrowphase --shard -1/2 --out '" + dir + "/x'").exit_code, 2);
   EXPECT_EQ(runTool("bench narrowphase --count 0").exit_code, 2);

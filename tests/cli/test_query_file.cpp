@@ -551,7 +551,7 @@ TEST(PlanTool, BadInput) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_MENTIONS(r.err, "/nonexistent/scene.yaml");
   EXPECT_EQ(runTool("plan " + bundledScene() + " --time -1").exit_code, 2);
-  EXPECT_EQ(runTool("plan " + bundledScene() + " --mode fuzzy").exit_code, 2);
+  EXPECT_EQ(runTool("plan " + bundledScene() + " --geometry fuzzy").exit_code, 2);
   // A start in collision: no path (exit 1), and the links are named.
   const std::string dir = testing::TempDir() + "clearway_plan_" + std::to_string(::getpid());
   std::filesystem::create_directories(dir);
@@ -621,13 +621,13 @@ TEST(MotionTool, ChecksSegments) {
   EXPECT_EQ(lines[3].rfind("error line 5", 0), 0u) << lines[3];
   EXPECT_NE(lines[3].find("wrist_3_joint"), std::string::npos) << lines[3];
   // Without --motions: start -> goal; the sampled mode with a resolution; bad modes.
-  r = runTool("motion " + bundledScene() + " --mode sampled:0.01");
+  r = runTool("motion " + bundledScene() + " --motion sampled:0.01");
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_MENTIONS(r.out, "start -> goal: collision");
-  EXPECT_EQ(runTool("motion " + bundledScene() + " --mode sampled:0").exit_code, 2);
-  EXPECT_EQ(runTool("motion " + bundledScene() + " --mode warp").exit_code, 2);
+  EXPECT_EQ(runTool("motion " + bundledScene() + " --motion sampled:0").exit_code, 2);
+  EXPECT_EQ(runTool("motion " + bundledScene() + " --motion warp").exit_code, 2);
   // The arm only turns: cast mode has nothing to cast and gives certified's verdict, word for word.
-  r = runTool("motion " + bundledScene() + " --mode cast");
+  r = runTool("motion " + bundledScene() + " --motion cast");
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.out, runTool("motion " + bundledScene()).out);
   EXPECT_MENTIONS(r.out, "start -> goal: collision");

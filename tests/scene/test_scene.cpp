@@ -35,6 +35,20 @@ std::string planarScene(const std::string& checks = "[self, environment]", const
          "checks: " + checks + "\nstart: [1.5, 0]\ngoal: [-1.5, 0]\n" + tail;
 }
 
+TEST(SceneFile, TextFromElsewhereTakesItsPathsFromTheGivenFolder) {
+  // As `clearway check -` reads stdin: the same description as the file, errors named as asked.
+  TempDir dir;
+  const std::string text = planarScene();
+  const SceneDescription from_file = parseSceneFile(dir.write("s.yaml", text));
+  const SceneDescription from_text = parseSceneText(text, "<stdin>", dir.path(""));
+  EXPECT_EQ(from_text.urdf, from_file.urdf);
+  EXPECT_EQ(from_text.group, from_file.group);
+  EXPECT_EQ(from_text.file, "<stdin>");
+  const std::string relative = "format: 1\nrobot:\n  urdf: nowhere.urdf\n  group: [a]\n";
+  EXPECT_LOAD_ERROR(parseSceneText(relative, "<stdin>", dir.path("")), "<stdin>", "key 'robot.urdf'",
+                    dir.path("nowhere.urdf"));
+}
+
 TEST(SceneFile, ParsesEveryKey) {
   TempDir dir;
   const std::string path = dir.write("s.yaml", planarScene("[self, environment]",

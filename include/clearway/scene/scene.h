@@ -93,10 +93,13 @@ struct SceneDescription {
   std::vector<double> start, goal;  ///< empty when the file gives none
 };
 
-/// Parses a scene file (DESIGN.md, "Scene files"). Throws LoadError(file, "key 'a.b'", reason) for an
+/// Parses a scene file (docs/scene-format.md). Throws LoadError(file, "key 'a.b'", reason) for an
 /// unknown key, a missing required key, a value of the wrong type or length, a non-finite number, an
 /// unknown check, or a file that is missing or not YAML.
 SceneDescription parseSceneFile(const std::string& path);
+
+/// parseSceneFile on text read elsewhere (stdin): `name` names it in errors, relative paths start at `base_dir`.
+SceneDescription parseSceneText(const std::string& yaml, const std::string& name, const std::string& base_dir);
 
 /// The robot a description names (URDF, SRDF, meshes → trees and hulls), with its attached bodies as links
 /// of their own; options.package_paths are searched before the description's. Throws LoadError.

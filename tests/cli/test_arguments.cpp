@@ -1,0 +1,198 @@
+// The tool's one argument parser (CLI11), case by case: --opt=value and --opt value, the deprecated
+// spellings (one warning each, --quiet silences them), - for stdin and stdout, --help and --version for
+// every command, the exit codes of exit_codes.h, and bad arguments named with their reason.
+#include "cli/tool_run.h"
+
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <fstream>
+#include <iterator>
+#include <string>
+
+using clearway_test::runTool;
+using clearway_test::ToolRun;
+
+namespace {
+
+#define EXPECT_MENTIONS(text, key) EXPECT_NE((text).find(key), std::string::npos) << "\"" << (text) << "\" should name " << (key)
+
+std::string source(const std::string& rel) { return "'" + std::string(CLEARWAY_SOURCE_DIR) + "/" + rel + "'"; }
+const std::string kScene = source("robots/scenes/arm6_wall.yaml");
+const std::string kUrdf = source("robots/arm6/arm6.urdf");
+const std::string kSrdf = source("robots/arm6/arm6.srdf");
+
+int count(const std::string& text, const std::string& what) {
+  int n = 0;
+  for (auto p = text.find(what); p != std::string::npos; p = text.find(what, p + 1)) ++n;
+  return n;
+}
+
+// A file in the test's temporary folder, named after this process (CTest runs tests in parallel).
+std::string writeTemp(const std::string& name, const std::string& text) {
+  const std::string path = testing::TempDir() + "clearway_args_" + std::to_string(::getpid()) + "_" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+const char* const kStates = "0 -0.6 -1.2 -1.34 0 0\n0 1.7 0.5 0 0 0\n";            // free, into the floor
+const char* const kMotions = "0 -0.6 -1.2 -1.34 0 0   0 0.6 1.2 1.34 0 0\n";  // through the wall
+
+}  // namespace
+
+TEST(Arguments, OptionEqualsValueIsTheSameAsTwoWords) {
+  const std::string states = writeTemp("states.txt", kStates);
+  const ToolRun spaced = runTool("check " + kScene + " --states '" + states + "' --geometry hull");
+  const ToolRun joined = runTool("check " + kScene + " --states='" + states + "' --geometry=hull");
+  ASSERT_EQ(spaced.exit_code, 0) << spaced.err;
+  EXPECT_EQ(joined.exit_code, 0) << joined.err;
+  EXPECT_EQ(joined.out, spaced.out);
+  // Given twice, the last value counts (scripts append "$@" after their defaults).
+  const ToolRun twice = runTool("check " + kScene + " --states '" + states + "' --geometry mesh --geometry hull");
+  EXPECT_EQ(twice.exit_code, 0) << twice.err;
+  EXPECT_EQ(twice.out, spaced.out);
+  const std::string motions = writeTemp("motions.txt", kMotions);
+  const ToolRun m = runTool("motion " + kScene + " --motions='" + motions + "' --motion=sampled:0.01 --geometry=mesh");
+  EXPECT_EQ(m.exit_code, 0) << m.err;
+  EXPECT_EQ(m.out.rfind("collision ", 0), 0u) << m.out;
+  const ToolRun a = runTool("audit " + kUrdf + " --samples=10 --threads=1 --seed=4 --quiet");
+  EXPECT_EQ(a.exit_code, 0) << a.err;
+  EXPECT_MENTIONS(a.out, "pairs");
+}
+
+TEST(Arguments, OldSpellingsWorkWithOneWarning) {
+  // check and plan: --mode was the geometry; motion: --mode was the motion mode.
+  const ToolRun now = runTool("check " + kScene + " --geometry hull --quiet");
+  ToolRun old = runTool("check " + kScene + " --mode hull --mode hull");
+  EXPECT_EQ(old.exit_code, 0) << old.err;
+  EXPECT_EQ(old.out, now.out);
+  EXPECT_EQ(count(old.err, "--mode is deprecated; use --geometry"), 1) << old.err;
+  old = runTool("check " + kScene + " --mode hull --quiet");
+  EXPECT_EQ(old.err, "");
+  const ToolRun cast = runTool("motion " + kScene + " --motion cast");
+  old = runTool("motion " + kScene + " --mode cast");
+  EXPECT_EQ(old.exit_code, 0) << old.err;
+  EXPECT_EQ(old.out, cast.out);
+  EXPECT_EQ(count(old.err, "--mode is deprecated; use --motion"), 1) << old.err;
+  EXPECT_EQ(count(cast.err, "deprecated"), 0) << cast.err;
+  old = runTool("motion " + kScene + " --mode warp");
+  EXPECT_EQ(old.exit_code, 2);
+  EXPECT_MENTIONS(old.err, "unknown motion mode 'warp'");
+  old = runTool("plan " + kScene + " --mode fuzzy");
+  EXPECT_EQ(old.exit_code, 2);
+  EXPECT_MENTIONS(old.err, "--mode: unknown geometry 'fuzzy' (mesh or hull)");
+}
+
+TEST(Arguments, DashIsStdinAndStdout) {
+  const std::string states = writeTemp("stdin_states.txt", kStates);
+  ToolRun r = runTool("check " + kScene + " --states - <'" + states + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("free\ncollision ", 0), 0u) << r.out;
+  const std::string motions = writeTemp("stdin_motions.txt", kMotions);
+  r = runTool("motion " + kScene + " --motions=- <'" + motions + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("collision ", 0), 0u) << r.out;
+  r = runTool("query - <" + source("robots/demo/queries.jsonl"));
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(count(r.out, "\n"), 5);
+  r = runTool("audit " + kUrdf + " --srdf " + kSrdf + " --samples 10 --srdf-out -");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("<?xml", 0), 0u) << r.out.substr(0, 200);
+  EXPECT_MENTIONS(r.err, "pairs differ");  // the report goes to stderr beside it
+  // A scene from stdin: its relative paths start at the working directory (absolute here).
+  std::ifstream in(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/arm6_wall.yaml");
+  std::string yaml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (std::size_t p; (p = yaml.find(": ../arm6/")) != std::string::npos;)
+    yaml.replace(p, 10, std::string(": ") + CLEARWAY_SOURCE_DIR + "/robots/arm6/");
+  const std::string scene = writeTemp("stdin_scene.yaml", yaml);
+  r = runTool("check - <'" + scene + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, runTool("check " + kScene).out);
+  r = runTool("motion - --motion sampled:0.01 <'" + scene + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("start -> goal: collision", 0), 0u) << r.out;
+  r = runTool("plan - --seed 3 --time 30 <'" + scene + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("path ", 0), 0u) << r.out;
+  r = runTool("check - --states - <'" + scene + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_MENTIONS(r.err, "cannot both be -");
+  // A folder is not an input file, - or not.
+  r = runTool("check " + kScene + " --states '" + testing::TempDir() + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_MENTIONS(r.err, "is a directory");
+}
+
+TEST(Arguments, HelpAndVersionForEveryCommand) {
+  for (const char* command : {"plan", "check", "motion", "audit", "query", "bench"}) {
+    ToolRun r = runTool(std::string(command) + " --help");
+    EXPECT_EQ(r.exit_code, 0) << command << ": " << r.err;
+    EXPECT_MENTIONS(r.out, "Exit status");
+    EXPECT_MENTIONS(r.out, std::string("clearway ") + command);
+    if (std::string(command) != "bench") EXPECT_MENTIONS(r.out, "docs/");
+    r = runTool(std::string(command) + " --version");
+    EXPECT_EQ(r.exit_code, 0) << command << ": " << r.err;
+    EXPECT_EQ(r.out, "clearway " CLEARWAY_VERSION "\n") << command;
+  }
+  ToolRun r = runTool("bench merge --help");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_MENTIONS(r.out, "SHARD_DIR");
+  r = runTool("--help");
+  EXPECT_MENTIONS(r.out, "docs/query-format.md");
+  EXPECT_MENTIONS(r.out, "docs/scene-format.md");
+  EXPECT_MENTIONS(r.out, "Exit status: 0 success; 1");
+  // The formats --help points to are in the repository.
+  for (const char* doc : {"docs/query-format.md", "docs/scene-format.md"})
+    EXPECT_TRUE(std::ifstream(std::string(CLEARWAY_SOURCE_DIR) + "/" + doc).good()) << doc;
+}
+
+TEST(Arguments, ExitCodes) {
+  const std::string states = writeTemp("exit_states.txt", std::string(kStates) + "0 1 x\n");
+  EXPECT_EQ(runTool("check " + kScene + " --states '" + states + "'").exit_code, 1);  // a bad line
+  EXPECT_EQ(runTool("check " + kScene).exit_code, 0);
+  EXPECT_EQ(runTool("check").exit_code, 2);  // usage
+  EXPECT_EQ(runTool("check /nonexistent/scene.yaml").exit_code, 2);
+  const ToolRun none = runTool("");
+  EXPECT_EQ(none.exit_code, 2);
+  EXPECT_MENTIONS(none.err, "plan");  // the usage, on stderr
+}
+
+TEST(Arguments, BadArgumentsNameTheOptionAndTheReason) {
+  struct Case {
+    std::string args, says;
+  };
+  const Case cases[] = {
+      {"plan " + kScene + " --time=abc", "--time: needs a number > 0, got 'abc'"},
+      {"plan " + kScene + " --time -1", "--time"},
+      {"plan " + kScene + " --planner Teleport", "--planner: unknown planner 'Teleport'"},
+      {"check " + kScene + " --geometry fuzzy", "--geometry: unknown geometry 'fuzzy' (mesh or hull)"},
+      {"motion " + kScene + " --motion sampled:0", "--motion: sampled:RES needs a resolution > 0, got '0'"},
+      {"check " + kScene + " --frobnicate", "--frobnicate"},
+      {"check " + kScene + " --states", "--states"},
+      {"check " + kScene + " --package-path /nonexistent/folder", "/nonexistent/folder: folder not found"},
+      {"audit " + kUrdf + " --samples 0", "--samples: needs a whole number from 1 to 100000000, got '0'"},
+      {"bench --count=x", "--count: needs a whole number"},
+      {"bench --shard 2/2", "--shard: '2/2'"},
+      {"query a b", "b"},
+      {"frobnicate", "frobnicate"},
+  };
+  for (const Case& c : cases) {
+    const ToolRun r = runTool(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args;
+    EXPECT_MENTIONS(r.err, c.says);
+    EXPECT_MENTIONS(r.err, "--help");  // where the usage is
+  }
+}
+
+TEST(Arguments, OneSeedParserForEveryCommand) {
+  for (const std::string& args : {"plan " + kScene, "audit " + kUrdf, std::string("bench narrowphase")})
+    for (const char* seed : {"-1", "1.5", "x", "18446744073709551616"}) {
+      const ToolRun r = runTool(args + " --seed " + seed);
+      EXPECT_EQ(r.exit_code, 2) << args << " --seed " << seed;
+      EXPECT_MENTIONS(r.err, std::string("--seed: needs a whole number from 0 to 2^64 - 1, got '") + seed + "'");
+    }
+  // The largest seed is a seed.
+  const ToolRun r = runTool("audit " + kUrdf + " --samples 10 --quiet --seed 18446744073709551615");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+}
