@@ -250,9 +250,6 @@ LinkGeometry::LinkGeometry(std::vector<Triangle> triangles, std::vector<Primitiv
   buildParts();
   findSolids();
   findCores();
-  std::vector<SphereTree::Placed> placed;
-  for (const Primitive& p : primitives_) placed.push_back({&p.shape, p.pose});
-  spheres_ = SphereTree(triangles_, tree_, placed);
 }
 
 void LinkGeometry::buildParts() {
@@ -419,11 +416,6 @@ bool meshesIntersect(const LinkGeometry& a, const Pose& pose_a, const LinkGeomet
   const double scale = a.boundingRadius() + b.boundingRadius() + b_in_a.t.norm();
   const double slack = padding + narrowBand(scale + padding, tol);
   if (detail::OrientedBoxTest(b_in_a, slack, scale).separated<false>(a.bounds(), b.bounds())) return false;
-  // Mesh mode: sphere trees apart, with no piece of either able to lie inside the other's closed meshes, is
-  // the exact answer "apart" without a GJK (the hull test would only have been a filter).
-  if (mode == GeometryMode::Mesh && sphereTreesApart(a.spheres(), b.spheres(), b_in_a, slack) &&
-      !mayNest(a, b, b_in_a, slack) && !mayNest(b, a, b_in_a.inverse(), slack))
-    return false;
   SimplexCache scratch;
   SimplexCache& cache = hull_cache ? *hull_cache : scratch;
   const IntersectResult hulls = gjkIntersect(Margin<ConvexHull>{a.hull(), padding}, pose_a, b.hull(), pose_b, tol, cache);
@@ -440,15 +432,6 @@ bool shapeIntersectsLink(const Shape& shape, const Pose& pose_shape, const LinkG
   if (spheresApart(pose_shape.t, boundingRadius(shape), pose_link * link.sphereCenter(), link.sphereRadius(), padding,
                    tol))
     return false;
-  // In the link's frame.
-  const Pose shape_in_link = relativePose(pose_link, pose_shape);
-  const double scale = link.boundingRadius() + shape_in_link.t.norm() + boundingRadius(shape);
-  const double slack = padding + narrowBand(scale + padding, tol);
-  // Mesh mode: the link's sphere tree apart from the shape, which cannot lie inside its closed meshes, is the
-  // exact answer "apart" without a GJK.
-  if (mode == GeometryMode::Mesh && sphereTreeApartFrom(link.spheres(), shape, shape_in_link, slack) &&
-      !shapeMayNest(link, shape, shape_in_link, slack))
-    return false;
   SimplexCache scratch;
   SimplexCache& cache = hull_cache ? *hull_cache : scratch;
   const bool hulls = std::visit(
@@ -459,7 +442,11 @@ bool shapeIntersectsLink(const Shape& shape, const Pose& pose_shape, const LinkG
       shape);
   if (!hulls) return false;
   if (mode == GeometryMode::Hull) return true;
+  // In the link's frame.
+  const Pose shape_in_link = relativePose(pose_link, pose_shape);
+  const double scale = link.boundingRadius() + shape_in_link.t.norm() + boundingRadius(shape);
   if (coreMeetsShape(shape, shape_in_link, link)) return true;
+  const double slack = padding + narrowBand(scale + padding, tol);
   if (shapeIntersectsTriangles(shape, shape_in_link, link, tol, padding, slack)) return true;
   for (const auto& p : link.primitives())
     if (shapesIntersect(shape, shape_in_link, p.shape, p.pose, tol, padding)) return true;

@@ -88,21 +88,13 @@ void LinkGeometry::findSolids() {
   }
   // Number the closed pieces; one probe (a vertex) per piece, closed or not.
   std::vector<std::int32_t> number(static_cast<std::size_t>(ids), -1);
-  std::vector<std::int32_t> piece(static_cast<std::size_t>(ids), -1);
+  std::vector<char> probed(static_cast<std::size_t>(ids), 0);
   for (std::size_t t = 0; t < n; ++t) {
     const std::int32_t root = pieces.find(id[3 * t]);
-    if (piece[root] < 0) {
-      piece[root] = static_cast<std::int32_t>(probes_.size());
+    if (!probed[root]) {
+      probed[root] = 1;
       probes_.push_back(triangles_[t].v[0]);
-      extremes_.emplace_back();
-      extremes_.back().fill(triangles_[t].v[0]);
     }
-    std::array<Vec3, 6>& far = extremes_[piece[root]];
-    for (const Vec3& v : triangles_[t].v)
-      for (int axis = 0; axis < 3; ++axis) {
-        if (v[axis] < far[2 * axis][axis]) far[2 * axis] = v;
-        if (v[axis] > far[2 * axis + 1][axis]) far[2 * axis + 1] = v;
-      }
     if (open[root]) continue;
     if (number[root] < 0) {
       number[root] = static_cast<std::int32_t>(solid_boxes_.size());
@@ -113,48 +105,8 @@ void LinkGeometry::findSolids() {
   }
   if (solid_boxes_.empty()) solid_of_.clear();
   // A primitive's core point lies in it (spheres and capsules: the centre or the axis).
-  for (const Primitive& p : primitives_) {
+  for (const Primitive& p : primitives_)
     probes_.push_back(std::visit([&](const auto& s) { return p.pose * s.support(Vec3::UnitX()); }, p.shape));
-    std::array<Vec3, 6>& far = extremes_.emplace_back();
-    for (int k = 0; k < 6; ++k) {
-      const Vec3 d = (k % 2 ? 1.0 : -1.0) * p.pose.R.row(k / 2).transpose();  // the link's axis in the shape's frame
-      far[k] = std::visit([&](const auto& s) { return p.pose * s.support(d); }, p.shape);
-    }
-  }
-}
-
-namespace {
-// True when every point lies in the box grown by slack (the points of one piece, in the box's frame).
-bool allIn(const std::array<Vec3, 6>& points, const Aabb& box, double slack) noexcept {
-  for (const Vec3& p : points)  // (a NaN coordinate is never out: in)
-    if ((p.array() < box.min.array() - slack).any() || (p.array() > box.max.array() + slack).any()) return false;
-  return true;
-}
-}  // namespace
-
-bool mayNest(const LinkGeometry& a, const LinkGeometry& b, const Pose& b_in_a, double slack) noexcept {
-  if (a.solidCount() == 0) return false;
-  if (!b_in_a.isFinite()) return true;
-  for (const std::array<Vec3, 6>& local : b.pieceExtremes()) {
-    std::array<Vec3, 6> placed;
-    for (int k = 0; k < 6; ++k) placed[k] = b_in_a * local[k];
-    for (const Aabb& box : a.solidBoxes())
-      if (allIn(placed, box, slack)) return true;
-  }
-  return false;
-}
-
-bool shapeMayNest(const LinkGeometry& link, const Shape& shape, const Pose& shape_in_link, double slack) noexcept {
-  if (link.solidCount() == 0) return false;
-  if (!shape_in_link.isFinite()) return true;
-  std::array<Vec3, 6> placed;
-  for (int k = 0; k < 6; ++k) {
-    const Vec3 d = (k % 2 ? 1.0 : -1.0) * shape_in_link.R.row(k / 2).transpose();
-    placed[k] = std::visit([&](const auto& s) { return shape_in_link * s.support(d); }, shape);
-  }
-  for (const Aabb& box : link.solidBoxes())
-    if (allIn(placed, box, slack)) return true;
-  return false;
 }
 
 int LinkGeometry::rayParity(int s, const Vec3& p, const Vec3& dir) const noexcept {

@@ -216,7 +216,6 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
   const detail::OrientedBoxTest obb(pose, slack, scale_ + maxAbs(link_box));
   const detail::OrientedBoxTest::PlacedB placed_link = obb.place(link.bounds());
   SimplexCache cache;  // one for all voxels: they are axis-aligned, so the last separating axis starts the next well
-  const Pose to_link = pose.inverse();
   int passed[kFewVoxels];
   int n_passed = 0;
   bool many = false;
@@ -233,14 +232,6 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
     double c[3], h[3];
     detail::OrientedBoxTest::centerHalf(*item.voxel, c, h);
     if (obb.separated<false>(c, h, placed_link)) return false;
-    if (mode == GeometryMode::Mesh) {  // the link's sphere tree apart from the voxel: exactly apart, no GJK
-      const Box voxel(Vec3(h[0], h[1], h[2]));
-      Pose voxel_in_link = to_link;
-      voxel_in_link.t = to_link * Vec3(c[0], c[1], c[2]);
-      if (sphereTreeApartFrom(link.spheres(), voxel, voxel_in_link, slack) &&
-          !shapeMayNest(link, voxel, voxel_in_link, slack))
-        return false;
-    }
     if (counters) ++counters->voxel_tests;
     if (!shapeIntersectsLink(Box(Vec3(h[0], h[1], h[2])), Pose::translation(Vec3(c[0], c[1], c[2])), link, pose, tol,
                              GeometryMode::Hull, padding, &cache))
@@ -326,6 +317,7 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
   }
   // No surface touches a voxel: one may still lie inside a closed mesh of the link.
   if (link.solidCount() > 0) {
+    const Pose to_link = pose.inverse();
     voxel_tree_.query(query, [&](std::int32_t v) {
       if (!link.containsPoint(to_link * voxels[v].center())) return false;
       found = v;

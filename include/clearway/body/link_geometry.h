@@ -13,7 +13,6 @@
 // throughout: touching counts as intersecting.
 //
 // Every query answers in the frames of the poses given; a LinkGeometry itself is in the link frame.
-#include <clearway/body/sphere_tree.h>
 #include <clearway/kinematics/robot_model.h>
 #include <clearway/shape/triangle_mesh.h>
 #include <clearway/narrowphase/gjk.h>
@@ -22,7 +21,6 @@
 #include <clearway/tolerances.h>
 #include <clearway/tree/aabb_tree.h>
 
-#include <array>
 #include <limits>
 #include <vector>
 
@@ -93,15 +91,6 @@ class LinkGeometry {
   /// outside the other's solids.
   const std::vector<Vec3>& probes() const noexcept { return probes_; }
 
-  /// Balls over every triangle and primitive (sphere_tree.h): the rung between the bounding ball and the hull.
-  const SphereTree& spheres() const noexcept { return spheres_; }
-  /// The box (link frame) of each closed piece: whatever lies inside that piece lies inside its box.
-  const std::vector<Aabb>& solidBoxes() const noexcept { return solid_boxes_; }
-  /// Six points of each connected piece (as probes()), link frame: its vertices farthest along −x, +x, −y,
-  /// +y, −z, +z (a primitive's support points). A piece lies inside a closed mesh only if all six lie in
-  /// that mesh's box.
-  const std::vector<std::array<Vec3, 6>>& pieceExtremes() const noexcept { return extremes_; }
-
   /// A ball, link frame.
   struct Ball {
     Vec3 center;
@@ -137,9 +126,7 @@ class LinkGeometry {
   std::vector<std::int32_t> solid_of_;  // per triangle: its closed piece, −1 for an open one
   std::vector<Aabb> solid_boxes_;       // per closed piece
   std::vector<Vec3> probes_;
-  std::vector<std::array<Vec3, 6>> extremes_;  // per piece, as probes_
   std::vector<Ball> cores_;
-  SphereTree spheres_;
 };
 
 /// The box, in the frame `pose` is given in, of a convex shape placed by it: 6 support queries plus its
@@ -168,12 +155,6 @@ bool linkContained(const LinkGeometry& a, const LinkGeometry& b, const Pose& b_i
 /// True when the convex shape (placed in the link's frame) lies inside one of the link's closed meshes,
 /// given that it meets none of the link's triangles.
 bool shapeInsideLink(const Shape& shape, const Pose& shape_in_link, const LinkGeometry& link) noexcept;
-
-/// False when no piece of `b` (placed in a's frame by b_in_a) can lie inside a closed mesh of `a`: each has
-/// a point outside every closed piece's box grown by `slack`. True proves nothing; a NaN pose gives true.
-bool mayNest(const LinkGeometry& a, const LinkGeometry& b, const Pose& b_in_a, double slack) noexcept;
-/// The same for a convex shape (placed in the link's frame) inside one of the link's closed meshes.
-bool shapeMayNest(const LinkGeometry& link, const Shape& shape, const Pose& shape_in_link, double slack) noexcept;
 
 /// True when a core of `a` and a core of `b` overlap (b placed in a's frame by b_in_a): the links collide.
 /// False proves nothing. The comparison keeps a margin far above the rounding of placing the centres.
