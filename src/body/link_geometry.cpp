@@ -404,26 +404,42 @@ double partsBound(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry&
 }
 }  // namespace
 
-bool meshesIntersect(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
-                     const Tolerances& tol, GeometryMode mode, double padding, SimplexCache* hull_cache) noexcept {
-  if (!pose_a.isFinite() || !pose_b.isFinite() || !validPadding(padding)) return true;
+Screen screenMeshes(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                    const Tolerances& tol, GeometryMode mode, double padding, SimplexCache* hull_cache) noexcept {
+  if (!pose_a.isFinite() || !pose_b.isFinite() || !validPadding(padding)) return Screen::Touching;
   // Conservative filters from cheapest to dearest: bounding spheres, the boxes of the hulls as oriented
-  // boxes (6 face axes), the hulls (GJK); then the exact geometry.
+  // boxes (6 face axes), the hulls (GJK), the cores.
   if (spheresApart(pose_a * a.sphereCenter(), a.sphereRadius(), pose_b * b.sphereCenter(), b.sphereRadius(), padding,
                    tol))
-    return false;
+    return Screen::Apart;
   const Pose b_in_a = relativePose(pose_a, pose_b);
   const double scale = a.boundingRadius() + b.boundingRadius() + b_in_a.t.norm();
   const double slack = padding + narrowBand(scale + padding, tol);
-  if (detail::OrientedBoxTest(b_in_a, slack, scale).separated<false>(a.bounds(), b.bounds())) return false;
+  if (detail::OrientedBoxTest(b_in_a, slack, scale).separated<false>(a.bounds(), b.bounds())) return Screen::Apart;
   SimplexCache scratch;
   SimplexCache& cache = hull_cache ? *hull_cache : scratch;
   const IntersectResult hulls = gjkIntersect(Margin<ConvexHull>{a.hull(), padding}, pose_a, b.hull(), pose_b, tol, cache);
-  if (!hulls.intersecting) return false;
-  if (mode == GeometryMode::Hull) return true;
+  if (!hulls.intersecting) return Screen::Apart;
+  if (mode == GeometryMode::Hull) return Screen::Touching;
   // Overlapping cores settle deep contacts before the triangle search, which is slowest exactly there.
-  if (coresOverlap(a, b, b_in_a)) return true;
+  if (coresOverlap(a, b, b_in_a)) return Screen::Touching;
+  return Screen::Unsure;
+}
+
+bool meshesIntersectExactly(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                            const Tolerances& tol, double padding) noexcept {
+  if (!pose_a.isFinite() || !pose_b.isFinite() || !validPadding(padding)) return true;
+  const Pose b_in_a = relativePose(pose_a, pose_b);
+  const double scale = a.boundingRadius() + b.boundingRadius() + b_in_a.t.norm();
+  const double slack = padding + narrowBand(scale + padding, tol);
   return exactIntersect(a, b, b_in_a, tol, padding, slack) || linkContained(a, b, b_in_a);
+}
+
+bool meshesIntersect(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                     const Tolerances& tol, GeometryMode mode, double padding, SimplexCache* hull_cache) noexcept {
+  const Screen s = screenMeshes(a, pose_a, b, pose_b, tol, mode, padding, hull_cache);
+  if (s != Screen::Unsure) return s == Screen::Touching;
+  return meshesIntersectExactly(a, pose_a, b, pose_b, tol, padding);
 }
 
 bool shapeIntersectsLink(const Shape& shape, const Pose& pose_shape, const LinkGeometry& link, const Pose& pose_link,

@@ -21,6 +21,15 @@ bool BodyPair::intersects(const Pose& pose_a, const Pose& pose_b, const Toleranc
   return meshesIntersect(*a_, pose_a, *b_, pose_b, tol, q.mode, q.padding, &hull_);
 }
 
+Screen BodyPair::screen(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, const IntersectQuery& q) noexcept {
+  return screenMeshes(*a_, pose_a, *b_, pose_b, tol, q.mode, q.padding, &hull_);
+}
+
+bool BodyPair::intersectsExactly(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol,
+                                 double padding) const noexcept {
+  return meshesIntersectExactly(*a_, pose_a, *b_, pose_b, tol, padding);
+}
+
 double BodyPair::lowerBound(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol,
                             const BoundQuery& q) noexcept {
   if (!pose_a.isFinite() || !pose_b.isFinite()) return 0.0;

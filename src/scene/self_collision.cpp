@@ -40,6 +40,7 @@ SelfCollisionContext SelfCollision::makeContext() const {
   c.bodies.reserve(pairs_.size());
   for (const LinkPair& p : pairs_) c.bodies.emplace_back(*geometry_->link(p.a), *geometry_->link(p.b));
   c.balls = EnclosingBalls(*geometry_);
+  c.unsure.reserve(pairs_.size());
   return c;
 }
 
@@ -68,15 +69,35 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
   // A pair that collided a moment ago probably still does: trying it first ends most colliding queries
   // of a planner exploring near an obstacle after one pair test.
   if (ctx.last_hit >= 0 && ctx.last_hit < n && pairHits(ctx.last_hit, poses, ctx, balls)) return &pairs_[ctx.last_hit];
+  // Two passes: the cheap rungs for every pair first, so that a collision they settle (overlapping cores)
+  // ends the query before any pair's triangle search; then the triangles of the pairs they left unsure.
+  const bool two_pass = static_cast<int>(ctx.bodies.size()) == n && static_cast<int>(ctx.unsure.capacity()) >= n;
+  if (two_pass) ctx.unsure.clear();
   for (int k = 0; k < n; ++k) {
     if (k == ctx.last_hit) continue;
-    if (pairHits(k, poses, ctx, balls)) {
-      ctx.last_hit = k;
-      return &pairs_[k];
+    if (!two_pass) {
+      if (pairHits(k, poses, ctx, balls)) return hit(k, ctx);
+      continue;
     }
+    const LinkPair& p = pairs_[k];
+    ++ctx.pair_tests;
+    if (balls && ctx.balls.apart(p.a, p.b, pair_padding_[k], options_.tolerances)) continue;
+    const Screen s = ctx.bodies[k].screen(poses[p.a], poses[p.b], options_.tolerances, {pair_padding_[k], options_.mode});
+    if (s == Screen::Touching) return hit(k, ctx);
+    if (s == Screen::Unsure) ctx.unsure.push_back(k);
   }
+  if (two_pass)
+    for (int k : ctx.unsure) {
+      const LinkPair& p = pairs_[k];
+      if (ctx.bodies[k].intersectsExactly(poses[p.a], poses[p.b], options_.tolerances, pair_padding_[k])) return hit(k, ctx);
+    }
   ctx.last_hit = -1;
   return nullptr;
+}
+
+const LinkPair* SelfCollision::hit(int k, SelfCollisionContext& ctx) const noexcept {
+  ctx.last_hit = k;
+  return &pairs_[k];
 }
 
 void SelfCollision::allCollisions(const Pose* poses, SelfCollisionContext& ctx, std::vector<LinkPair>& out) const {

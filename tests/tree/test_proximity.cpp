@@ -105,6 +105,39 @@ TEST(BodyPair, LadderBoundsTheBruteForceDistance) {
   EXPECT_GT(within_clear, cases / 10);
 }
 
+// The screen and the exact rung together answer as intersects() does, in both modes and with padding; the
+// screen settles some pairs each way and leaves some to the triangles (else the split would test nothing).
+TEST(BodyPair, ScreenThenTrianglesAnswerAsIntersects) {
+  const std::vector<Named> m = meshes();
+  std::vector<LinkGeometry> g;
+  for (const Named& n : m) g.emplace_back(n.mesh);
+  const Tolerances tol;
+  std::mt19937_64 rng(17);
+  int counts[3] = {0, 0, 0};
+  for (std::size_t i = 0; i < m.size(); ++i)
+    for (std::size_t j = i; j < m.size(); ++j) {
+      BodyPair split(g[i], g[j]), whole(g[i], g[j]);
+      const double reach = 0.9 * (tree_ref::meshRadius(m[i].mesh) + tree_ref::meshRadius(m[j].mesh));
+      for (int c = 0; c < 60; ++c) {
+        const Pose pa = randomPose(rng, 0.1);
+        Pose pb = randomPose(rng, reach);
+        pb.t += pa.t;
+        for (GeometryMode mode : {GeometryMode::Mesh, GeometryMode::Hull}) {
+          const IntersectQuery q{c % 4 == 0 ? 0.01 : 0.0, mode};
+          const Screen s = split.screen(pa, pb, tol, q);
+          if (mode == GeometryMode::Mesh) ++counts[static_cast<int>(s)];
+          if (mode == GeometryMode::Hull) EXPECT_NE(s, Screen::Unsure);
+          const bool answer = s == Screen::Unsure ? split.intersectsExactly(pa, pb, tol, q.padding) : s == Screen::Touching;
+          EXPECT_EQ(answer, whole.intersects(pa, pb, tol, q)) << m[i].name << " vs " << m[j].name << " case " << c;
+        }
+      }
+    }
+  std::printf("  Mesh mode: %d apart, %d touching, %d left to the triangles by the screen\n", counts[0], counts[1], counts[2]);
+  EXPECT_GT(counts[0], 0);
+  EXPECT_GT(counts[1], 0);
+  EXPECT_GT(counts[2], 0);
+}
+
 TEST(BodyPair, PenetrationBoundsTheOverlap) {
   // Two unit-ish boxes (closed meshes) overlapping by a known depth along x: their hulls are the boxes.
   const LinkGeometry a(tree_ref::gridBox(Vec3(0.1, 0.1, 0.1), 2)), b(tree_ref::gridBox(Vec3(0.05, 0.05, 0.05), 2));

@@ -175,6 +175,18 @@ bool meshesIntersect(const LinkGeometry& a, const Pose& pose_a, const LinkGeomet
                      const Tolerances& tol, GeometryMode mode, double padding = 0.0,
                      SimplexCache* hull_cache = nullptr) noexcept;
 
+/// What the cheap rungs of meshesIntersect (bounding balls, boxes, hulls, cores) tell of a pair.
+enum class Screen : char { Apart, Touching, Unsure };
+/// meshesIntersect's rungs short of the triangles: Apart or Touching where they settle it (the answer
+/// meshesIntersect gives), Unsure where only meshesIntersectExactly can. Hull mode is never Unsure.
+Screen screenMeshes(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                    const Tolerances& tol, GeometryMode mode, double padding = 0.0,
+                    SimplexCache* hull_cache = nullptr) noexcept;
+/// The exact rung of meshesIntersect in Mesh mode (triangles, primitives, closed meshes as solids), for a pair
+/// the screen left Unsure; meshesIntersect's answer there.
+bool meshesIntersectExactly(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                            const Tolerances& tol, double padding = 0.0) noexcept;
+
 /// A certified lower bound on the distance between two links from their convex parts (0 when parts
 /// touch): the least over part pairs, each pair's GJK stopping once it reaches `enough` metres or is
 /// within `relative` of its distance. Between the hulls' bound and meshDistance in cost and tightness.

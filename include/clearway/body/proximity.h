@@ -55,6 +55,10 @@ class BodyPair {
   /// True when the bodies (placed by the poses) are within q.padding of each other: meshesIntersect, warm.
   /// Never "free" by accident (non-finite input, a narrow-phase failure: true).
   bool intersects(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, const IntersectQuery& q) noexcept;
+  /// intersects() split in two: its rungs short of the triangles (screenMeshes, warm), then, for an Unsure
+  /// pair, the triangles (meshesIntersectExactly). Together they answer as intersects() does.
+  Screen screen(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, const IntersectQuery& q) noexcept;
+  bool intersectsExactly(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, double padding) const noexcept;
   /// A certified lower bound on the distance between the bodies (see BoundQuery); 0 for non-finite input or
   /// a narrow-phase failure.
   double lowerBound(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, const BoundQuery& q) noexcept;

@@ -34,6 +34,7 @@ struct SelfCollisionOptions {
 struct SelfCollisionContext {
   std::vector<BodyPair> bodies;  ///< per checked pair: its two links' geometry and warm starts
   EnclosingBalls balls;          ///< the links' enclosing balls at the current query's poses
+  std::vector<int> unsure;       ///< pairs the cheap rungs left to the triangles (scratch of one query)
   int last_hit = -1;
   long long pair_tests = 0;  ///< pairs that reached the narrow phase (bounding spheres not apart), cumulative
 };
@@ -74,6 +75,8 @@ class SelfCollision {
  private:
   // pairCollides, first asking the context's enclosing balls (placed for these poses by the caller).
   bool pairHits(int k, const Pose* link_poses, SelfCollisionContext& context, bool balls_placed) const noexcept;
+  // Records pair k as the last hit and returns it.
+  const LinkPair* hit(int k, SelfCollisionContext& context) const noexcept;
   // Places the context's balls when it has them (a context made by makeContext); false otherwise.
   bool placeBalls(const Pose* link_poses, SelfCollisionContext& context) const noexcept;
 
