@@ -1,5 +1,6 @@
 #include <clearway/scene/audit.h>
 
+#include <clearway/body/proximity.h>
 #include <clearway/kinematics/forward_kinematics.h>
 
 #include <tinyxml2.h>
@@ -162,6 +163,10 @@ std::vector<PairAudit> auditSelfCollision(std::shared_ptr<const RobotGeometry> g
       configurations[static_cast<std::size_t>(s) * model.variableCount() + v] = x;
     }
 
+  // A Default pair's clearance is 0 (it collided at the default configuration): it is not measured.
+  std::vector<char> measured(result.size(), 0);
+  for (const int k : sampled_pairs) measured[k] = result[k].reason != "Default";
+
   // Each thread takes every threads-th sample and keeps its own counts and minima; merged after.
   struct Partial {
     std::vector<int> colliding;
@@ -175,6 +180,9 @@ std::vector<PairAudit> auditSelfCollision(std::shared_ptr<const RobotGeometry> g
     mine.colliding.assign(result.size(), 0);
     mine.min_clearance.assign(result.size(), std::numeric_limits<double>::infinity());
     std::vector<Pose> ps(n_links);
+    std::vector<BodyPair> bodies;  // the pairs' warm starts, this thread's own
+    bodies.reserve(result.size());
+    for (const PairAudit& p : result) bodies.emplace_back(*geometry->link(p.a), *geometry->link(p.b));
     for (int s = t; s < options.samples; s += options.threads) {
       // data() + offset: a robot without joints has no configurations to index (&v[0] of an empty vector).
       computeLinkPoses(model, configurations.data() + static_cast<std::size_t>(s) * model.variableCount(), ps.data());
@@ -185,15 +193,14 @@ std::vector<PairAudit> auditSelfCollision(std::shared_ptr<const RobotGeometry> g
           mine.min_clearance[k] = 0.0;
           continue;
         }
-        // The smallest clearance: the hulls' distance (one GJK call) bounds it from below, so the exact
-        // distance is needed only when the hulls come nearer than the smallest clearance yet, and then
-        // only a distance below it matters: as the cutoff, it prunes element pairs farther apart.
-        const LinkGeometry& ga = *geometry->link(p.a);
-        const LinkGeometry& gb = *geometry->link(p.b);
-        const DistanceResult h = gjkDistance(ga.hull(), ps[p.a], gb.hull(), ps[p.b], tol);
-        if (!isFailure(h.status) && h.lower_bound >= mine.min_clearance[k]) continue;
-        const DistanceResult d = meshDistance(ga, ps[p.a], gb, ps[p.b], tol, 0.0, mine.min_clearance[k]);
-        if (!isFailure(d.status)) mine.min_clearance[k] = std::min(mine.min_clearance[k], d.distance);
+        // The smallest clearance is a running minimum, so only a distance below it matters: as the cutoff,
+        // it lets the balls, hulls and convex parts skip a sample they prove farther, and prunes element pairs.
+        double& least = mine.min_clearance[k];
+        if (!measured[k] || !(least > 0.0)) continue;
+        DistanceQuery q;
+        q.cutoff = least;
+        const DistanceResult d = bodies[k].distance(ps[p.a], ps[p.b], tol, q);
+        if (!isFailure(d.status) && d.distance < q.cutoff) least = d.distance;
       }
       const int now = done.fetch_add(1, std::memory_order_relaxed) + 1;
       // Only the calling thread reports, so the callback needs no locking.
