@@ -166,6 +166,11 @@ std::vector<PairAudit> auditSelfCollision(std::shared_ptr<const RobotGeometry> g
   // A Default pair's clearance is 0 (it collided at the default configuration): it is not measured.
   std::vector<char> measured(result.size(), 0);
   for (const int k : sampled_pairs) measured[k] = result[k].reason != "Default";
+  // GJK gives each distance to tol.gjk_relative only. A pair that a joint turns about an axis of both (the
+  // UR5's wrist_2_link and the gripper's links) is equally far at every sample, its distances differing in
+  // that last digit alone, and each sample would search the triangles again to tell which is least: so
+  // only a distance more than twice that below the smallest yet counts.
+  const double tie = 1.0 - 2.0 * tol.gjk_relative;
 
   // Each thread takes every threads-th sample and keeps its own counts and minima; merged after.
   struct Partial {
@@ -198,7 +203,7 @@ std::vector<PairAudit> auditSelfCollision(std::shared_ptr<const RobotGeometry> g
         double& least = mine.min_clearance[k];
         if (!measured[k] || !(least > 0.0)) continue;
         DistanceQuery q;
-        q.cutoff = least;
+        q.cutoff = least * tie;
         const DistanceResult d = bodies[k].distance(ps[p.a], ps[p.b], tol, q);
         if (!isFailure(d.status) && d.distance < q.cutoff) least = d.distance;
       }
