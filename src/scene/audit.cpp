@@ -55,15 +55,16 @@ bool rigidPair(const RobotModel& model, int a, int b) {
   return true;
 }
 
-// log P(X ≤ k) for X ~ Binomial(n, p), summed in log space.
-double logBinomialCdf(int k, int n, double p) {
+// log P(X ≤ k) for X ~ Binomial(n, p), summed in log space; log_choose[i] = log C(n, i) for i = 0 … k.
+double logBinomialCdf(const std::vector<double>& log_choose, int n, double p) {
+  const int k = static_cast<int>(log_choose.size()) - 1;
   if (p <= 0.0) return 0.0;
   if (p >= 1.0) return k >= n ? 0.0 : -std::numeric_limits<double>::infinity();
+  const double log_p = std::log(p), log_q = std::log1p(-p);
   // A running log-sum-exp: the sum is rescaled whenever a larger term arrives.
   double best = -std::numeric_limits<double>::infinity(), sum = 0.0;
   for (int i = 0; i <= k; ++i) {
-    const double term = std::lgamma(n + 1.0) - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0) + i * std::log(p) +
-                        (n - i) * std::log1p(-p);
+    const double term = log_choose[i] + i * log_p + (n - i) * log_q;
     if (term > best) {
       sum = sum * std::exp(best - term) + 1.0;
       best = term;
@@ -79,13 +80,17 @@ double logBinomialCdf(int k, int n, double p) {
 double clopperPearsonUpper(int k, int n) {
   if (n <= 0 || k >= n) return 1.0;
   if (k == 0) return 1.0 - std::pow(0.05, 1.0 / n);  // the closed form of the case below
+  // log C(n, i) does not depend on p: computed once, not at each step of the bisection (summed as before,
+  // so the answer is the same to the bit).
+  std::vector<double> log_choose(k + 1);
+  for (int i = 0; i <= k; ++i) log_choose[i] = std::lgamma(n + 1.0) - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0);
   // The p at which P(X ≤ k) falls to 5%: P(X ≤ k) decreases in p, so bisection; 100 halvings of [0, 1]
   // reach double precision.
   double lo = static_cast<double>(k) / n, hi = 1.0;
   const double target = std::log(0.05);
   for (int it = 0; it < 100 && hi - lo > 1e-15; ++it) {
     const double mid = 0.5 * (lo + hi);
-    (logBinomialCdf(k, n, mid) > target ? lo : hi) = mid;
+    (logBinomialCdf(log_choose, n, mid) > target ? lo : hi) = mid;
   }
   return hi;
 }
