@@ -1,5 +1,6 @@
 #include <clearway/scene/audit.h>
 
+#include <clearway/body/proximity.h>
 #include <clearway/kinematics/forward_kinematics.h>
 
 #include <tinyxml2.h>
@@ -54,15 +55,16 @@ bool rigidPair(const RobotModel& model, int a, int b) {
   return true;
 }
 
-// log P(X ≤ k) for X ~ Binomial(n, p), summed in log space.
-double logBinomialCdf(int k, int n, double p) {
+// log P(X ≤ k) for X ~ Binomial(n, p), summed in log space; log_choose[i] = log C(n, i) for i = 0 … k.
+double logBinomialCdf(const std::vector<double>& log_choose, int n, double p) {
+  const int k = static_cast<int>(log_choose.size()) - 1;
   if (p <= 0.0) return 0.0;
   if (p >= 1.0) return k >= n ? 0.0 : -std::numeric_limits<double>::infinity();
+  const double log_p = std::log(p), log_q = std::log1p(-p);
   // A running log-sum-exp: the sum is rescaled whenever a larger term arrives.
   double best = -std::numeric_limits<double>::infinity(), sum = 0.0;
   for (int i = 0; i <= k; ++i) {
-    const double term = std::lgamma(n + 1.0) - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0) + i * std::log(p) +
-                        (n - i) * std::log1p(-p);
+    const double term = log_choose[i] + i * log_p + (n - i) * log_q;
     if (term > best) {
       sum = sum * std::exp(best - term) + 1.0;
       best = term;
@@ -78,13 +80,17 @@ double logBinomialCdf(int k, int n, double p) {
 double clopperPearsonUpper(int k, int n) {
   if (n <= 0 || k >= n) return 1.0;
   if (k == 0) return 1.0 - std::pow(0.05, 1.0 / n);  // the closed form of the case below
+  // log C(n, i) does not depend on p: computed once, not at each step of the bisection (summed as before,
+  // so the answer is the same to the bit).
+  std::vector<double> log_choose(k + 1);
+  for (int i = 0; i <= k; ++i) log_choose[i] = std::lgamma(n + 1.0) - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0);
   // The p at which P(X ≤ k) falls to 5%: P(X ≤ k) decreases in p, so bisection; 100 halvings of [0, 1]
   // reach double precision.
   double lo = static_cast<double>(k) / n, hi = 1.0;
   const double target = std::log(0.05);
   for (int it = 0; it < 100 && hi - lo > 1e-15; ++it) {
     const double mid = 0.5 * (lo + hi);
-    (logBinomialCdf(k, n, mid) > target ? lo : hi) = mid;
+    (logBinomialCdf(log_choose, n, mid) > target ? lo : hi) = mid;
   }
   return hi;
 }
@@ -162,6 +168,15 @@ std::vector<PairAudit> auditSelfCollision(std::shared_ptr<const RobotGeometry> g
       configurations[static_cast<std::size_t>(s) * model.variableCount() + v] = x;
     }
 
+  // A Default pair's clearance is 0 (it collided at the default configuration): it is not measured.
+  std::vector<char> measured(result.size(), 0);
+  for (const int k : sampled_pairs) measured[k] = result[k].reason != "Default";
+  // GJK gives each distance to tol.gjk_relative only. A pair that a joint turns about an axis of both (the
+  // UR5's wrist_2_link and the gripper's links) is equally far at every sample, its distances differing in
+  // that last digit alone, and each sample would search the triangles again to tell which is least: so
+  // only a distance more than twice that below the smallest yet counts.
+  const double tie = 1.0 - 2.0 * tol.gjk_relative;
+
   // Each thread takes every threads-th sample and keeps its own counts and minima; merged after.
   struct Partial {
     std::vector<int> colliding;
@@ -175,6 +190,9 @@ std::vector<PairAudit> auditSelfCollision(std::shared_ptr<const RobotGeometry> g
     mine.colliding.assign(result.size(), 0);
     mine.min_clearance.assign(result.size(), std::numeric_limits<double>::infinity());
     std::vector<Pose> ps(n_links);
+    std::vector<BodyPair> bodies;  // the pairs' warm starts, this thread's own
+    bodies.reserve(result.size());
+    for (const PairAudit& p : result) bodies.emplace_back(*geometry->link(p.a), *geometry->link(p.b));
     for (int s = t; s < options.samples; s += options.threads) {
       // data() + offset: a robot without joints has no configurations to index (&v[0] of an empty vector).
       computeLinkPoses(model, configurations.data() + static_cast<std::size_t>(s) * model.variableCount(), ps.data());
@@ -185,15 +203,14 @@ std::vector<PairAudit> auditSelfCollision(std::shared_ptr<const RobotGeometry> g
           mine.min_clearance[k] = 0.0;
           continue;
         }
-        // The smallest clearance: the hulls' distance (one GJK call) bounds it from below, so the exact
-        // distance is needed only when the hulls come nearer than the smallest clearance yet, and then
-        // only a distance below it matters: as the cutoff, it prunes element pairs farther apart.
-        const LinkGeometry& ga = *geometry->link(p.a);
-        const LinkGeometry& gb = *geometry->link(p.b);
-        const DistanceResult h = gjkDistance(ga.hull(), ps[p.a], gb.hull(), ps[p.b], tol);
-        if (!isFailure(h.status) && h.lower_bound >= mine.min_clearance[k]) continue;
-        const DistanceResult d = meshDistance(ga, ps[p.a], gb, ps[p.b], tol, 0.0, mine.min_clearance[k]);
-        if (!isFailure(d.status)) mine.min_clearance[k] = std::min(mine.min_clearance[k], d.distance);
+        // The smallest clearance is a running minimum, so only a distance below it matters: as the cutoff,
+        // it lets the balls, hulls and convex parts skip a sample they prove farther, and prunes element pairs.
+        double& least = mine.min_clearance[k];
+        if (!measured[k] || !(least > 0.0)) continue;
+        DistanceQuery q;
+        q.cutoff = least * tie;
+        const DistanceResult d = bodies[k].distance(ps[p.a], ps[p.b], tol, q);
+        if (!isFailure(d.status) && d.distance < q.cutoff) least = d.distance;
       }
       const int now = done.fetch_add(1, std::memory_order_relaxed) + 1;
       // Only the calling thread reports, so the callback needs no locking.

@@ -1,7 +1,7 @@
 // BodyPair (body/proximity.h): the ladder's bound never exceeds the brute-force distance of
 // tests/tree/mesh_reference.h, `within` decides as the reference does, Hull mode is never tighter than
-// Mesh mode, forgetting the warm starts gives a fresh pair's answers bit for bit, and bad input is
-// never "far".
+// Mesh mode, forgetting the warm starts gives a fresh pair's answers bit for bit, a distance with a cutoff
+// is meshDistance's, and bad input is never "far".
 #include <clearway/body/proximity.h>
 
 #include <gtest/gtest.h>
@@ -45,7 +45,7 @@ TEST(BodyPair, LadderBoundsTheBruteForceDistance) {
   for (const Named& n : m) g.emplace_back(n.mesh);
   const Tolerances tol;
   std::mt19937_64 rng(7);
-  int exact = 0, within_hits = 0, within_clear = 0, cases = 0;
+  int exact = 0, within_hits = 0, within_clear = 0, cut_short = 0, cases = 0;
   for (std::size_t i = 0; i < m.size(); ++i) {
     for (std::size_t j = i; j < m.size(); ++j) {
       BodyPair pair(g[i], g[j]);  // warm starts carried from case to case, as along a segment
@@ -95,14 +95,27 @@ TEST(BodyPair, LadderBoundsTheBruteForceDistance) {
             << what;
         const DistanceResult d = pair.distance(pa, pb, tol, {});
         EXPECT_NEAR(d.distance, ref, 1e-7) << what;
+        // A finite cutoff: bodies at least that far apart answer it (the convex rungs, warm, may say so
+        // before any triangle), nearer ones meshDistance's distance to the digit.
+        DistanceQuery cut;
+        cut.cutoff = 0.5 * ref;
+        if (ref > kBand) {
+          EXPECT_EQ(pair.distance(pa, pb, tol, cut).distance, cut.cutoff) << what;
+          if (pair.lastRung() != Rung::Exact) ++cut_short;
+        }
+        cut.cutoff = 2.0 * ref + 0.01;
+        EXPECT_EQ(pair.distance(pa, pb, tol, cut).distance,
+                  meshDistance(g[i], pa, g[j], pb, tol, 0.0, cut.cutoff).distance)
+            << what;
       }
     }
   }
-  std::printf("  %d cases: %d reached the triangles, %d within 1 cm, %d beyond\n", cases, exact, within_hits,
-              within_clear);
+  std::printf("  %d cases: %d reached the triangles, %d within 1 cm, %d beyond, %d cut off before the triangles\n",
+              cases, exact, within_hits, within_clear, cut_short);
   EXPECT_GT(exact, cases / 10);
   EXPECT_GT(within_hits, cases / 10);
   EXPECT_GT(within_clear, cases / 10);
+  EXPECT_GT(cut_short, cases / 4) << "the convex rungs should answer most distances cut off at half";
 }
 
 // The screen and the exact rung together answer as intersects() does, in both modes and with padding; the
@@ -187,6 +200,13 @@ TEST(BodyPair, NeverFarByAccident) {
   const LinkGeometry small(tree_ref::gridBox(Vec3(0.01, 0.01, 0.01), 1));
   BodyPair inside(a, small);
   EXPECT_EQ(inside.lowerBound(Pose(), Pose(), tol, {}), 0.0);
+  // A distance with a cutoff: a bad pose or cutoff is a failure, and a body inside a solid is 0 away, not cut off.
+  DistanceQuery cut;
+  cut.cutoff = 0.05;
+  EXPECT_TRUE(pair.distance(Pose(), bad, tol, cut).mayCollide());
+  EXPECT_EQ(inside.distance(Pose(), Pose(), tol, cut).distance, 0.0);
+  cut.cutoff = nan;
+  EXPECT_TRUE(pair.distance(Pose(), Pose::translation(Vec3(5, 0, 0)), tol, cut).mayCollide());
 }
 
 }  // namespace

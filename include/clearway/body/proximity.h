@@ -66,19 +66,24 @@ class BodyPair {
   /// apart than padding): the hulls' EPA depth plus padding, the hulls containing the bodies. NaN when EPA
   /// fails or the input is not finite (never a depth of 0 by accident).
   double penetration(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, double padding = 0.0) const noexcept;
-  /// The distance between the exact geometries: meshDistance.
+  /// The distance between the exact geometries: meshDistance's answer, but with a finite q.cutoff the balls,
+  /// hulls and parts (warm) are asked first, and bodies they prove that far apart answer the cutoff at once.
   DistanceResult distance(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol,
-                          const DistanceQuery& q) const noexcept;
+                          const DistanceQuery& q) noexcept;
 
   /// Drops the warm starts (O(1): the parts' are emptied when next used), so that the next answers
   /// depend on nothing asked before.
   void forget() noexcept;
   /// The hulls' last GJK axis (valid once a query has reached the hulls).
   const SimplexCache& hullAxis() const noexcept { return hull_; }
-  /// The rung the last lowerBound() stopped at.
+  /// The rung the last lowerBound() or distance() stopped at.
   Rung lastRung() const noexcept { return rung_; }
 
  private:
+  // The balls, the hulls, then (in Mesh mode, while the bound is at most `climb`) the convex parts; sets rung_.
+  double convexBound(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, double enough, double relative,
+                     double climb, GeometryMode mode) noexcept;
+
   const LinkGeometry* a_;
   const LinkGeometry* b_;
   SimplexCache hull_;

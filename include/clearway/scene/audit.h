@@ -42,7 +42,9 @@ struct PairAudit {
   /// 95% upper confidence bound on the collision probability; exact (0 or 1) for a rigid pair, whose links
   /// no sampled joint moves apart, measured once for all samples.
   double p_upper = 1.0;
-  double min_clearance = 0;  ///< smallest exact distance seen (0 when it collided; NaN when not measured)
+  /// Smallest exact distance seen (0 when it collided; NaN when not measured), or one at most 2·gjk_relative
+  /// (relative) above it: each distance is exact to gjk_relative only.
+  double min_clearance = 0;
   bool near_miss = false;    ///< Never, but closer than near_margin at some sample
   /// Why the verdict may mislead ("" when it does not): a Default pair that collides in more than
   /// warn_fraction of the samples, or a checked pair that collides in more than most_fraction.
