@@ -426,6 +426,14 @@ TEST_F(BadInput, ColladaThatAssimpCannotSurvive) {
       {"uncounted.dae", uncounted(), "<accessor> (line 6)", "reaches value 12 of 'pa', which holds 0"},
       {"stride.dae", collada(kTetP, kTetNode, "<node id=\"n\"/>", "0 0 0 1 0 0 0 1 0 0 0 1", 4, "count=\"4\" stride=\"-3\""),
        "<accessor>", "stride=\"-3\" is not a whole number"},
+      // Found by fuzz_mesh_dae: a form feed (or vertical tab) between indices, which assimp's list reader
+      // does not skip: it read a 0 index at the same place forever, until memory ran out (2.4 GB).
+      {"form_feed.dae", collada("0 2 1 0 1 3\f0 3 2 1 2 3", kTetNode, "<node id=\"n\"/>"), "<p> (line 9)",
+       "'3\\x0C0' is not an integer"},
+      {"vertical_tab.dae", collada("0 2 1 0 1 3 0 3 2 1 2 3\v", kTetNode, "<node id=\"n\"/>"), "<p>",
+       "'3\\x0B' is not an integer"},
+      {"float_form_feed.dae", collada(kTetP, kTetNode, "<node id=\"n\"/>", "0 0 0 1 0 0\f0 1 0 0 0 1"),
+       "<float_array> (line 5)", "'0\\x0C0' is not a number"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
