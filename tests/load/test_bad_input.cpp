@@ -330,6 +330,12 @@ TEST_F(BadInput, PlyHeaderWithoutEndHeader) {
   EXPECT_LOAD_ERROR(loadMesh(none, Vec3::Ones()), none, "", "the PLY header has no 'end_header' line");
   // The same header closed loads, also with a CR LF line end.
   EXPECT_EQ(loadMesh(dir.write("end.ply", header + "end_header\r\n" + body), Vec3::Ones()).triangles.size(), 1u);
+  // Found by fuzz_mesh_ply: end_header as the file's last bytes, without a line end, after a line longer
+  // than it; assimp's line reader never reached the end of the file (a hang, seeking forever).
+  const std::string unended = dir.write("unended.ply", "ply\nformat ascii 1.0\nunknown_keyword\nend_header");
+  EXPECT_LOAD_ERROR(loadMesh(unended, Vec3::Ones()), unended, "line 4", "'end_header' line has no line end");
+  const std::string unended_header = dir.write("unended_header.ply", header + "end_header");
+  EXPECT_LOAD_ERROR(loadMesh(unended_header, Vec3::Ones()), unended_header, "line 9", "'end_header' line has no line end");
 }
 
 namespace {
