@@ -378,6 +378,11 @@ std::string polylist(const std::string& vcount) {
 }
 const char* const kTetNode = "<node id=\"tet\"><instance_geometry url=\"#g\"/></node>";
 
+// text with its first `from` replaced by `to`.
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  return text.replace(text.find(from), from.size(), to);
+}
+
 }  // namespace
 
 TEST_F(BadInput, ColladaThatAssimpCannotSurvive) {
@@ -438,6 +443,12 @@ TEST_F(BadInput, ColladaThatAssimpCannotSurvive) {
        "'3\\x0C0' is not an integer"},
       {"vertical_tab.dae", collada("0 2 1 0 1 3 0 3 2 1 2 3\v", kTetNode, "<node id=\"n\"/>"), "<p>",
        "'3\\x0B' is not an integer"},
+      // Found by fuzz_mesh_dae (then valgrind, as assimp is not instrumented): <triangles> without an
+      // <input semantic="VERTEX">, where assimp read before the start of a heap block.
+      {"no_vertex_input.dae", replaced(collada(kTetP, kTetNode, "<node id=\"n\"/>"), "<input semantic=\"VERTEX\"", "<input"),
+       "<triangles> (line 8)", "no <input semantic=\"VERTEX\">"},
+      {"texcoord_input.dae", replaced(collada(kTetP, kTetNode, "<node id=\"n\"/>"), "semantic=\"VERTEX\"", "semantic=\"TEXCOORD\""),
+       "<triangles>", "no <input semantic=\"VERTEX\">"},
       {"float_form_feed.dae", collada(kTetP, kTetNode, "<node id=\"n\"/>", "0 0 0 1 0 0\f0 1 0 0 0 1"),
        "<float_array> (line 5)", "'0\\x0C0' is not a number"},
   };
