@@ -1,5 +1,6 @@
 // loadRobot on bad input: each problem a user can make in a URDF, an SRDF or a mesh is a LoadError that
 // names the file, the element (with its line) and the reason.
+#include <clearway/body/robot_geometry.h>
 #include <clearway/load/robot_loader.h>
 #include <clearway/load/mesh_loader.h>
 
@@ -282,6 +283,19 @@ TEST_F(BadInput, SizesAndCoordinatesBeyondTheInputLimits) {
   // At the limits, and a flat box, still load.
   const std::string edge = dir.write("edge.urdf", twoLinks("revolute", "<origin xyz=\"1e6 0 0\"/>\n", "<collision><geometry><sphere radius=\"1e-9\"/></geometry></collision><collision><geometry><box size=\"1 0 1\"/></geometry></collision>"));
   EXPECT_EQ(loadRobot(edge).link(1).collisions.size(), 2u);
+  // Found by fuzz_urdf: the geometry of a flat box (size 0 on an axis) cast an infinite ball count to int
+  // (UBSan), and so did a box 5e14 times longer than thick; both build (the plate without a core, the
+  // needle with at most 4).
+  const std::string plate = dir.write("plate.urdf", "<?xml version=\"1.0\"?>\n<robot name=\"r\"><link name=\"a\"><collision><geometry>"
+                                                    "<box size=\"0.1 0.0 0.1\"/></geometry></collision></link></robot>\n");
+  const RobotGeometry plate_geometry(std::make_shared<const RobotModel>(loadRobot(plate)));
+  ASSERT_NE(plate_geometry.link(0), nullptr);
+  EXPECT_EQ(plate_geometry.link(0)->primitives().size(), 1u);
+  EXPECT_TRUE(plate_geometry.link(0)->cores().empty());
+  const std::string needle = dir.write("needle.urdf", twoLinks("revolute", "", "<collision><geometry><box size=\"2e-9 2e-9 1e6\"/></geometry></collision>"));
+  const RobotGeometry needle_geometry(std::make_shared<const RobotModel>(loadRobot(needle)));
+  ASSERT_NE(needle_geometry.link(1), nullptr);
+  EXPECT_LE(needle_geometry.link(1)->cores().size(), 4u);
 
   // A mesh scaled to 1e270 (finite, far beyond any robot), or to nothing.
   dir.write("tet.stl", test::tetrahedronStl());
