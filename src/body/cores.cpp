@@ -52,8 +52,10 @@ struct InscribedBalls {
   const Pose& pose;
   std::vector<LinkGeometry::Ball>& out;
   void along(int axis, double half_length, double radius) const {
+    if (!(radius > 0.0)) return;  // a flat box or a disc holds no ball
     const double reach = std::max(0.0, half_length - radius);
-    const int n = reach > 0.0 ? std::min(4, 1 + static_cast<int>(std::ceil(reach / radius))) : 1;
+    // Counted in double: reach / radius reaches 1e15 within the input limits (a 1 nm plate 1000 km long).
+    const int n = reach > 0.0 ? static_cast<int>(std::min(4.0, 1.0 + std::ceil(reach / radius))) : 1;
     for (int i = 0; i < n; ++i) {
       Vec3 c = Vec3::Zero();
       c[axis] = n == 1 ? 0.0 : -reach + 2.0 * reach * i / (n - 1);

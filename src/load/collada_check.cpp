@@ -24,6 +24,28 @@ using tinyxml2::XMLElement;
 constexpr int kMaxNodeDepth = 256;
 constexpr std::int64_t kMaxExpandedNodes = 100000;
 
+// The separators of a list (<p>, <float_array>, ...): XML's whitespace, as assimp skips it. A form feed
+// or vertical tab (std::isspace) stops assimp's reader without consuming it: it then reads the same
+// place forever, one 0 index after another, until memory runs out.
+bool listSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+
+// A token for a message: control and non-ASCII bytes as \xNN.
+std::string printable(const std::string& token) {
+  std::string out;
+  for (const char c : token.substr(0, 40)) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u >= 0x20 && u < 0x7f) {
+      out += c;
+    } else {
+      static const char kHex[] = "0123456789ABCDEF";
+      out += "\\x";
+      out += kHex[u >> 4];
+      out += kHex[u & 15];
+    }
+  }
+  return out;
+}
+
 std::string where(const XMLElement* e) { return "<" + std::string(e->Name()) + "> (line " + std::to_string(e->GetLineNum()) + ")"; }
 
 class Checker {
@@ -46,6 +68,9 @@ class Checker {
     if (name == "accessor") accessors_.push_back(e);
     if (name == "polylist") polylist(e);
     if (name == "triangles" || name == "polylist" || name == "polygons") primitiveCount(e);
+    if (name == "triangles" || name == "polylist" || name == "polygons" || name == "lines" || name == "linestrips" ||
+        name == "trifans" || name == "tristrips")
+      vertexInput(e);
     for (const XMLElement* c = e->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) visit(c);
   }
 
@@ -94,6 +119,16 @@ class Checker {
       fail(e, "count=\"" + std::to_string(count) + "\" primitives, but " +
                   (polygons ? "it has " + std::to_string(ps) + " <p> elements (one per polygon)"
                             : "it has " + std::to_string(ps) + " <p> elements (one holds them all)"));
+  }
+
+  // Primitives whose inputs name no VERTEX (positions): assimp reads before the start of its vertex
+  // arrays (an invalid read that ASan cannot see in the uninstrumented library, found with valgrind).
+  void vertexInput(const XMLElement* e) const {
+    for (const XMLElement* i = e->FirstChildElement("input"); i != nullptr; i = i->NextSiblingElement("input")) {
+      const char* semantic = i->Attribute("semantic");
+      if (semantic != nullptr && std::strcmp(semantic, "VERTEX") == 0) return;
+    }
+    fail(e, "no <input semantic=\"VERTEX\">: its primitives have no vertex positions");
   }
 
   // No cycle through <instance_node>, and a bounded hierarchy once instances are expanded.
@@ -165,15 +200,15 @@ class Checker {
     return v;
   }
 
-  // Whitespace-separated integers (integers = true) or numbers in the element's text.
+  // Integers (integers = true) or numbers in the element's text, separated by XML whitespace (listSpace).
   void tokens(const XMLElement* e, bool integers) const {
     const char* p = e->GetText();
     if (p == nullptr) return;
     while (*p != '\0') {
-      while (std::isspace(static_cast<unsigned char>(*p))) ++p;
+      while (listSpace(*p)) ++p;
       if (*p == '\0') break;
       const char* start = p;
-      while (*p != '\0' && !std::isspace(static_cast<unsigned char>(*p))) ++p;
+      while (*p != '\0' && !listSpace(*p)) ++p;
       const std::string token(start, p);
       bool ok = false;
       if (integers) {
@@ -186,7 +221,7 @@ class Checker {
         ok = end != token.c_str() && *end == '\0';
       }
       if (!ok)
-        fail(e, "'" + token.substr(0, 40) + "' is not " + (integers ? "an integer" : "a number") +
+        fail(e, "'" + printable(token) + "' is not " + (integers ? "an integer" : "a number") +
                     " (assimp would never finish reading this list)");
     }
   }
@@ -195,7 +230,7 @@ class Checker {
     const char* p = e->GetText();
     std::uint64_t n = 0;
     for (bool in_token = false; p != nullptr && *p != '\0'; ++p) {
-      const bool space = std::isspace(static_cast<unsigned char>(*p));
+      const bool space = listSpace(*p);
       if (!space && !in_token) ++n;
       in_token = !space;
     }

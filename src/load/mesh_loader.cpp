@@ -202,14 +202,21 @@ void countBadEdges(const TriangleMesh& mesh, std::size_t* open, std::size_t* non
 }
 
 // Assimp's PLY reader reads header lines until `end_header` without looking for the end of the file:
-// a header without that line never ends. The PLY header is text, one keyword per line.
+// a header without that line never ends. Nor does one whose `end_header` is the file's last bytes,
+// without a line end, after a longer line (its line buffer then never reaches the end). The PLY header
+// is text, one keyword per line, each line ended.
 void checkPlyHeader(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw LoadError(path, "", "cannot open the file");
   std::string line;
-  while (std::getline(in, line)) {
+  for (long number = 1; std::getline(in, line); ++number) {
     const std::size_t end = line.find_last_not_of(" \t\r");
-    if (end != std::string::npos && line.compare(0, end + 1, "end_header") == 0) return;
+    if (end != std::string::npos && line.compare(0, end + 1, "end_header") == 0) {
+      if (in.eof() && line.back() != '\r')
+        throw LoadError(path, "line " + std::to_string(number),
+                        "the PLY header's 'end_header' line has no line end (the file ends there)");
+      return;
+    }
   }
   throw LoadError(path, "", "the PLY header has no 'end_header' line");
 }

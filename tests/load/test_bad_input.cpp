@@ -1,5 +1,6 @@
 // loadRobot on bad input: each problem a user can make in a URDF, an SRDF or a mesh is a LoadError that
 // names the file, the element (with its line) and the reason.
+#include <clearway/body/robot_geometry.h>
 #include <clearway/load/robot_loader.h>
 #include <clearway/load/mesh_loader.h>
 
@@ -282,6 +283,19 @@ TEST_F(BadInput, SizesAndCoordinatesBeyondTheInputLimits) {
   // At the limits, and a flat box, still load.
   const std::string edge = dir.write("edge.urdf", twoLinks("revolute", "<origin xyz=\"1e6 0 0\"/>\n", "<collision><geometry><sphere radius=\"1e-9\"/></geometry></collision><collision><geometry><box size=\"1 0 1\"/></geometry></collision>"));
   EXPECT_EQ(loadRobot(edge).link(1).collisions.size(), 2u);
+  // Found by fuzz_urdf: the geometry of a flat box (size 0 on an axis) cast an infinite ball count to int
+  // (UBSan), and so did a box 5e14 times longer than thick; both build (the plate without a core, the
+  // needle with at most 4).
+  const std::string plate = dir.write("plate.urdf", "<?xml version=\"1.0\"?>\n<robot name=\"r\"><link name=\"a\"><collision><geometry>"
+                                                    "<box size=\"0.1 0.0 0.1\"/></geometry></collision></link></robot>\n");
+  const RobotGeometry plate_geometry(std::make_shared<const RobotModel>(loadRobot(plate)));
+  ASSERT_NE(plate_geometry.link(0), nullptr);
+  EXPECT_EQ(plate_geometry.link(0)->primitives().size(), 1u);
+  EXPECT_TRUE(plate_geometry.link(0)->cores().empty());
+  const std::string needle = dir.write("needle.urdf", twoLinks("revolute", "", "<collision><geometry><box size=\"2e-9 2e-9 1e6\"/></geometry></collision>"));
+  const RobotGeometry needle_geometry(std::make_shared<const RobotModel>(loadRobot(needle)));
+  ASSERT_NE(needle_geometry.link(1), nullptr);
+  EXPECT_LE(needle_geometry.link(1)->cores().size(), 4u);
 
   // A mesh scaled to 1e270 (finite, far beyond any robot), or to nothing.
   dir.write("tet.stl", test::tetrahedronStl());
@@ -330,6 +344,12 @@ TEST_F(BadInput, PlyHeaderWithoutEndHeader) {
   EXPECT_LOAD_ERROR(loadMesh(none, Vec3::Ones()), none, "", "the PLY header has no 'end_header' line");
   // The same header closed loads, also with a CR LF line end.
   EXPECT_EQ(loadMesh(dir.write("end.ply", header + "end_header\r\n" + body), Vec3::Ones()).triangles.size(), 1u);
+  // Found by fuzz_mesh_ply: end_header as the file's last bytes, without a line end, after a line longer
+  // than it; assimp's line reader never reached the end of the file (a hang, seeking forever).
+  const std::string unended = dir.write("unended.ply", "ply\nformat ascii 1.0\nunknown_keyword\nend_header");
+  EXPECT_LOAD_ERROR(loadMesh(unended, Vec3::Ones()), unended, "line 4", "'end_header' line has no line end");
+  const std::string unended_header = dir.write("unended_header.ply", header + "end_header");
+  EXPECT_LOAD_ERROR(loadMesh(unended_header, Vec3::Ones()), unended_header, "line 9", "'end_header' line has no line end");
 }
 
 namespace {
@@ -371,6 +391,11 @@ std::string polylist(const std::string& vcount) {
   return text;
 }
 const char* const kTetNode = "<node id=\"tet\"><instance_geometry url=\"#g\"/></node>";
+
+// text with its first `from` replaced by `to`.
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  return text.replace(text.find(from), from.size(), to);
+}
 
 }  // namespace
 
@@ -426,6 +451,20 @@ TEST_F(BadInput, ColladaThatAssimpCannotSurvive) {
       {"uncounted.dae", uncounted(), "<accessor> (line 6)", "reaches value 12 of 'pa', which holds 0"},
       {"stride.dae", collada(kTetP, kTetNode, "<node id=\"n\"/>", "0 0 0 1 0 0 0 1 0 0 0 1", 4, "count=\"4\" stride=\"-3\""),
        "<accessor>", "stride=\"-3\" is not a whole number"},
+      // Found by fuzz_mesh_dae: a form feed (or vertical tab) between indices, which assimp's list reader
+      // does not skip: it read a 0 index at the same place forever, until memory ran out (2.4 GB).
+      {"form_feed.dae", collada("0 2 1 0 1 3\f0 3 2 1 2 3", kTetNode, "<node id=\"n\"/>"), "<p> (line 9)",
+       "'3\\x0C0' is not an integer"},
+      {"vertical_tab.dae", collada("0 2 1 0 1 3 0 3 2 1 2 3\v", kTetNode, "<node id=\"n\"/>"), "<p>",
+       "'3\\x0B' is not an integer"},
+      // Found by fuzz_mesh_dae (then valgrind, as assimp is not instrumented): <triangles> without an
+      // <input semantic="VERTEX">, where assimp read before the start of a heap block.
+      {"no_vertex_input.dae", replaced(collada(kTetP, kTetNode, "<node id=\"n\"/>"), "<input semantic=\"VERTEX\"", "<input"),
+       "<triangles> (line 8)", "no <input semantic=\"VERTEX\">"},
+      {"texcoord_input.dae", replaced(collada(kTetP, kTetNode, "<node id=\"n\"/>"), "semantic=\"VERTEX\"", "semantic=\"TEXCOORD\""),
+       "<triangles>", "no <input semantic=\"VERTEX\">"},
+      {"float_form_feed.dae", collada(kTetP, kTetNode, "<node id=\"n\"/>", "0 0 0 1 0 0\f0 1 0 0 0 1"),
+       "<float_array> (line 5)", "'0\\x0C0' is not a number"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
