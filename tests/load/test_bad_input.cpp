@@ -501,6 +501,13 @@ TEST_F(BadInput, ColladaThatAssimpCannotSurvive) {
        "<triangles> (line 8)", "no <input semantic=\"VERTEX\">"},
       {"texcoord_input.dae", replaced(collada(kTetP, kTetNode, "<node id=\"n\"/>"), "semantic=\"VERTEX\"", "semantic=\"TEXCOORD\""),
        "<triangles>", "no <input semantic=\"VERTEX\">"},
+      // Found by fuzz_mesh_dae (out of memory, 19 GB): a <vcount> entry of 2222222222222222222222222222222
+      // corners, room for which assimp reserved before reading <p>; likewise a triangle count beyond <p>.
+      {"huge_vcount.dae", polylist("<vcount>3 3 2222222222222222222222222222222 3</vcount>"), "<vcount> (line 8)",
+       "the corner counts add up to more than 12, the corners <p> holds (1 indices each)"},
+      {"negative_vcount.dae", polylist("<vcount>3 3 -3 3</vcount>"), "<vcount>", "a negative corner count"},
+      {"short_p.dae", replaced(collada(kTetP, kTetNode, "<node id=\"n\"/>"), "<triangles count=\"4\">", "<triangles count=\"5\">"),
+       "<triangles> (line 8)", "count=\"5\" triangles, but <p> holds 12 corners (1 indices each)"},
       {"float_form_feed.dae", collada(kTetP, kTetNode, "<node id=\"n\"/>", "0 0 0 1 0 0\f0 1 0 0 0 1"),
        "<float_array> (line 5)", "'0\\x0C0' is not a number"},
   };
