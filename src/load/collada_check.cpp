@@ -66,12 +66,13 @@ class Checker {
       if (const char* n = e->Attribute("name")) names_.emplace(n, e);
     }
     if (name == "accessor") accessors_.push_back(e);
-    if (name == "polylist") polylist(e);
+    for (const XMLElement* c = e->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) visit(c);
+    // A primitive once its lists are known to be numbers: their count, then what the counts ask for.
     if (name == "triangles" || name == "polylist" || name == "polygons") primitiveCount(e);
+    if (name == "polylist") polylist(e);
     if (name == "triangles" || name == "polylist" || name == "polygons" || name == "lines" || name == "linestrips" ||
         name == "trifans" || name == "tristrips")
       vertexInput(e);
-    for (const XMLElement* c = e->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) visit(c);
   }
 
   // Accessors within their arrays: assimp reads offset + index·stride unchecked.
@@ -105,6 +106,36 @@ class Checker {
     if (given < count)
       fail(e, "count=\"" + std::to_string(count) + "\" polygons, but <vcount> gives " + std::to_string(given) +
                   " corner counts");
+    // Assimp reserves room for every corner the first count="N" entries give before reading <p>: their
+    // sum, times the indices per corner, must be indices that <p> holds.
+    const std::uint64_t held = cornersHeld(e);
+    std::uint64_t corners = 0;
+    const char* p = vcount != nullptr ? vcount->GetText() : nullptr;
+    for (std::uint64_t i = 0; p != nullptr && i < count; ++i) {
+      while (listSpace(*p)) ++p;
+      char* end = nullptr;
+      errno = 0;
+      const unsigned long long n = *p == '-' ? ~0ULL : std::strtoull(p, &end, 10);
+      if (*p == '-' || errno == ERANGE || n > held || (corners += n) > held)
+        fail(vcount, std::string(*p == '-' ? "a negative corner count" : "the corner counts add up to more than " + std::to_string(held)) +
+                         ", the corners <p> holds (" + std::to_string(offsets(e)) + " indices each)");
+      p = end;
+    }
+  }
+
+  // Indices per corner of a primitive: the largest offset="N" of its inputs, plus 1.
+  std::uint64_t offsets(const XMLElement* e) const {
+    std::uint64_t n = 1;
+    for (const XMLElement* i = e->FirstChildElement("input"); i != nullptr; i = i->NextSiblingElement("input"))
+      n = std::max(n, wholeNumber(i, "offset") + 1);
+    return n;
+  }
+
+  // Corners the <p> elements of a primitive hold whole: their indices over offsets(e).
+  std::uint64_t cornersHeld(const XMLElement* e) const {
+    std::uint64_t indices = 0;
+    for (const XMLElement* p = e->FirstChildElement("p"); p != nullptr; p = p->NextSiblingElement("p")) indices += countTokens(p);
+    return indices / offsets(e);
   }
 
   // Assimp asserts (aborts) unless it reads exactly count="N" primitives: for <triangles> and <polylist>
@@ -119,6 +150,11 @@ class Checker {
       fail(e, "count=\"" + std::to_string(count) + "\" primitives, but " +
                   (polygons ? "it has " + std::to_string(ps) + " <p> elements (one per polygon)"
                             : "it has " + std::to_string(ps) + " <p> elements (one holds them all)"));
+
+    // Assimp reserves room for count="N" triangles before reading them: <p> must hold their corners.
+    if (std::strcmp(e->Name(), "triangles") == 0 && count > cornersHeld(e) / 3)
+      fail(e, "count=\"" + std::to_string(count) + "\" triangles, but <p> holds " + std::to_string(cornersHeld(e)) +
+                  " corners (" + std::to_string(offsets(e)) + " indices each)");
   }
 
   // Primitives whose inputs name no VERTEX (positions): assimp reads before the start of its vertex

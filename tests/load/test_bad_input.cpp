@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <string>
 
 using namespace clearway;
@@ -350,6 +351,43 @@ TEST_F(BadInput, PlyHeaderWithoutEndHeader) {
   EXPECT_LOAD_ERROR(loadMesh(unended, Vec3::Ones()), unended, "line 4", "'end_header' line has no line end");
   const std::string unended_header = dir.write("unended_header.ply", header + "end_header");
   EXPECT_LOAD_ERROR(loadMesh(unended_header, Vec3::Ones()), unended_header, "line 9", "'end_header' line has no line end");
+
+  // Found by fuzz_mesh_ply (heap corruption reported by ASan's allocator, then valgrind): a second vertex
+  // or face element, which assimp wrote past the arrays it sized by the first.
+  const std::string vertex = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
+  const std::string face = "element face 1\nproperty list uchar int vertex_indices\n";
+  const std::string two_vertex = dir.write("two_vertex.ply", "ply\nformat ascii 1.0\n" + vertex + vertex + face + "end_header\n" + body);
+  EXPECT_LOAD_ERROR(loadMesh(two_vertex, Vec3::Ones()), two_vertex, "line 7", "a second 'element vertex' (the first is on line 3)");
+  const std::string two_faces = dir.write("two_faces.ply", header + "element tristrips 2\nproperty list uchar int vertex_indices\nend_header\n" + body);
+  EXPECT_LOAD_ERROR(loadMesh(two_faces, Vec3::Ones()), two_faces, "line 9",
+                    "a second face list 'element tristrips' (the first, 'element face', is on line 7)");
+  // Found by fuzz_mesh_ply (out of memory): counts that assimp allocates before reading what they count.
+  const std::string huge = dir.write("huge.ply", "ply\nformat ascii 1.0\n" + vertex +
+                                                   "element face 8888888888888888888888\nproperty list uchar int vertex_indices\nend_header\n" + body);
+  EXPECT_LOAD_ERROR(loadMesh(huge, Vec3::Ones()), huge, "line 7", "element 'face' has 8888888888888888888888 instances, more than the file has bytes");
+  const std::string long_list = dir.write("long_list.ply", header + "end_header\n0 0 0\n1 0 0\n0 1 0\n555555555555 0 1 2\n");
+  EXPECT_LOAD_ERROR(loadMesh(long_list, Vec3::Ones()), long_list, "line 13",
+                    "list 'vertex_indices' of face 0 claims 555555555555 values, but the line holds 3 more");
+  const std::string negative = dir.write("negative.ply", header + "end_header\n0 0 0\n1 0 0\n0 1 0\n-1 0 1 2\n");
+  EXPECT_LOAD_ERROR(loadMesh(negative, Vec3::Ones()), negative, "line 13", "claims -1 values");
+  // The same in binary: a count of 2^32 - 1 (uint), and of -1 (int), in a file of a few bytes.
+  const std::string binary_header = "ply\nformat binary_little_endian 1.0\n" + vertex + "element face 1\nproperty list TYPE int vertex_indices\nend_header\n";
+  const std::string vertices(36, '\0');
+  for (const char* type : {"uint", "int"}) {
+    std::string text = binary_header;
+    text.replace(text.find("TYPE"), 4, type);
+    text += vertices + std::string(4, '\xff') + std::string(12, '\0');
+    const std::string path = dir.write(std::string("count_") + type + ".ply", text);
+    EXPECT_LOAD_ERROR(loadMesh(path, Vec3::Ones()), path, "byte", std::string(type) == "uint" ? "claims 4294967295 values, but the file holds 3 more" : "claims a negative number of values");
+  }
+  // A sound binary file still loads (little-endian values, as on the machines we build for).
+  std::string good_binary = binary_header;
+  good_binary.replace(good_binary.find("TYPE"), 4, "uchar");
+  const auto bytes = [](auto v) { return std::string(reinterpret_cast<const char*>(&v), sizeof v); };
+  for (const float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) good_binary += bytes(v);
+  good_binary += bytes(std::uint8_t{3});
+  for (const std::int32_t i : {0, 1, 2}) good_binary += bytes(i);
+  EXPECT_EQ(loadMesh(dir.write("good_binary.ply", good_binary), Vec3::Ones()).triangles.size(), 1u);
 }
 
 namespace {
@@ -463,6 +501,13 @@ TEST_F(BadInput, ColladaThatAssimpCannotSurvive) {
        "<triangles> (line 8)", "no <input semantic=\"VERTEX\">"},
       {"texcoord_input.dae", replaced(collada(kTetP, kTetNode, "<node id=\"n\"/>"), "semantic=\"VERTEX\"", "semantic=\"TEXCOORD\""),
        "<triangles>", "no <input semantic=\"VERTEX\">"},
+      // Found by fuzz_mesh_dae (out of memory, 19 GB): a <vcount> entry of 2222222222222222222222222222222
+      // corners, room for which assimp reserved before reading <p>; likewise a triangle count beyond <p>.
+      {"huge_vcount.dae", polylist("<vcount>3 3 2222222222222222222222222222222 3</vcount>"), "<vcount> (line 8)",
+       "the corner counts add up to more than 12, the corners <p> holds (1 indices each)"},
+      {"negative_vcount.dae", polylist("<vcount>3 3 -3 3</vcount>"), "<vcount>", "a negative corner count"},
+      {"short_p.dae", replaced(collada(kTetP, kTetNode, "<node id=\"n\"/>"), "<triangles count=\"4\">", "<triangles count=\"5\">"),
+       "<triangles> (line 8)", "count=\"5\" triangles, but <p> holds 12 corners (1 indices each)"},
       {"float_form_feed.dae", collada(kTetP, kTetNode, "<node id=\"n\"/>", "0 0 0 1 0 0\f0 1 0 0 0 1"),
        "<float_array> (line 5)", "'0\\x0C0' is not a number"},
   };
