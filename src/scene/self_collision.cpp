@@ -55,12 +55,23 @@ bool SelfCollision::pairCollides(int k, const Pose* poses, SelfCollisionContext&
 }
 
 bool SelfCollision::pairHits(int k, const Pose* poses, SelfCollisionContext& ctx, bool balls_placed) const noexcept {
+  const Screen s = pairScreen(k, poses, ctx, balls_placed);
+  return s == Screen::Unsure ? pairExactly(k, poses) : s == Screen::Touching;
+}
+
+Screen SelfCollision::pairScreen(int k, const Pose* poses, SelfCollisionContext& ctx, bool balls_placed) const noexcept {
   const LinkPair& p = pairs_[k];
   ++ctx.pair_tests;
-  if (balls_placed && ctx.balls.apart(p.a, p.b, pair_padding_[k], options_.tolerances)) return false;
+  if (balls_placed && ctx.balls.apart(p.a, p.b, pair_padding_[k], options_.tolerances)) return Screen::Apart;
   const IntersectQuery q{pair_padding_[k], options_.mode};
-  if (k < static_cast<int>(ctx.bodies.size())) return ctx.bodies[k].intersects(poses[p.a], poses[p.b], options_.tolerances, q);
-  return BodyPair(*geometry_->link(p.a), *geometry_->link(p.b)).intersects(poses[p.a], poses[p.b], options_.tolerances, q);
+  if (k < static_cast<int>(ctx.bodies.size())) return ctx.bodies[k].screen(poses[p.a], poses[p.b], options_.tolerances, q);
+  return BodyPair(*geometry_->link(p.a), *geometry_->link(p.b)).screen(poses[p.a], poses[p.b], options_.tolerances, q);
+}
+
+bool SelfCollision::pairExactly(int k, const Pose* poses) const noexcept {
+  const LinkPair& p = pairs_[k];
+  return meshesIntersectExactly(*geometry_->link(p.a), poses[p.a], *geometry_->link(p.b), poses[p.b],
+                                options_.tolerances, pair_padding_[k]);
 }
 
 const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionContext& ctx) const noexcept {
@@ -71,7 +82,7 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
   if (ctx.last_hit >= 0 && ctx.last_hit < n && pairHits(ctx.last_hit, poses, ctx, balls)) return &pairs_[ctx.last_hit];
   // Two passes: the cheap rungs for every pair first, so that a collision they settle (overlapping cores)
   // ends the query before any pair's triangle search; then the triangles of the pairs they left unsure.
-  const bool two_pass = static_cast<int>(ctx.bodies.size()) == n && static_cast<int>(ctx.unsure.capacity()) >= n;
+  const bool two_pass = static_cast<int>(ctx.unsure.capacity()) >= n;  // (else pushing would allocate)
   if (two_pass) ctx.unsure.clear();
   for (int k = 0; k < n; ++k) {
     if (k == ctx.last_hit) continue;
@@ -79,18 +90,13 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
       if (pairHits(k, poses, ctx, balls)) return hit(k, ctx);
       continue;
     }
-    const LinkPair& p = pairs_[k];
-    ++ctx.pair_tests;
-    if (balls && ctx.balls.apart(p.a, p.b, pair_padding_[k], options_.tolerances)) continue;
-    const Screen s = ctx.bodies[k].screen(poses[p.a], poses[p.b], options_.tolerances, {pair_padding_[k], options_.mode});
+    const Screen s = pairScreen(k, poses, ctx, balls);
     if (s == Screen::Touching) return hit(k, ctx);
     if (s == Screen::Unsure) ctx.unsure.push_back(k);
   }
   if (two_pass)
-    for (int k : ctx.unsure) {
-      const LinkPair& p = pairs_[k];
-      if (ctx.bodies[k].intersectsExactly(poses[p.a], poses[p.b], options_.tolerances, pair_padding_[k])) return hit(k, ctx);
-    }
+    for (int k : ctx.unsure)
+      if (pairExactly(k, poses)) return hit(k, ctx);
   ctx.last_hit = -1;
   return nullptr;
 }

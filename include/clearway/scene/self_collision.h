@@ -75,6 +75,9 @@ class SelfCollision {
  private:
   // pairCollides, first asking the context's enclosing balls (placed for these poses by the caller).
   bool pairHits(int k, const Pose* link_poses, SelfCollisionContext& context, bool balls_placed) const noexcept;
+  // pairHits in two halves: the enclosing balls and the pair's cheap rungs, then (for Unsure) the triangles.
+  Screen pairScreen(int k, const Pose* link_poses, SelfCollisionContext& context, bool balls_placed) const noexcept;
+  bool pairExactly(int k, const Pose* link_poses) const noexcept;
   // Records pair k as the last hit and returns it.
   const LinkPair* hit(int k, SelfCollisionContext& context) const noexcept;
   // Places the context's balls when it has them (a context made by makeContext); false otherwise.
