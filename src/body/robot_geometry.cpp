@@ -6,14 +6,28 @@
 namespace clearway {
 
 RobotGeometry::RobotGeometry(std::shared_ptr<const RobotModel> model, const TreeBuildOptions& options)
+    : RobotGeometry(std::move(model), nullptr, options) {}
+
+RobotGeometry::RobotGeometry(std::shared_ptr<const RobotModel> model, const RobotGeometry& reuse,
+                             const TreeBuildOptions& options)
+    : RobotGeometry(std::move(model), &reuse, options) {}
+
+RobotGeometry::RobotGeometry(std::shared_ptr<const RobotModel> model, const RobotGeometry* reuse,
+                             const TreeBuildOptions& options)
     : model_(std::move(model)) {
   if (!model_) throw std::invalid_argument("RobotGeometry: null robot model");
   links_.resize(model_->linkCount());
   for (int i = 0; i < model_->linkCount(); ++i) {
     const Link& link = model_->link(i);
     if (link.collisions.empty()) continue;
+    const int same = reuse ? reuse->model().linkIndex(link.name) : -1;
+    if (same >= 0 && reuse->links_[same]) {
+      links_[i] = reuse->links_[same];
+      geometric_.push_back(i);
+      continue;
+    }
     try {
-      links_[i] = std::make_unique<const LinkGeometry>(link.collisions, model_->meshes(), options);
+      links_[i] = std::make_shared<const LinkGeometry>(link.collisions, model_->meshes(), options);
     } catch (const std::exception& e) {
       throw ShapeError("robot '" + model_->name() + "': link '" + link.name + "': " + e.what());
     }

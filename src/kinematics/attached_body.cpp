@@ -51,4 +51,68 @@ RobotModel attachBodies(const RobotModel& model, const std::vector<AttachedBody>
                     model.loadWarnings());
 }
 
+RobotModel detachBodies(const RobotModel& model, const std::vector<std::string>& names) {
+  std::vector<char> gone_link(model.linkCount(), 0), gone_joint(model.jointCount(), 0);
+  std::vector<char> has_child(model.linkCount(), 0);
+  for (const Joint& j : model.joints()) has_child[j.parent_link] = 1;
+  for (const std::string& name : names) {
+    const int l = model.linkIndex(name);
+    const auto bad = [&](const std::string& reason) {
+      throw std::invalid_argument("detach '" + name + "': " + reason);
+    };
+    if (l < 0) bad("robot '" + model.name() + "' has no such link");
+    const int j = model.link(l).parent_joint;
+    if (j < 0 || model.joint(j).type != JointType::Fixed) bad("it does not hang from a fixed joint");
+    if (has_child[l]) bad("other links hang from it");
+    gone_link[l] = 1;
+    gone_joint[j] = 1;
+  }
+  // New indices of what stays (−1: gone).
+  const auto renumber = [](const std::vector<char>& gone) {
+    std::vector<int> to(gone.size(), -1);
+    int n = 0;
+    for (std::size_t i = 0; i < gone.size(); ++i)
+      if (!gone[i]) to[i] = n++;
+    return to;
+  };
+  const std::vector<int> link_to = renumber(gone_link), joint_to = renumber(gone_joint);
+  std::vector<char> mesh_unused(model.meshes().size(), 1);
+  for (int l = 0; l < model.linkCount(); ++l)
+    if (!gone_link[l])
+      for (const CollisionElement& e : model.link(l).collisions)
+        if (e.mesh >= 0) mesh_unused[e.mesh] = 0;
+  const std::vector<int> mesh_to = renumber(mesh_unused);
+
+  std::vector<Link> links;
+  for (int l = 0; l < model.linkCount(); ++l) {
+    if (gone_link[l]) continue;
+    Link link = model.link(l);
+    if (link.parent_joint >= 0) link.parent_joint = joint_to[link.parent_joint];
+    for (CollisionElement& e : link.collisions)
+      if (e.mesh >= 0) e.mesh = mesh_to[e.mesh];
+    links.push_back(std::move(link));
+  }
+  std::vector<Joint> joints;
+  for (int j = 0; j < model.jointCount(); ++j) {
+    if (gone_joint[j]) continue;
+    Joint joint = model.joint(j);
+    joint.parent_link = link_to[joint.parent_link];
+    joint.child_link = link_to[joint.child_link];
+    if (joint.mimic.joint >= 0) joint.mimic.joint = joint_to[joint.mimic.joint];
+    joints.push_back(std::move(joint));
+  }
+  std::vector<TriangleMesh> meshes;
+  for (std::size_t m = 0; m < model.meshes().size(); ++m)
+    if (!mesh_unused[m]) meshes.push_back(model.meshes()[m]);
+  std::vector<DisabledCollision> disabled;
+  for (DisabledCollision d : model.disabledCollisions()) {
+    if (gone_link[d.link_a] || gone_link[d.link_b]) continue;
+    d.link_a = link_to[d.link_a];
+    d.link_b = link_to[d.link_b];
+    disabled.push_back(std::move(d));
+  }
+  return RobotModel(model.name(), std::move(links), std::move(joints), std::move(meshes), std::move(disabled),
+                    model.loadWarnings());
+}
+
 }  // namespace clearway

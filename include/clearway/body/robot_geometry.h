@@ -14,6 +14,10 @@ class RobotGeometry {
   /// Builds each link's trees and hull from the model's collision elements. Throws ShapeError naming
   /// the link when its geometry is unusable.
   explicit RobotGeometry(std::shared_ptr<const RobotModel> model, const TreeBuildOptions& options = {});
+  /// The same, sharing the geometry of every link of `reuse` whose name the model also has: a body
+  /// attached or detached rebuilds only what changed. The caller promises that same-named links have the
+  /// same collision elements (true for models made from one another by attachBodies/detachBodies).
+  RobotGeometry(std::shared_ptr<const RobotModel> model, const RobotGeometry& reuse, const TreeBuildOptions& options = {});
 
   const RobotModel& model() const noexcept { return *model_; }
   const std::shared_ptr<const RobotModel>& modelPtr() const noexcept { return model_; }
@@ -23,8 +27,9 @@ class RobotGeometry {
   const std::vector<int>& geometricLinks() const noexcept { return geometric_; }
 
  private:
+  RobotGeometry(std::shared_ptr<const RobotModel> model, const RobotGeometry* reuse, const TreeBuildOptions& options);
   std::shared_ptr<const RobotModel> model_;
-  std::vector<std::unique_ptr<const LinkGeometry>> links_;
+  std::vector<std::shared_ptr<const LinkGeometry>> links_;
   std::vector<int> geometric_;
 };
 

@@ -28,4 +28,10 @@ struct AttachedBody {
 RobotModel attachBodies(const RobotModel& model, const std::vector<AttachedBody>& bodies,
                         const std::vector<TriangleMesh>& meshes = {});
 
+/// The model without the named bodies: each must be a leaf link hanging from a fixed joint (as
+/// attachBodies makes them). Their links, joints, disabled pairs and the meshes no other link uses go;
+/// the other links keep their order, names and elements. Throws std::invalid_argument for a name that is
+/// not such a link.
+RobotModel detachBodies(const RobotModel& model, const std::vector<std::string>& names);
+
 }  // namespace clearway
