@@ -87,7 +87,8 @@ struct FclRobot {
 class FclScene {
  public:
   explicit FclScene(const clearway::Scene& scene) : scene_(scene), robot_(scene.robot()) {
-    for (const clearway::Obstacle& o : scene.environment().obstacles()) {
+    for (const auto& shared : scene.environment().obstacles()) {
+      const clearway::Obstacle& o = *shared;
       if (o.mesh) throw std::runtime_error("FclScene: mesh obstacles are not converted");
       obstacles_.push_back(std::make_unique<fcl::CollisionObjectd>(toFclShape(o.shape), toFcl(o.pose)));
     }

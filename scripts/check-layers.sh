@@ -8,7 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 # The pipeline, from the bottom up: the one place its order is written.
-stages=(detail shape narrowphase tree kinematics load body environment scene motion ompl cli python)
+stages=(detail shape narrowphase tree kinematics load body environment scene motion world ompl cli python)
 
 rank() {
   local i

@@ -172,7 +172,7 @@ int runPlan(const PlanSettings& s) {
 
   std::cerr << "scene " << scene->name() << " (" << scene_path << "): robot " << scene->robot().name() << ", "
             << scene->dimension() << " joints, " << scene->selfCollision().pairs().size() << " self pairs, "
-            << scene->environment().obstacles().size() << " obstacles"
+            << scene->environment().obstacleCount() << " obstacles"
             << (scene->environment().map() ? ", an OctoMap" : "") << "; checks: " << scene->effects().toString()
             << "\n";
   const auto t0 = std::chrono::steady_clock::now();

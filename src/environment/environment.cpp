@@ -107,26 +107,180 @@ DistanceResult swapped(DistanceResult r) noexcept {
 
 }  // namespace
 
-Environment::Environment(std::vector<Obstacle> obstacles, std::shared_ptr<const OccupancyMap> map)
-    : obstacles_(std::move(obstacles)), map_(std::move(map)) {
-  std::vector<Aabb> boxes;
-  for (std::size_t i = 0; i < obstacles_.size(); ++i) {
-    const Obstacle& o = obstacles_[i];
+Environment::Environment(std::vector<Obstacle> obstacles, std::shared_ptr<const OccupancyMap> map) {
+  std::vector<std::pair<Aabb, Static>> items;
+  std::vector<std::string> item_names;
+  for (Obstacle& o : obstacles) {
     if (!o.pose.isFinite()) throw std::invalid_argument("environment: obstacle '" + o.name + "' has a non-finite pose");
     if (!o.velocity.allFinite())
       throw std::invalid_argument("environment: obstacle '" + o.name + "' has a non-finite velocity");
-    if (o.moving()) {
-      moving_.push_back(static_cast<int>(i));
+    auto shared = std::make_shared<const Obstacle>(std::move(o));
+    ++named_count_;
+    if (shared->moving()) {
+      if (const Named* n = names_.find(shared->name)) {
+        Named twice = *n;
+        ++twice.count;
+        names_ = names_.assigned(shared->name, twice);
+      } else {
+        Named named;
+        named.moving = true;
+        names_ = names_.inserted(shared->name, named);
+      }
+      moving_.push_back(std::move(shared));
       continue;
     }
-    static_.push_back(static_cast<int>(i));
-    boxes.push_back(obstacleBox(o, o.pose));
+    const Aabb box = obstacleBox(*shared, shared->pose);
+    if (box.isEmpty() || !box.min.allFinite() || !box.max.allFinite())
+      throw std::invalid_argument("environment: obstacle '" + shared->name + "' has no finite bounds");
+    item_names.push_back(shared->name);
+    items.push_back({box, Static{std::move(shared), slot_count_++, false}});
   }
-  has_moving_ = !moving_.empty();
-  static_tree_ = AabbTree(boxes);  // throws std::invalid_argument for a non-finite box
+  std::vector<StaticTree::Key> keys;
+  static_ = StaticTree::build(std::move(items), &keys);
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    Named named;
+    if (const Named* n = names_.find(item_names[i])) {
+      named = *n;
+      ++named.count;
+    } else {
+      named.key = keys[i];
+    }
+    names_ = names_.assigned(item_names[i], named);
+  }
+  *this = withMap(std::move(map));
+}
+
+Environment Environment::withMap(std::shared_ptr<const OccupancyMap> map) const {
+  Environment e = *this;
+  e.map_ = std::move(map);
+  e.voxel_tree_.reset();
   // Voxels lie on a grid: the median split is as good as the SAH there and builds several times faster.
-  if (map_ && !map_->occupied.empty()) voxel_tree_ = AabbTree(map_->occupied, {TreeSplit::Median, 2});
-  scale_ = std::max(maxAbs(static_tree_.bounds()), maxAbs(voxel_tree_.bounds()));
+  if (e.map_ && !e.map_->occupied.empty())
+    e.voxel_tree_ = std::make_shared<const AabbTree>(e.map_->occupied, TreeBuildOptions{TreeSplit::Median, 2});
+  e.rescale();
+  return e;
+}
+
+void Environment::rescale() noexcept {
+  scale_ = std::max(maxAbs(static_.bounds()), voxel_tree_ ? maxAbs(voxel_tree_->bounds()) : 0.0);
+}
+
+std::vector<std::shared_ptr<const Obstacle>> Environment::obstacles() const {
+  std::vector<std::shared_ptr<const Obstacle>> all;
+  static_.forEach([&](const Static& s, const Aabb&) {
+    if (!s.voxel) all.push_back(s.obstacle);
+  });
+  all.insert(all.end(), moving_.begin(), moving_.end());
+  return all;
+}
+
+const Obstacle* Environment::obstacle(const std::string& name) const noexcept {
+  const Named* n = names_.find(name);
+  if (!n || n->count != 1) return nullptr;
+  if (!n->moving) {
+    const Static* s = static_.find(n->key);
+    return s ? s->obstacle.get() : nullptr;
+  }
+  for (const auto& o : moving_)
+    if (o->name == name) return o.get();
+  return nullptr;
+}
+
+Environment Environment::withStatic(std::shared_ptr<const Obstacle> o) const {
+  Environment e = *this;
+  const Aabb box = obstacleBox(*o, o->pose);
+  if (box.isEmpty() || !box.min.allFinite() || !box.max.allFinite())
+    throw std::invalid_argument("environment: obstacle '" + o->name + "' has no finite bounds");
+  int slot;
+  if (e.free_slots_) {
+    slot = e.free_slots_->slot;
+    e.free_slots_ = e.free_slots_->next;
+  } else {
+    slot = e.slot_count_++;
+  }
+  const std::string name = o->name;
+  Named named;
+  e.static_ = e.static_.inserted(box, Static{std::move(o), slot, false}, &named.key);
+  e.names_ = e.names_.inserted(name, named);
+  ++e.named_count_;
+  e.rescale();
+  return e;
+}
+
+Environment Environment::withObstacle(Obstacle obstacle) const {
+  const std::string& name = obstacle.name;
+  if (name.empty()) throw std::invalid_argument("environment: an obstacle added needs a name");
+  if (names_.find(name)) throw std::invalid_argument("environment: obstacle '" + name + "' already exists");
+  if (!obstacle.pose.isFinite()) throw std::invalid_argument("environment: obstacle '" + name + "' has a non-finite pose");
+  if (!obstacle.velocity.allFinite())
+    throw std::invalid_argument("environment: obstacle '" + name + "' has a non-finite velocity");
+  auto shared = std::make_shared<const Obstacle>(std::move(obstacle));
+  if (!shared->moving()) return withStatic(std::move(shared));
+  Environment e = *this;
+  Named named;
+  named.moving = true;
+  e.names_ = e.names_.inserted(shared->name, named);
+  e.moving_.push_back(std::move(shared));
+  ++e.named_count_;
+  return e;
+}
+
+Environment Environment::withoutObstacle(const std::string& name) const {
+  const Named* n = names_.find(name);
+  if (!n) throw std::invalid_argument("environment: no obstacle is named '" + name + "'");
+  if (n->count != 1)
+    throw std::invalid_argument("environment: " + std::to_string(n->count) + " obstacles are named '" + name +
+                                "': an edit needs a name of its own");
+  Environment e = *this;
+  if (n->moving) {
+    e.moving_.erase(std::find_if(e.moving_.begin(), e.moving_.end(), [&](const auto& o) { return o->name == name; }));
+  } else {
+    const Static* s = static_.find(n->key);
+    e.free_slots_ = std::make_shared<const FreeSlot>(FreeSlot{s->slot, free_slots_});
+    e.static_ = static_.erased(n->key);
+  }
+  e.names_ = names_.erased(name);
+  --e.named_count_;
+  e.rescale();
+  return e;
+}
+
+Environment Environment::withObstacleMoved(const std::string& name, const Pose& pose) const {
+  if (!pose.isFinite()) throw std::invalid_argument("environment: obstacle '" + name + "' moved to a non-finite pose");
+  const Obstacle* old = obstacle(name);
+  Obstacle moved = old ? *old : Obstacle{};
+  Environment e = withoutObstacle(name);  // (throws for a missing or shared name)
+  moved.pose = pose;
+  return e.withObstacle(std::move(moved));
+}
+
+Environment Environment::withPoints(const std::vector<Vec3>& points, double resolution) const {
+  if (resolution == 0.0 && map_) resolution = map_->resolution;
+  if (!(resolution > 0.0) || !std::isfinite(resolution))
+    throw std::invalid_argument("environment: points need a finite voxel size > 0 (the map's, or given)");
+  Environment e = *this;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Vec3& p = points[i];
+    if (!p.allFinite()) throw std::invalid_argument("environment: point " + std::to_string(i) + " is not finite");
+    const Vec3 lo = (p / resolution).array().floor() * resolution;
+    Aabb cell = Aabb::fromMinMax(lo, lo + Vec3::Constant(resolution));
+    cell.grow(p);  // (where rounding leaves the point just outside its cell, the cell grows to it)
+    const Vec3 c = cell.center();
+    bool held = false;
+    const Aabb probe = Aabb::ofPoint(c);
+    if (e.voxel_tree_)
+      e.voxel_tree_->query(probe, [&](std::int32_t v) { return held = e.map_->occupied[v].contains(cell); });
+    if (!held) e.static_.query(probe, [&](const Static& s, const Aabb&) { return held = s.voxel && s.obstacle->pose.t == c; });
+    if (held) continue;
+    auto voxel = std::make_shared<Obstacle>();
+    voxel->shape = Box(cell.halfExtents());
+    voxel->pose = Pose::translation(c);
+    const Aabb box = shapeWorldBox(voxel->shape, voxel->pose);
+    e.static_ = e.static_.inserted(box, Static{std::move(voxel), -1, true});
+    ++e.point_voxels_;
+  }
+  e.rescale();
+  return e;
 }
 
 // Which items a query visits: those whose boxes overlap a world box, or those within `limit` of the link's
@@ -151,14 +305,15 @@ struct Environment::Reach {
   }
 };
 
-// One item near the link: an obstacle where it is at the query's time, or a voxel.
+// One item near the link: an obstacle where it is at the query's time, a voxel made by withPoints (as a box
+// obstacle), or a voxel of the map.
 struct Environment::Item {
   EnvironmentHit::Kind kind;
-  int index;                   // obstacle index, or voxel index
-  const Obstacle* obstacle;    // null for a voxel
-  const Aabb* voxel;           // null for an obstacle
+  int index;                   // a map voxel's index, else −1
+  const Obstacle* obstacle;    // null for a map voxel
+  const Aabb* voxel;           // a map voxel, else null
   Pose pose;                   // the obstacle's at the query's time, or the voxel's centre
-  int warm;                    // a static obstacle's index among the static ones (its warm start), else −1
+  int warm;                    // a static obstacle's warm-start slot, else −1
 
   Aabb box() const noexcept { return obstacle ? obstacleBox(*obstacle, pose) : *voxel; }
   // f applied to the item as a convex shape: a mesh obstacle's hull, a primitive, a voxel's box.
@@ -166,32 +321,42 @@ struct Environment::Item {
   decltype(auto) convex(F&& f) const {
     return obstacle ? onConvex(*obstacle, f) : f(Box(voxel->halfExtents()));
   }
+  // What a hit on it reports.
+  EnvironmentHit hit() const noexcept {
+    EnvironmentHit h;
+    h.kind = kind;
+    h.index = index;
+    if (kind == EnvironmentHit::Kind::Obstacle) h.obstacle = obstacle;
+    else h.voxel = box();
+    return h;
+  }
 };
 
 template <class F>
 Environment::Walk Environment::forEachItem(const Reach& reach, double t, F&& visit) const {
-  const auto tree = [&](const AabbTree& items, auto&& on_item) {
-    return reach.box ? items.query(*reach.box, on_item) : items.forEachWithin(*reach.local, *reach.pose, *reach.limit, on_item);
+  const auto on_static = [&](const Static& s, const Aabb&) {
+    const Obstacle& o = *s.obstacle;
+    return visit(Item{s.voxel ? EnvironmentHit::Kind::Voxel : EnvironmentHit::Kind::Obstacle, -1, &o, nullptr, o.pose,
+                      s.slot});
   };
-  if (tree(static_tree_, [&](std::int32_t k) {
-        const int i = static_[k];
-        return visit(Item{EnvironmentHit::Kind::Obstacle, i, &obstacles_[i], nullptr, obstacles_[i].pose, k});
-      }))
+  if (reach.box ? static_.query(*reach.box, on_static) : static_.forEachWithin(*reach.local, *reach.pose, *reach.limit, on_static))
     return Walk::Stopped;
   // Moving obstacles are few by nature: each box is placed at t and tested on its own.
   const Aabb link_box = reach.box ? Aabb() : transformed(*reach.local, *reach.pose);
-  for (const int i : moving_) {
-    const Item item{EnvironmentHit::Kind::Obstacle, i, &obstacles_[i], nullptr, poseAt(obstacles_[i], t), -1};
+  for (const auto& o : moving_) {
+    const Item item{EnvironmentHit::Kind::Obstacle, -1, o.get(), nullptr, poseAt(*o, t), -1};
     if (!item.pose.isFinite()) return Walk::Invalid;
     const Aabb box = item.box();
     if (reach.box ? !overlaps(box, *reach.box) : !(boxDistance(box, link_box) <= *reach.limit)) continue;
     if (visit(item)) return Walk::Stopped;
   }
-  if (voxel_tree_.empty()) return Walk::Done;
+  if (!voxel_tree_) return Walk::Done;
   const std::vector<Aabb>& voxels = map_->occupied;
-  return tree(voxel_tree_, [&](std::int32_t v) {
-           return visit(Item{EnvironmentHit::Kind::Voxel, v, nullptr, &voxels[v], Pose::translation(voxels[v].center()), -1});
-         })
+  const auto on_voxel = [&](std::int32_t v) {
+    return visit(Item{EnvironmentHit::Kind::Voxel, v, nullptr, &voxels[v], Pose::translation(voxels[v].center()), -1});
+  };
+  return (reach.box ? voxel_tree_->query(*reach.box, on_voxel)
+                    : voxel_tree_->forEachWithin(*reach.local, *reach.pose, *reach.limit, on_voxel))
              ? Walk::Stopped
              : Walk::Done;
 }
@@ -201,12 +366,17 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
                                  EnvironmentCounters* counters) const noexcept {
   if (hit) *hit = EnvironmentHit{};
   if (!pose.isFinite() || !(padding >= 0.0) || !std::isfinite(padding) || !std::isfinite(t)) return true;
-  const auto report = [&](EnvironmentHit::Kind kind, int index) {
-    if (hit) {
-      hit->kind = kind;
-      hit->index = index;
-    }
+  const auto report = [&](const EnvironmentHit& h) {
+    if (hit) *hit = h;
     return true;
+  };
+  const std::vector<Aabb>* map_voxels = map_ ? &map_->occupied : nullptr;
+  const auto voxelHit = [&](int v) {
+    EnvironmentHit h;
+    h.kind = EnvironmentHit::Kind::Voxel;
+    h.index = v;
+    h.voxel = (*map_voxels)[v];
+    return report(h);
   };
   const Aabb link_box = transformed(link.bounds(), pose);
   const double slack = padding + bandOf(scale_ + maxAbs(link_box) + padding, tol);
@@ -220,13 +390,12 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
   int n_passed = 0;
   bool many = false;
   int found = -1;
-  EnvironmentHit::Kind found_kind = EnvironmentHit::Kind::None;
+  EnvironmentHit found_obstacle;  // an obstacle (or a point voxel) touched
   const Walk walk = forEachItem(Reach::overlapping(query), t, [&](const Item& item) {
-    found_kind = item.kind;
     if (item.obstacle) {
       if (counters) ++counters->obstacle_tests;
       if (!obstacleIntersects(*item.obstacle, item.pose, link, pose, tol, mode, padding)) return false;
-      found = item.index;
+      found_obstacle = item.hit();
       return true;
     }
     double c[3], h[3];
@@ -245,13 +414,19 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
     return false;
   });
   if (walk == Walk::Invalid) {  // a moving obstacle out of reach of the doubles: touching, never free
-    for (const int i : moving_)
-      if (!poseAt(obstacles_[i], t).isFinite()) return report(EnvironmentHit::Kind::Obstacle, i);
+    for (const auto& o : moving_)
+      if (!poseAt(*o, t).isFinite()) {
+        EnvironmentHit h;
+        h.kind = EnvironmentHit::Kind::Obstacle;
+        h.obstacle = o.get();
+        return report(h);
+      }
   }
-  if (found >= 0 && found_kind == EnvironmentHit::Kind::Obstacle) return report(found_kind, found);
-  if (voxel_tree_.empty()) return false;
+  if (found_obstacle.kind != EnvironmentHit::Kind::None) return report(found_obstacle);
+  if (!voxel_tree_) return false;
+  const AabbTree& voxel_tree = *voxel_tree_;
   const std::vector<Aabb>& voxels = map_->occupied;
-  if (mode == GeometryMode::Hull) return found >= 0 ? report(EnvironmentHit::Kind::Voxel, found) : false;
+  if (mode == GeometryMode::Hull) return found >= 0 ? voxelHit(found) : false;
 
   if (!many) {
     for (int k = 0; k < n_passed; ++k) {
@@ -259,7 +434,7 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
       if (counters) ++counters->voxel_tests;
       if (shapeIntersectsLink(Box(b.halfExtents()), Pose::translation(b.center()), link, pose, tol, GeometryMode::Mesh,
                               padding, &cache))
-        return report(EnvironmentHit::Kind::Voxel, passed[k]);
+        return voxelHit(passed[k]);
     }
     return false;
   }
@@ -273,17 +448,17 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
     const Vec3 c = pose * core.center;
     const double r = core.radius - core_margin;
     if (!(r > 0.0)) continue;
-    voxel_tree_.query(Aabb::fromCenterHalf(c, Vec3::Constant(r)), [&](std::int32_t v) {
+    voxel_tree.query(Aabb::fromCenterHalf(c, Vec3::Constant(r)), [&](std::int32_t v) {
       const Aabb& b = voxels[v];
       if (((c - b.center()).cwiseAbs() - b.halfExtents()).cwiseMax(0.0).norm() >= r) return false;
       found = v;
       return true;
     });
-    if (found >= 0) return report(EnvironmentHit::Kind::Voxel, found);
+    if (found >= 0) return voxelHit(found);
   }
   const std::vector<Triangle>& tris = link.triangles();
   forEachOverlap(
-      voxel_tree_, link.tree(), pose,
+      voxel_tree, link.tree(), pose,
       [&](std::int32_t v, std::int32_t j) {
         if (counters) ++counters->voxel_tests;
         const Aabb& b = voxels[v];
@@ -296,10 +471,10 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
         return true;
       },
       slack);
-  if (found >= 0) return report(EnvironmentHit::Kind::Voxel, found);
+  if (found >= 0) return voxelHit(found);
   for (const LinkGeometry::Primitive& p : link.primitives()) {
     const Pose pose_p = pose * p.pose;
-    voxel_tree_.query(shapeWorldBox(p.shape, pose_p).inflated(slack), [&](std::int32_t v) {
+    voxel_tree.query(shapeWorldBox(p.shape, pose_p).inflated(slack), [&](std::int32_t v) {
       if (counters) ++counters->voxel_tests;
       const Aabb& b = voxels[v];
       const Box box(b.halfExtents());
@@ -313,17 +488,17 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
       if (touching) found = v;
       return touching;
     });
-    if (found >= 0) return report(EnvironmentHit::Kind::Voxel, found);
+    if (found >= 0) return voxelHit(found);
   }
   // No surface touches a voxel: one may still lie inside a closed mesh of the link.
   if (link.solidCount() > 0) {
     const Pose to_link = pose.inverse();
-    voxel_tree_.query(query, [&](std::int32_t v) {
+    voxel_tree.query(query, [&](std::int32_t v) {
       if (!link.containsPoint(to_link * voxels[v].center())) return false;
       found = v;
       return true;
     });
-    if (found >= 0) return report(EnvironmentHit::Kind::Voxel, found);
+    if (found >= 0) return voxelHit(found);
   }
   return false;
 }

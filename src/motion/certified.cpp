@@ -217,7 +217,10 @@ struct MotionChecker::Sweep {
     } else {
       const double t = time(s);  // where moving obstacles are
       const int e = k - mc.env_begin_;
-      SimplexCache* warm = warmStarts(ctx.env_cache, ctx.env_slot[e], ctx.env_stamp[e], sc.environment().staticCount());
+      // (A context made for another version of the environment has blocks of another size: no warm starts.)
+      SimplexCache* warm = ctx.warm_obstacles == sc.environment().staticCount()
+                               ? warmStarts(ctx.env_cache, ctx.env_slot[e], ctx.env_stamp[e], ctx.warm_obstacles)
+                               : nullptr;
       EnvironmentHit hit;  // what lies within contact, when that settled it
       d = sc.environment().lowerBound(*it.ga, pa, tol, q, t, warm, &hit, &ctx.scene.counters.environment) - it.padding;
       const bool found = hit.kind != EnvironmentHit::Kind::None;

@@ -50,7 +50,7 @@ MotionChecker::Bodies MotionChecker::mergeBodies(const Scene& scene) {
       }
     }
     for (const int l : members[anchor]) out.index[l] = static_cast<int>(out.list.size());
-    out.geometry.push_back(std::make_unique<const LinkGeometry>(elements, model.meshes()));
+    out.geometry.push_back(std::make_shared<const LinkGeometry>(elements, model.meshes()));
     const LinkGeometry& g = *out.geometry.back();
     out.list.push_back({anchor, &g.hull(), g.sphereCenter(), g.sphereRadius()});
   }
@@ -69,15 +69,8 @@ MotionChecker::Bodies MotionChecker::mergeBodies(const Scene& scene) {
 
 MotionChecker::MotionChecker(std::shared_ptr<const Scene> scene, MotionOptions options)
     : scene_(std::move(scene)), options_(options), bodies_(mergeBodies(*scene_)), bound_(*scene_, bodies_.list) {
-  if (!(options_.contact_distance > 0.0) || !std::isfinite(options_.contact_distance))
-    throw std::invalid_argument("MotionChecker: contact_distance must be finite and > 0");
-  if (!(options_.resolution > 0.0) || !std::isfinite(options_.resolution))
-    throw std::invalid_argument("MotionChecker: resolution must be finite and > 0");
-  if (!(options_.distance_relative_error >= 0.0) || !std::isfinite(options_.distance_relative_error))
-    throw std::invalid_argument("MotionChecker: distance_relative_error must be finite and >= 0");
-  if (options_.max_queries < 1) throw std::invalid_argument("MotionChecker: max_queries must be >= 1");
-  if (options_.max_samples < 1) throw std::invalid_argument("MotionChecker: max_samples must be >= 1");
-  for (const Obstacle& o : scene_->environment().obstacles()) obstacle_speed_ = std::max(obstacle_speed_, o.velocity.norm());
+  validateOptions();
+  for (const auto& o : scene_->environment().movingObstacles()) obstacle_speed_ = std::max(obstacle_speed_, o->velocity.norm());
   // A floating joint's quaternion turns along the great arc (slerp), as OMPL's SO(3) interpolates.
   const RobotModel& model = scene_->robot();
   for (int i = 0; i < scene_->dimension(); ++i) {
@@ -86,6 +79,28 @@ MotionChecker::MotionChecker(std::shared_ptr<const Scene> scene, MotionOptions o
     if (joint.type == JointType::Floating && v == joint.first_variable + 3) quaternions_.push_back(i);
   }
   buildItems();
+}
+
+MotionChecker::MotionChecker(const MotionChecker& base, std::shared_ptr<const Scene> scene)
+    : MotionChecker(scene->geometryPtr() == base.scene_->geometryPtr() &&
+                            scene->environmentLinks() == base.scene_->environmentLinks() &&
+                            scene->selfCollision().pairs().size() == base.scene_->selfCollision().pairs().size()
+                        ? base
+                        : MotionChecker(scene, base.options_)) {
+  scene_ = std::move(scene);
+  obstacle_speed_ = 0.0;
+  for (const auto& o : scene_->environment().movingObstacles()) obstacle_speed_ = std::max(obstacle_speed_, o->velocity.norm());
+}
+
+void MotionChecker::validateOptions() const {
+  if (!(options_.contact_distance > 0.0) || !std::isfinite(options_.contact_distance))
+    throw std::invalid_argument("MotionChecker: contact_distance must be finite and > 0");
+  if (!(options_.resolution > 0.0) || !std::isfinite(options_.resolution))
+    throw std::invalid_argument("MotionChecker: resolution must be finite and > 0");
+  if (!(options_.distance_relative_error >= 0.0) || !std::isfinite(options_.distance_relative_error))
+    throw std::invalid_argument("MotionChecker: distance_relative_error must be finite and >= 0");
+  if (options_.max_queries < 1) throw std::invalid_argument("MotionChecker: max_queries must be >= 1");
+  if (options_.max_samples < 1) throw std::invalid_argument("MotionChecker: max_samples must be >= 1");
 }
 
 void MotionChecker::buildItems() {
@@ -235,6 +250,7 @@ MotionContext MotionChecker::makeContext() const {
   const int env_items = static_cast<int>(items_.size()) - env_begin_;
   c.env_slot.assign(env_items, -1);
   c.env_stamp.assign(env_items, 0);
+  c.warm_obstacles = obstacles;
   if (obstacles > 0 && obstacles <= kWarmObstacles) {
     for (int k = 0; k < env_items; ++k) c.env_slot[k] = static_cast<int>(k * obstacles);
     c.env_cache.resize(env_items * obstacles);
@@ -274,6 +290,12 @@ MotionResult MotionChecker::check(const double* q0, double t0, const double* q1,
     return r;
   }
   motion_detail::Scratch& ctx = *context.scratch_;
+  // A context made by a checker of another robot (a World before an attach, say) does not fit: refused.
+  if (ctx.safe_until.size() != items_.size() || ctx.scene.poses.size() != static_cast<std::size_t>(scene_->robot().linkCount())) {
+    MotionResult r;
+    r.report.kind = CollisionReport::Kind::Invalid;
+    return r;
+  }
   return options_.mode == MotionMode::Sampled ? sampled(q0, t0, q1, t1, ctx)
                                               : certified(q0, t0, q1, t1, ctx, locate_contact);
 }

@@ -24,6 +24,7 @@ struct Scratch {
   // Per environment item, its hull's GJK axes against each static obstacle, kept the same way (the
   // item's block starts at env_slot[k − first environment item], −1: none).
   std::vector<SimplexCache> env_cache;
+  std::size_t warm_obstacles = 0;  // the static obstacles each block holds (the environment's when made)
   std::vector<int> env_slot;
   std::vector<std::uint64_t> env_stamp;
   // Per self item, the motion bounds of its links' convex parts against the other link for this segment

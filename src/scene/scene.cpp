@@ -221,11 +221,8 @@ void Scene::init() {
     const int j = model.link(i).parent_joint;
     moves[i] = moves[model.parentLink(i)] || joint_moves[j];
   }
-  for (int i : geometry_->geometricLinks()) {
+  for (int i : geometry_->geometricLinks())
     if (moves[i]) moving_links_.push_back(i);
-    // Static links meet static obstacles the same way at every state: checked once below.
-    if (moves[i] || environment_->hasMovingObstacles()) env_links_.push_back(i);
-  }
 
   link_padding_.assign(model.linkCount(), description_.padding);
   CollisionFilter moving_filter = filter_;
@@ -253,6 +250,22 @@ void Scene::init() {
         static_collision_.other_link = b;
         break;
       }
+  self_static_collision_ = static_collision_;
+  initEnvironment();
+}
+
+void Scene::initEnvironment() {
+  const RobotModel& model = geometry_->model();
+  std::vector<char> moves(model.linkCount(), 0);
+  for (const int i : moving_links_) moves[i] = 1;
+  // Static links meet static obstacles the same way at every state: checked once here.
+  env_links_.clear();
+  for (int i : geometry_->geometricLinks())
+    if (moves[i] || environment_->hasMovingObstacles()) env_links_.push_back(i);
+  static_collision_ = self_static_collision_;
+  static_clearance_ = static_clearance_lower_ = std::numeric_limits<double>::infinity();
+  std::vector<Pose> poses(model.linkCount());
+  computeLinkPoses(model, base_q_.data(), poses.data());
   if (description_.effects.environment && static_collision_.kind == CollisionReport::Kind::None &&
       !environment_->hasMovingObstacles())
     for (int i : geometry_->geometricLinks()) {
@@ -276,6 +289,13 @@ void Scene::init() {
       static_clearance_lower_ =
           std::min(static_clearance_lower_, failed ? 0.0 : std::max(0.0, d.lower_bound - link_padding_[i]));
     }
+}
+
+std::shared_ptr<const Scene> Scene::withEnvironment(std::shared_ptr<const Environment> environment) const {
+  auto scene = std::make_shared<Scene>(*this);
+  scene->environment_ = environment ? std::move(environment) : std::make_shared<const Environment>();
+  scene->initEnvironment();
+  return scene;
 }
 
 SceneContext Scene::makeContext() const {
@@ -324,7 +344,8 @@ bool Scene::isFree(const double* state, SceneContext& ctx, CollisionReport* repo
   CollisionReport local;
   CollisionReport& r = report ? *report : local;
   r = CollisionReport{};
-  if (!withinBounds(state)) {
+  // (A context of another scene's robot, such as a World's before an attach, does not fit: refused.)
+  if (!withinBounds(state) || ctx.poses.size() != static_cast<std::size_t>(robot().linkCount())) {
     ++ctx.counters.invalid_states;
     r.kind = CollisionReport::Kind::Invalid;
     return false;
@@ -383,7 +404,7 @@ double Scene::clearance(const double* state, SceneContext& ctx, double* lower_bo
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const Effects& fx = description_.effects;
   if (!fx.clearance) return nan;
-  if (!withinBounds(state)) return nan;
+  if (!withinBounds(state) || ctx.poses.size() != static_cast<std::size_t>(robot().linkCount())) return nan;
   ++ctx.counters.clearance_queries;
   computePoses(state, ctx);
   // Distances first; EPA only when something touches (then the value is minus the deepest penetration).
@@ -435,7 +456,7 @@ std::string Scene::describe(const CollisionReport& r) const {
     case CollisionReport::Kind::Self: return model.link(r.link).name + " " + model.link(r.other_link).name;
     case CollisionReport::Kind::Environment:
       if (r.hit.kind == EnvironmentHit::Kind::Obstacle)
-        return model.link(r.link).name + " " + environment_->obstacles()[r.hit.index].name;
+        return model.link(r.link).name + " " + (r.hit.obstacle ? r.hit.obstacle->name : std::string("?"));
       if (r.hit.kind == EnvironmentHit::Kind::Voxel) return model.link(r.link).name + " octomap";
       return model.link(r.link).name + " environment";
   }

@@ -455,7 +455,8 @@ TEST(Environment, ObstacleInsideALink) {
   for (const LinkGeometry* link : {&solid, &closed}) {
     EXPECT_TRUE(env.linkIntersects(*link, Pose(), kTol, GeometryMode::Mesh, 0.0, 0.0, &hit));
     EXPECT_EQ(hit.kind, EnvironmentHit::Kind::Obstacle);
-    EXPECT_EQ(hit.index, 0);
+    ASSERT_NE(hit.obstacle, nullptr);
+    EXPECT_EQ(hit.obstacle->name, "pebble");
     EXPECT_EQ(env.linkDistance(*link, Pose(), kTol).distance, 0.0);
     EXPECT_EQ(env.linkDistance(*link, Pose(), kTol).lower_bound, 0.0);
     EXPECT_EQ(env.hullLowerBound(*link, Pose(), kTol, 1.0, 0.1, 0.0, nullptr, nullptr, true), 0.0);

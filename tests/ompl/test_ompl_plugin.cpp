@@ -274,6 +274,48 @@ TEST(OmplPlugin, PlansOnTheBundledScene) {
   planAndCertify([](const ob::SpaceInformationPtr& si) { return std::make_shared<og::RRTConnect>(si); });
 }
 
+// A world edited between two plans, with the same space information: the first path is blocked by an
+// obstacle added on it, and the second plan goes around it, every segment certified in the edited world.
+TEST(OmplPlugin, PlansAgainAfterAnEditWithoutNewSpaceInformation) {
+  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+  ompl::RNG::setSeed(7);
+  auto world = World::load(bundledScene());
+  const auto scene = world->current().scene;
+  og::SimpleSetup setup(makeStateSpace(*scene));
+  const CollisionChecking c = setupCollisionChecking(setup.getSpaceInformation(), world);
+  const StateMap map(*scene);
+  ob::ScopedState<> start(setup.getStateSpace()), goal(setup.getStateSpace());
+  map.fromVector(scene->description().start.data(), start.get());
+  map.fromVector(scene->description().goal.data(), goal.get());
+  setup.setStartAndGoalStates(start, goal);
+  setup.setPlanner(std::make_shared<og::RRTConnect>(setup.getSpaceInformation()));
+  ASSERT_EQ(setup.solve(30.0), ob::PlannerStatus::EXACT_SOLUTION);
+  og::PathGeometric first = setup.getSolutionPath();
+  first.interpolate(50);
+  // A ball where the wrist is halfway along the first path.
+  std::vector<double> q(scene->dimension());
+  map.toVector(first.getState(first.getStateCount() / 2), q.data());
+  SceneContext ctx = scene->makeContext();
+  scene->computePoses(q.data(), ctx);
+  Obstacle ball;
+  ball.name = "ball";
+  ball.shape = Sphere(0.06);
+  ball.pose = Pose::translation(ctx.poses[scene->robot().linkIndex("wrist_2_link")].t);
+  world->addObstacle(ball);
+  EXPECT_FALSE(c.validity->isValid(first.getState(first.getStateCount() / 2)));
+  bool first_blocked = false;
+  for (std::size_t i = 0; i + 1 < first.getStateCount(); ++i)
+    first_blocked = first_blocked || !c.motion->check(first.getState(i), first.getState(i + 1)).free;
+  EXPECT_TRUE(first_blocked);
+
+  setup.clear();  // the planner's trees were grown in the old world; the space information stays
+  ASSERT_EQ(setup.solve(30.0), ob::PlannerStatus::EXACT_SOLUTION);
+  og::PathGeometric& second = setup.getSolutionPath();
+  for (std::size_t i = 0; i + 1 < second.getStateCount(); ++i)
+    EXPECT_TRUE(c.motion->check(second.getState(i), second.getState(i + 1)).free) << "segment " << i;
+  EXPECT_EQ(c.validity->world().version(), 2u);
+}
+
 // A Panda start 0.5 mm below a ceiling: within the certified check's contact distance (1 mm), but free,
 // so it must be leavable and the problem planned (it once used up the whole time limit).
 TEST(OmplPlugin, PlansFromAStartJustBelowACeiling) {

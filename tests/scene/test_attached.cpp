@@ -42,7 +42,8 @@ TEST(Attached, CollidesWhereTheBareArmDoesNot) {
   ASSERT_FALSE(held->isFree(upright, &report));
   ASSERT_EQ(report.kind, CollisionReport::Kind::Environment);
   EXPECT_EQ(held->robot().link(report.link).name, "stick");
-  EXPECT_EQ(held->environment().obstacles()[report.hit.index].name, "wall");
+  ASSERT_NE(report.hit.obstacle, nullptr);
+  EXPECT_EQ(report.hit.obstacle->name, "wall");
   EXPECT_TRUE(held->isFree(turned));  // pointing along y, away from the wall
   EXPECT_EQ(held->dimension(), bare->dimension());  // the state is the arm's alone
 }

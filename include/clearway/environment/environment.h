@@ -3,6 +3,11 @@
 // OctoMap occupancy (occupied leaves at any depth become boxes; unknown space counts as free or as
 // occupied, by choice). Everything sits in AABB trees in the world frame, so a link is tested only
 // against the obstacles and voxels its bounds can touch, then exactly (body/link_geometry.h).
+//
+// An environment never changes; an edit (an obstacle added, moved or removed, points inserted) makes a
+// new one that shares every untouched part with the old: static obstacles and inserted voxels sit in a
+// versioned tree (tree/versioned_tree.h), so an edit costs O(log n), and a query running on the old
+// environment meanwhile sees it whole.
 #include <clearway/load/load_error.h>
 #include <clearway/shape/triangle_mesh.h>
 #include <clearway/math.h>
@@ -11,7 +16,9 @@
 #include <clearway/body/proximity.h>
 #include <clearway/shape/shape.h>
 #include <clearway/tolerances.h>
+#include <clearway/detail/persistent_map.h>
 #include <clearway/tree/aabb_tree.h>
+#include <clearway/tree/versioned_tree.h>
 
 #include <limits>
 #include <memory>
@@ -53,7 +60,9 @@ struct Obstacle {
 /// Which part of the environment a link touched.
 struct EnvironmentHit {
   enum class Kind { None, Obstacle, Voxel } kind = Kind::None;
-  int index = -1;  ///< obstacle index, or index into OccupancyMap::occupied
+  int index = -1;  ///< a voxel of the map: its index into OccupancyMap::occupied (−1 for other hits)
+  const Obstacle* obstacle = nullptr;  ///< the obstacle touched (valid while its environment lives)
+  Aabb voxel;  ///< the voxel touched (a map's, or one made by withPoints)
 };
 
 /// Work a query did, for tests and benchmarks ("compute nothing the scene did not ask for").
@@ -65,16 +74,46 @@ struct EnvironmentCounters {
   long long cast_tests = 0;      ///< GJK shape casts (translating links)
 };
 
-/// Obstacles and occupancy, immutable once built; queries are const and thread-safe.
+/// Obstacles and occupancy, immutable once built; queries are const and thread-safe. Copies are cheap
+/// (they share everything).
 class Environment {
  public:
-  /// An empty world. Throws std::invalid_argument for a non-finite pose or velocity.
+  /// A world of these obstacles and this map. Throws std::invalid_argument for a non-finite pose or
+  /// velocity.
   Environment(std::vector<Obstacle> obstacles = {}, std::shared_ptr<const OccupancyMap> map = nullptr);
 
-  const std::vector<Obstacle>& obstacles() const noexcept { return obstacles_; }
+  /// Every obstacle (static ones in tree order, then moving ones): O(n), for tools, not for queries.
+  std::vector<std::shared_ptr<const Obstacle>> obstacles() const;
+  /// The obstacles (not counting voxels made by withPoints).
+  std::size_t obstacleCount() const noexcept { return named_count_; }
+  /// The obstacle of that name, or null (also when several share it).
+  const Obstacle* obstacle(const std::string& name) const noexcept;
+  /// The obstacles that move.
+  const std::vector<std::shared_ptr<const Obstacle>>& movingObstacles() const noexcept { return moving_; }
   const OccupancyMap* map() const noexcept { return map_.get(); }
-  bool empty() const noexcept { return obstacles_.empty() && (!map_ || map_->occupied.empty()); }
-  bool hasMovingObstacles() const noexcept { return has_moving_; }
+  /// Voxels made occupied by withPoints (beyond the map's own).
+  int pointVoxelCount() const noexcept { return point_voxels_; }
+  bool empty() const noexcept {
+    return static_.empty() && moving_.empty() && (!map_ || map_->occupied.empty());
+  }
+  bool hasMovingObstacles() const noexcept { return !moving_.empty(); }
+
+  /// This world with one obstacle more: O(log n). Throws std::invalid_argument for an empty name or one
+  /// in use, or a non-finite pose or velocity.
+  Environment withObstacle(Obstacle obstacle) const;
+  /// This world without the named obstacle: O(log n). Throws std::invalid_argument when no obstacle, or
+  /// more than one, has that name.
+  Environment withoutObstacle(const std::string& name) const;
+  /// This world with the named obstacle at `pose` (at time 0): O(log n). Throws as withoutObstacle does,
+  /// and for a non-finite pose.
+  Environment withObstacleMoved(const std::string& name, const Pose& pose) const;
+  /// This world with the voxel holding each point occupied: voxels of edge `resolution` on OctoMap's grid
+  /// (cell k spans [k·res, (k+1)·res) per axis), the map's resolution when 0. Points in voxels already
+  /// occupied (by the map or earlier points) add nothing; O(log n) per new voxel. Non-finite points are
+  /// refused: std::invalid_argument naming the first, as for a resolution ≤ 0 (or 0 without a map).
+  Environment withPoints(const std::vector<Vec3>& points, double resolution = 0.0) const;
+  /// This world with another occupancy map (a changed .bt); the obstacles and point voxels are shared.
+  Environment withMap(std::shared_ptr<const OccupancyMap> map) const;
 
   /// True when the link (placed by pose) is within `padding` of an obstacle or an occupied voxel at
   /// time t (moving obstacles displaced by t·velocity; static ones ignore t). Never "free" by
@@ -112,8 +151,9 @@ class Environment {
   double lowerBound(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, const BoundQuery& q,
                     double t = 0.0, SimplexCache* warm = nullptr, EnvironmentHit* hit = nullptr,
                     EnvironmentCounters* counters = nullptr) const noexcept;
-  /// How many obstacles do not move (the warm starts hullLowerBound takes).
-  std::size_t staticCount() const noexcept { return static_.size(); }
+  /// How many warm starts hullLowerBound takes: one slot per static obstacle (slots of removed obstacles
+  /// are reused by those added later).
+  std::size_t staticCount() const noexcept { return static_cast<std::size_t>(slot_count_); }
 
   /// For a link translating by s·velocity (world frame), s ∈ [0, max_s], with its convex hull grown by
   /// `margin`: a certified lower bound on the first s at which it touches an obstacle (its hull, for a mesh
@@ -139,13 +179,36 @@ class Environment {
   template <class F>
   Walk forEachItem(const Reach& reach, double t, F&& visit) const;
 
-  std::vector<Obstacle> obstacles_;
+  // A static obstacle in the tree, with its warm-start slot; or a voxel made by withPoints (slot −1).
+  struct Static {
+    std::shared_ptr<const Obstacle> obstacle;
+    int slot = -1;
+    bool voxel = false;
+  };
+  using StaticTree = VersionedAabbTree<Static>;
+  // Where a name is: its static obstacle's key, or moving; and how many obstacles carry it.
+  struct Named {
+    StaticTree::Key key{};
+    bool moving = false;
+    int count = 1;
+  };
+  // Warm-start slots freed by removals, reused first (a shared list: each version keeps its own head).
+  struct FreeSlot {
+    int slot;
+    std::shared_ptr<const FreeSlot> next;
+  };
+  Environment withStatic(std::shared_ptr<const Obstacle> o) const;  // adds (name checked by the caller)
+  void rescale() noexcept;
+
   std::shared_ptr<const OccupancyMap> map_;
-  AabbTree static_tree_;          // static obstacles, world frame
-  std::vector<int> static_;       // static_tree_ item → obstacle index
-  std::vector<int> moving_;       // indices of moving obstacles (checked one by one: few by nature)
-  AabbTree voxel_tree_;           // map_->occupied
-  bool has_moving_ = false;
+  StaticTree static_;                  // static obstacles and point voxels, world frame
+  detail::PersistentMap<std::string, Named> names_;
+  std::vector<std::shared_ptr<const Obstacle>> moving_;  // checked one by one: few by nature
+  std::shared_ptr<const AabbTree> voxel_tree_;  // map_->occupied (null without voxels)
+  std::shared_ptr<const FreeSlot> free_slots_;
+  int slot_count_ = 0;
+  std::size_t named_count_ = 0;
+  int point_voxels_ = 0;
   double scale_ = 0.0;            // the largest |coordinate| of the trees' bounds (sizes the rounding band)
 };
 

@@ -146,6 +146,10 @@ class MotionChecker {
  public:
   /// Throws std::invalid_argument for options out of range.
   MotionChecker(std::shared_ptr<const Scene> scene, MotionOptions options = {});
+  /// base's checker for `scene`, an edit of base's scene (Scene::withEnvironment): with the same robot and
+  /// the same links checked against the environment, it shares base's merged bodies, bound and items, and
+  /// only the obstacles' speed is read again; otherwise it is built as the constructor above builds it.
+  MotionChecker(const MotionChecker& base, std::shared_ptr<const Scene> scene);
 
   const Scene& scene() const noexcept { return *scene_; }
   const MotionOptions& options() const noexcept { return options_; }
@@ -185,7 +189,7 @@ class MotionChecker {
     std::vector<int> anchor;  // per link: the link nearest the root that it moves rigidly with
     std::vector<int> index;   // per link: its body in `list` when merged, else -1
     std::vector<Pose> reference;  // per link: its pose at a reference state (rigid offsets are read from it)
-    std::vector<std::unique_ptr<const LinkGeometry>> geometry;  // per merged body, in its anchor's frame
+    std::vector<std::shared_ptr<const LinkGeometry>> geometry;  // per merged body, in its anchor's frame
     std::vector<MotionBound::Body> list;  // the merged bodies, then every link's and body's convex parts
     std::vector<int> parts_begin;  // per link, then per merged body: the bound's link of its first part, −1: none
   };
@@ -208,6 +212,7 @@ class MotionChecker {
   double itemBound(const Item& item, const double* dq, double obstacle_motion) const noexcept;
   struct Sweep;  // certified.cpp
 
+  void validateOptions() const;
   std::shared_ptr<const Scene> scene_;
   MotionOptions options_;
   Bodies bodies_;

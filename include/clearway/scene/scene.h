@@ -127,6 +127,12 @@ class Scene {
   Scene(const SceneDescription& description, std::shared_ptr<const RobotGeometry> robot,
         std::shared_ptr<const Environment> environment, const SceneOptions& options = {});
 
+  /// This scene over another environment (an edited one): the robot, its self pairs and everything
+  /// else are shared or copied, and only what depends on the obstacles is computed again (which links
+  /// meet them at every state, the static links' collision and clearance). The description still lists
+  /// the obstacles the scene was first built from.
+  std::shared_ptr<const Scene> withEnvironment(std::shared_ptr<const Environment> environment) const;
+
   /// parseSceneFile + the constructor.
   static std::shared_ptr<const Scene> load(const std::string& path, const SceneOptions& options = {});
 
@@ -192,6 +198,7 @@ class Scene {
 
  private:
   void init();
+  void initEnvironment();  // the part of init() that depends on the environment
   SceneContext& threadContext() const;
   bool withinBounds(const double* state) const noexcept;  // the cheap check of every query (no reason)
 
@@ -207,6 +214,7 @@ class Scene {
   std::vector<int> moving_links_, env_links_;
   std::vector<double> link_padding_;
   CollisionReport static_collision_;  // a collision no state can undo (static links), found at construction
+  CollisionReport self_static_collision_;  // the part of it among the robot's own links
   double static_clearance_ = std::numeric_limits<double>::infinity();  // static links to static obstacles
   double static_clearance_lower_ = std::numeric_limits<double>::infinity();
   detail::ScratchOwner scratch_owner_;  // identifies this scene's per-thread contexts

@@ -20,12 +20,15 @@ namespace {
 
 using detail::perThread;
 
+// A thread's scratch, made again when the world's snapshot changes (an attached body changes the links).
 struct ValidityScratch {
+  std::uint64_t version = 0;
   SceneContext ctx;
   std::vector<double> q;
 };
 
 struct MotionScratch {
+  std::uint64_t version = 0;
   MotionContext ctx;
   std::vector<double> q0, q1;
 };
@@ -203,31 +206,46 @@ void StateMap::unwrap(const double* from, double* to) const noexcept {
 
 // ---- ValidityChecker ----------------------------------------------------------------------------------
 
+namespace {
+
+std::shared_ptr<World> worldOf(std::shared_ptr<const Scene> scene, MotionOptions options = {}) {
+  return std::make_shared<World>(std::move(scene), options);
+}
+
+ValidityScratch& validityScratch(const detail::ScratchOwner& owner, const WorldSnapshot& w) {
+  ValidityScratch& s = perThread<ValidityScratch>(owner, [] { return ValidityScratch{}; });
+  if (s.version != w.version) s = ValidityScratch{w.version, w.scene->makeContext(), std::vector<double>(w.scene->dimension())};
+  return s;
+}
+
+}  // namespace
+
 ValidityChecker::ValidityChecker(const ob::SpaceInformationPtr& si, std::shared_ptr<const Scene> scene)
-    : ob::StateValidityChecker(si), scene_(std::move(scene)), map_(*scene_) {
+    : ValidityChecker(si, worldOf(std::move(scene))) {}
+
+ValidityChecker::ValidityChecker(const ob::SpaceInformationPtr& si, std::shared_ptr<World> world)
+    : ob::StateValidityChecker(si), world_(std::move(world)), map_(*world_->current().scene) {
   // Honest specs: clearance is an exact distance only when the scene computes it.
-  specs_.clearanceComputationType = scene_->effects().clearance ? ob::StateValidityCheckerSpecs::EXACT
-                                                                : ob::StateValidityCheckerSpecs::NONE;
+  specs_.clearanceComputationType = world_->current().scene->effects().clearance ? ob::StateValidityCheckerSpecs::EXACT
+                                                                                 : ob::StateValidityCheckerSpecs::NONE;
   specs_.hasValidDirectionComputation = false;
 }
 
 bool ValidityChecker::isValid(const ob::State* state) const {
   const Timer timer(counters_.nanoseconds);
   ++counters_.states;
-  ValidityScratch& s = perThread<ValidityScratch>(scratch_owner_, [&] {
-    return ValidityScratch{scene_->makeContext(), std::vector<double>(scene_->dimension())};
-  });
+  const WorldSnapshot& w = world_->current();
+  ValidityScratch& s = validityScratch(scratch_owner_, w);
   map_.toVector(state, s.q.data());
-  return scene_->isFree(s.q.data(), s.ctx);
+  return w.scene->isFree(s.q.data(), s.ctx);
 }
 
 double ValidityChecker::clearance(const ob::State* state) const {
-  if (!scene_->effects().clearance) return ob::StateValidityChecker::clearance(state);
-  ValidityScratch& s = perThread<ValidityScratch>(scratch_owner_, [&] {
-    return ValidityScratch{scene_->makeContext(), std::vector<double>(scene_->dimension())};
-  });
+  const WorldSnapshot& w = world_->current();
+  if (!w.scene->effects().clearance) return ob::StateValidityChecker::clearance(state);
+  ValidityScratch& s = validityScratch(scratch_owner_, w);
   map_.toVector(state, s.q.data());
-  const double c = scene_->clearance(s.q.data(), s.ctx);
+  const double c = w.scene->clearance(s.q.data(), s.ctx);
   return std::isnan(c) ? 0.0 : c;
 }
 
@@ -237,30 +255,43 @@ namespace {
 
 // OMPL's states carry no time, and against moving obstacles a segment's verdict depends on when it is
 // travelled: refused rather than checked with the obstacles held where they are at t = 0.
-std::shared_ptr<const Scene> timeless(std::shared_ptr<const Scene> scene) {
-  if (scene && scene->effects().moving && scene->environment().hasMovingObstacles())
-    throw std::invalid_argument("ContinuousMotionValidator: scene '" + scene->name() +
+bool timeless(const Scene& scene) { return !(scene.effects().moving && scene.environment().hasMovingObstacles()); }
+
+std::shared_ptr<World> timelessWorld(std::shared_ptr<World> world) {
+  const Scene& scene = *world->current().scene;
+  if (!timeless(scene))
+    throw std::invalid_argument("ContinuousMotionValidator: scene '" + scene.name() +
                                 "' has moving obstacles, and OMPL states carry no time (use MotionChecker::check with times)");
-  return scene;
+  return world;
 }
 
 }  // namespace
 
 ContinuousMotionValidator::ContinuousMotionValidator(const ob::SpaceInformationPtr& si,
                                                      std::shared_ptr<const Scene> scene, MotionOptions options)
-    : ob::MotionValidator(si), checker_(timeless(scene), options), map_(*scene) {}
+    : ContinuousMotionValidator(si, worldOf(std::move(scene), options)) {}
+
+ContinuousMotionValidator::ContinuousMotionValidator(const ob::SpaceInformationPtr& si, std::shared_ptr<World> world)
+    : ob::MotionValidator(si), world_(timelessWorld(std::move(world))), map_(*world_->current().scene) {}
 
 MotionResult ContinuousMotionValidator::check(const ob::State* s1, const ob::State* s2, bool locate_contact) const {
   const Timer timer(counters_.nanoseconds);
   ++counters_.motions;
-  MotionScratch& s = perThread<MotionScratch>(scratch_owner_, [&] {
-    const int n = checker_.scene().dimension();
-    return MotionScratch{checker_.makeContext(), std::vector<double>(n), std::vector<double>(n)};
-  });
+  const WorldSnapshot& w = world_->current();
+  if (!timeless(*w.scene)) {  // moving obstacles added after construction: never free by accident
+    MotionResult r;
+    r.free = false;
+    return r;
+  }
+  MotionScratch& s = perThread<MotionScratch>(scratch_owner_, [] { return MotionScratch{}; });
+  if (s.version != w.version) {
+    const int n = w.scene->dimension();
+    s = MotionScratch{w.version, w.motion->makeContext(), std::vector<double>(n), std::vector<double>(n)};
+  }
   map_.toVector(s1, s.q0.data());
   map_.toVector(s2, s.q1.data());
   map_.unwrap(s.q0.data(), s.q1.data());
-  return checker_.check(s.q0.data(), s.q1.data(), s.ctx, locate_contact);
+  return w.motion->check(s.q0.data(), s.q1.data(), s.ctx, locate_contact);
 }
 
 void ContinuousMotionValidator::count(bool free) const {
@@ -288,9 +319,13 @@ bool ContinuousMotionValidator::checkMotion(const ob::State* s1, const ob::State
 
 CollisionChecking setupCollisionChecking(const ob::SpaceInformationPtr& si, std::shared_ptr<const Scene> scene,
                                          MotionOptions options) {
+  return setupCollisionChecking(si, std::make_shared<World>(std::move(scene), options));
+}
+
+CollisionChecking setupCollisionChecking(const ob::SpaceInformationPtr& si, std::shared_ptr<World> world) {
   CollisionChecking c;
-  c.validity = std::make_shared<ValidityChecker>(si, scene);
-  c.motion = std::make_shared<ContinuousMotionValidator>(si, scene, options);
+  c.validity = std::make_shared<ValidityChecker>(si, world);
+  c.motion = std::make_shared<ContinuousMotionValidator>(si, world);
   si->setStateValidityChecker(c.validity);
   si->setMotionValidator(c.motion);
   si->setup();

@@ -1,12 +1,15 @@
 #pragma once
 // Clearway inside OMPL: a state space made from a scene's group, a StateValidityChecker and a
 // continuous MotionValidator. Both are thread-safe (OMPL's parallel planners and PRM's second thread
-// call them at once): every thread gets its own scratch, and the counters are atomic.
+// call them at once): every thread gets its own scratch, and the counters are atomic. Both check a
+// World's current snapshot: edit the world (world/world.h) and plan again, with the same space
+// information; a planner already running sees each query answered by one whole snapshot.
 //
 // The namespace is clearway, not clearway::ompl: inside a clearway::ompl, `ompl::base` would resolve
 // to clearway::ompl::base.
 #include <clearway/motion/motion.h>
 #include <clearway/scene/scene.h>
+#include <clearway/world/world.h>
 
 #include <ompl/base/MotionValidator.h>
 #include <ompl/base/SpaceInformation.h>
@@ -59,13 +62,17 @@ struct CheckerCounters {
 class ValidityChecker : public ompl::base::StateValidityChecker {
  public:
   ValidityChecker(const ompl::base::SpaceInformationPtr& si, std::shared_ptr<const Scene> scene);
+  /// The checker of a world's current snapshot, whichever it is at each query.
+  ValidityChecker(const ompl::base::SpaceInformationPtr& si, std::shared_ptr<World> world);
   bool isValid(const ompl::base::State* state) const override;
   double clearance(const ompl::base::State* state) const override;
   const CheckerCounters& counters() const noexcept { return counters_; }
-  const Scene& scene() const noexcept { return *scene_; }
+  /// The current snapshot's scene (World::current(): valid until this thread's next query).
+  const Scene& scene() const { return *world_->current().scene; }
+  World& world() const noexcept { return *world_; }
 
  private:
-  std::shared_ptr<const Scene> scene_;
+  std::shared_ptr<World> world_;
   StateMap map_;
   detail::ScratchOwner scratch_owner_;  // identifies its per-thread scratch
   mutable CheckerCounters counters_;
@@ -79,6 +86,9 @@ class ContinuousMotionValidator : public ompl::base::MotionValidator {
  public:
   ContinuousMotionValidator(const ompl::base::SpaceInformationPtr& si, std::shared_ptr<const Scene> scene,
                             MotionOptions options = {});
+  /// The validator of a world's current snapshot (its motion checker; the world's MotionOptions). A segment
+  /// checked after moving obstacles were added is not free: OMPL states carry no time.
+  ContinuousMotionValidator(const ompl::base::SpaceInformationPtr& si, std::shared_ptr<World> world);
   bool checkMotion(const ompl::base::State* s1, const ompl::base::State* s2) const override;
   bool checkMotion(const ompl::base::State* s1, const ompl::base::State* s2,
                    std::pair<ompl::base::State*, double>& lastValid) const override;
@@ -87,7 +97,7 @@ class ContinuousMotionValidator : public ompl::base::MotionValidator {
   MotionResult check(const ompl::base::State* s1, const ompl::base::State* s2, bool locate_contact = true) const;
 
  private:
-  MotionChecker checker_;
+  std::shared_ptr<World> world_;
   StateMap map_;
   detail::ScratchOwner scratch_owner_;  // identifies its per-thread scratch
   mutable CheckerCounters counters_;
@@ -105,5 +115,7 @@ struct CollisionChecking {
 };
 CollisionChecking setupCollisionChecking(const ompl::base::SpaceInformationPtr& si, std::shared_ptr<const Scene> scene,
                                          MotionOptions options = {});
+/// The same over a world: planning again after an edit needs no new space information.
+CollisionChecking setupCollisionChecking(const ompl::base::SpaceInformationPtr& si, std::shared_ptr<World> world);
 
 }  // namespace clearway

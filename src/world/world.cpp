@@ -1,0 +1,133 @@
+#include <clearway/world/world.h>
+
+#include <clearway/detail/per_thread.h>
+#include <clearway/kinematics/attached_body.h>
+#include <clearway/load/mesh_loader.h>
+
+#include <algorithm>
+#include <stdexcept>
+#include <utility>
+
+namespace clearway {
+
+World::World(std::shared_ptr<const Scene> scene, MotionOptions motion) : motion_options_(motion) {
+  if (!scene) throw std::invalid_argument("World: null scene");
+  auto checker = std::make_shared<const MotionChecker>(scene, motion);
+  publish(std::move(scene), std::move(checker));
+}
+
+std::shared_ptr<World> World::load(const std::string& path, const SceneOptions& options, MotionOptions motion) {
+  return std::make_shared<World>(Scene::load(path, options), motion);
+}
+
+std::shared_ptr<const WorldSnapshot> World::snapshot() const {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  return current_;
+}
+
+const WorldSnapshot& World::current() const {
+  struct Seen {
+    std::shared_ptr<const WorldSnapshot> snapshot;
+  };
+  Seen& seen = detail::perThread<Seen>(scratch_owner_, [] { return Seen{}; });
+  // The version is stored after current_ is swapped, under the same lock: seeing a new version, the copy
+  // taken under the lock is at least that new.
+  if (!seen.snapshot || seen.snapshot->version != version_.load(std::memory_order_acquire)) seen.snapshot = snapshot();
+  return *seen.snapshot;
+}
+
+void World::publish(std::shared_ptr<const Scene> scene, std::shared_ptr<const MotionChecker> motion) {
+  auto next = std::make_shared<WorldSnapshot>();
+  next->scene = std::move(scene);
+  next->motion = std::move(motion);
+  const std::lock_guard<std::mutex> lock(mutex_);
+  next->version = (current_ ? current_->version : 0) + 1;
+  current_ = std::move(next);
+  version_.store(current_->version, std::memory_order_release);
+}
+
+template <class Edit>
+void World::apply(Edit&& edit) {
+  const std::lock_guard<std::mutex> lock(edit_mutex_);
+  edit(*snapshot());
+}
+
+void World::editEnvironment(const Environment& next) {
+  const WorldSnapshot now = *snapshot();
+  auto scene = now.scene->withEnvironment(std::make_shared<const Environment>(next));
+  auto checker = std::make_shared<const MotionChecker>(*now.motion, scene);
+  publish(std::move(scene), std::move(checker));
+}
+
+void World::addObstacle(Obstacle obstacle) {
+  apply([&](const WorldSnapshot& s) { editEnvironment(s.scene->environment().withObstacle(std::move(obstacle))); });
+}
+
+void World::moveObstacle(const std::string& name, const Pose& pose) {
+  apply([&](const WorldSnapshot& s) { editEnvironment(s.scene->environment().withObstacleMoved(name, pose)); });
+}
+
+void World::removeObstacle(const std::string& name) {
+  apply([&](const WorldSnapshot& s) { editEnvironment(s.scene->environment().withoutObstacle(name)); });
+}
+
+void World::insertPoints(const std::vector<Vec3>& points, double resolution) {
+  apply([&](const WorldSnapshot& s) { editEnvironment(s.scene->environment().withPoints(points, resolution)); });
+}
+
+void World::setMap(std::shared_ptr<const OccupancyMap> map) {
+  apply([&](const WorldSnapshot& s) { editEnvironment(s.scene->environment().withMap(std::move(map))); });
+}
+
+void World::replaceRobot(std::shared_ptr<const RobotModel> model, SceneDescription description) {
+  const WorldSnapshot now = *snapshot();
+  const Scene& old = *now.scene;
+  auto geometry = std::make_shared<const RobotGeometry>(std::move(model), old.geometry());
+  auto scene = std::make_shared<const Scene>(description, std::move(geometry), old.environmentPtr(), old.options());
+  auto checker = std::make_shared<const MotionChecker>(scene, motion_options_);
+  publish(std::move(scene), std::move(checker));
+}
+
+void World::attach(const SceneDescription::AttachedSpec& spec, const LoadOptions& load) {
+  apply([&](const WorldSnapshot& s) {
+    const RobotModel& model = s.scene->robot();
+    const std::string& name = spec.body.name;
+    const auto link = [&](const std::string& l) {
+      const int i = model.linkIndex(l);
+      if (i < 0) throw std::invalid_argument("attach '" + name + "': robot '" + model.name() + "' has no link '" + l + "'");
+      return i;
+    };
+    AttachedBody b;
+    b.name = name;
+    b.link = link(spec.link);
+    b.pose = spec.body.pose;
+    for (const std::string& t : spec.touch_links) b.touch_links.push_back(link(t));
+    std::vector<TriangleMesh> meshes;
+    if (spec.body.mesh_file.empty()) {
+      b.element.primitive = spec.body.shape;
+    } else {
+      b.element.mesh = 0;
+      try {
+        meshes.push_back(loadMesh(spec.body.mesh_file, spec.body.mesh_scale, nullptr, load.mesh));
+      } catch (const std::exception& e) {
+        throw std::invalid_argument("attach '" + name + "': " + e.what());
+      }
+    }
+    SceneDescription d = s.scene->description();
+    d.attached.push_back(spec);
+    replaceRobot(std::make_shared<const RobotModel>(attachBodies(model, {b}, meshes)), std::move(d));
+  });
+}
+
+void World::detach(const std::string& name) {
+  apply([&](const WorldSnapshot& s) {
+    SceneDescription d = s.scene->description();
+    const auto it = std::find_if(d.attached.begin(), d.attached.end(),
+                                 [&](const SceneDescription::AttachedSpec& a) { return a.body.name == name; });
+    if (it == d.attached.end()) throw std::invalid_argument("detach '" + name + "': no attached body has that name");
+    d.attached.erase(it);
+    replaceRobot(std::make_shared<const RobotModel>(detachBodies(s.scene->robot(), {name})), std::move(d));
+  });
+}
+
+}  // namespace clearway
