@@ -9,10 +9,12 @@
 #include <clearway/world/world.h>
 
 #include "load/robot_files.h"
+#include "shared_data.h"
 
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <functional>
 #include <cmath>
 #include <mutex>
 #include <random>
@@ -87,36 +89,38 @@ Obstacle randomObstacle(const std::string& name, std::mt19937& rng) {
   return o;
 }
 
-TEST(WorldEdits, RandomEditsAnswerAsAFreshSceneStatesAndMotions) {
-  TempDir dir;
-  auto world = World::load(dir.write("w.yaml", armScene("", "")));
-  const std::shared_ptr<const Scene> base = world->current().scene;
-  std::mt19937 rng(7);
-  std::vector<Obstacle> live;  // the obstacles a fresh scene is built from
+// After every edit, the world answers as a scene built from scratch on the obstacles it should now hold:
+// `states` states after each edit (10,000 after the last), and `motions` certified motions every 50 edits.
+void expectEditsMatchFreshScenes(World& world, std::vector<Obstacle> live, int n_edits, int states,
+                                 const std::function<Obstacle(int, std::mt19937&)>& make,
+                                 const std::function<Pose(const Obstacle&, std::mt19937&)>& move, std::mt19937& rng) {
+  const std::shared_ptr<const Scene> base = world.current().scene;
+  const std::shared_ptr<const OccupancyMap> map =
+      base->environment().map() ? std::make_shared<const OccupancyMap>(*base->environment().map()) : nullptr;
+  const std::size_t floor = live.size() / 2 + 5, ceiling = live.size() + 30;
   int next_name = 0;
-  int checked_states = 0, colliding = 0, checked_motions = 0;
-  for (int edit = 1; edit <= 1000; ++edit) {
-    // Between 10 and 40 obstacles: add, move or remove alike.
-    const unsigned kind = live.size() < 10 ? 0 : live.size() > 40 ? 4 : rng() % 5;
-    if (kind <= 2) {
-      live.push_back(randomObstacle("o" + std::to_string(next_name++), rng));
-      world->addObstacle(live.back());
-    } else if (kind == 3) {
+  long checked_states = 0, colliding = 0, checked_motions = 0;
+  for (int edit = 1; edit <= n_edits; ++edit) {
+    // Between `floor` and `ceiling` obstacles: add, move or remove alike.
+    const unsigned kind = live.size() < floor ? 0 : live.size() > ceiling ? 2 : rng() % 3;
+    if (kind == 0) {
+      live.push_back(make(next_name++, rng));
+      world.addObstacle(live.back());
+    } else if (kind == 1) {
       Obstacle& o = live[rng() % live.size()];
-      o.pose = randomPose(rng);
-      world->moveObstacle(o.name, o.pose);
+      o.pose = move(o, rng);
+      world.moveObstacle(o.name, o.pose);
     } else {
       const std::size_t k = rng() % live.size();
-      world->removeObstacle(live[k].name);
+      world.removeObstacle(live[k].name);
       live.erase(live.begin() + static_cast<std::ptrdiff_t>(k));
     }
-    ASSERT_EQ(world->version(), static_cast<std::uint64_t>(edit + 1));
-    if (edit % 50 != 0) continue;
-    const WorldSnapshot& w = world->current();
+    const WorldSnapshot& w = world.current();
+    ASSERT_EQ(w.version, static_cast<std::uint64_t>(edit + 1));
     ASSERT_EQ(w.scene->environment().obstacleCount(), live.size());
     const auto fresh = std::make_shared<const Scene>(base->description(), base->geometryPtr(),
-                                                     std::make_shared<const Environment>(live));
-    const int n_states = edit == 1000 ? 10000 : 1000;
+                                                     std::make_shared<const Environment>(live, map), base->options());
+    const int n_states = edit == n_edits ? 10000 : states;
     SceneContext a = w.scene->makeContext(), b = fresh->makeContext();
     for (int i = 0; i < n_states; ++i) {
       const std::vector<double> q = randomState(*fresh, rng);
@@ -125,9 +129,10 @@ TEST(WorldEdits, RandomEditsAnswerAsAFreshSceneStatesAndMotions) {
       colliding += !free;
       ++checked_states;
     }
+    if (edit % 50 != 0) continue;
     const MotionChecker fresh_motion(fresh);
     MotionContext ma = w.motion->makeContext(), mb = fresh_motion.makeContext();
-    for (int i = 0; i < 30; ++i) {
+    for (int i = 0; i < 20; ++i) {
       const std::vector<double> q0 = randomState(*fresh, rng), q1 = randomState(*fresh, rng);
       ASSERT_EQ(w.motion->check(q0.data(), q1.data(), ma, false).free, fresh_motion.check(q0.data(), q1.data(), mb, false).free)
           << "edit " << edit << ", motion " << i;
@@ -135,9 +140,45 @@ TEST(WorldEdits, RandomEditsAnswerAsAFreshSceneStatesAndMotions) {
     }
   }
   // The sample means something: many states collide, many do not.
-  EXPECT_GT(colliding, checked_states / 10);
-  EXPECT_LT(colliding, checked_states * 9 / 10);
-  EXPECT_EQ(checked_motions, 600);
+  EXPECT_GT(colliding, checked_states / 20);
+  EXPECT_LT(colliding, checked_states * 19 / 20);
+  EXPECT_EQ(checked_motions, 20 * (n_edits / 50));
+}
+
+TEST(WorldEdits, RandomEditsAnswerAsAFreshSceneStatesAndMotions) {
+  TempDir dir;
+  auto world = World::load(dir.write("w.yaml", armScene("", "")));
+  std::mt19937 rng(7);
+  expectEditsMatchFreshScenes(
+      *world, {}, 1000, 60, [](int id, std::mt19937& r) { return randomObstacle("o" + std::to_string(id), r); },
+      [](const Obstacle&, std::mt19937& r) { return randomPose(r); }, rng);
+}
+
+// The Panda among a shared problem's shelves (primitive form, then OctoMap form): its own obstacles
+// moved a few centimetres, removed, and new ones added among them.
+TEST(WorldEdits, SharedPandaShelvesEditedAnswerAsAFreshScene) {
+  for (const char* form : {"bookshelf_small_panda_0001.yaml", "bookshelf_small_panda_0001.octomap.yaml"}) {
+    SCOPED_TRACE(form);
+    CLEARWAY_SHARED_OR_SKIP(file, std::string("scenes/bookshelf_small_panda/") + form);
+    auto world = World::load(file);
+    const auto own = world->current().scene->environment().obstacles();
+    std::vector<Obstacle> live;
+    for (const auto& o : own) live.push_back(*o);
+    std::mt19937 rng(11);
+    const auto nudge = [](const Obstacle& o, std::mt19937& r) {
+      std::uniform_real_distribution<double> u(-0.05, 0.05);
+      Pose p = o.pose;
+      p.t += Vec3(u(r), u(r), u(r));
+      return p;
+    };
+    const auto make = [&](int id, std::mt19937& r) {
+      Obstacle o = randomObstacle("new" + std::to_string(id), r);
+      o.pose.t = Vec3(std::uniform_real_distribution<double>(0.2, 0.9)(r), std::uniform_real_distribution<double>(-0.6, 0.6)(r),
+                      std::uniform_real_distribution<double>(0.0, 1.0)(r));
+      return o;
+    };
+    expectEditsMatchFreshScenes(*world, live, 300, 40, make, nudge, rng);
+  }
 }
 
 TEST(WorldEdits, OldSnapshotsStayWhole) {
@@ -308,6 +349,53 @@ TEST(WorldPoints, PointsInsideTheMapsVoxelsAddNothing) {
   const Environment more = env.withPoints({Vec3(0.05, 0.05, 0.05), Vec3(0.35, 0.15, 0.25), Vec3(0.45, 0.05, 0.05)});
   EXPECT_EQ(more.pointVoxelCount(), 1);  // only the point outside the leaf
   EXPECT_EQ(env.pointVoxelCount(), 0);   // the old environment is unchanged
+}
+
+// A box's surface scanned into the shared OctoMap problem: the world with the points inserted answers as
+// a map holding the same voxels among its own (the points' voxels checked as obstacles, the map's as
+// voxels: two paths, one verdict).
+TEST(WorldPoints, ScannedBoxAnswersAsTheSameVoxelsInTheMap) {
+  CLEARWAY_SHARED_OR_SKIP(file, "scenes/bookshelf_small_panda/bookshelf_small_panda_0001.octomap.yaml");
+  auto world = World::load(file);
+  const std::shared_ptr<const Scene> base = world->current().scene;
+  ASSERT_NE(base->environment().map(), nullptr);
+  const double res = base->environment().map()->resolution;
+  // The surface of a 30 cm box in front of the shelf, sampled every 7 mm.
+  std::vector<Vec3> points;
+  const Vec3 lo(0.35, -0.15, 0.35), hi(0.65, 0.15, 0.65);
+  for (double u = 0.0; u <= 1.0; u += 0.007 / 0.3)
+    for (double v = 0.0; v <= 1.0; v += 0.007 / 0.3)
+      for (int axis = 0; axis < 3; ++axis)
+        for (const double side : {0.0, 1.0}) {
+          Vec3 t;
+          t[axis] = side;
+          t[(axis + 1) % 3] = u;
+          t[(axis + 2) % 3] = v;
+          points.push_back(lo + t.cwiseProduct(hi - lo));
+        }
+  world->insertPoints(points);
+  EXPECT_GT(world->current().scene->environment().pointVoxelCount(), 100);
+  auto map = std::make_shared<OccupancyMap>(*base->environment().map());
+  for (const Vec3& p : points) {
+    const Vec3 corner = (p / res).array().floor() * res;
+    map->occupied.push_back(Aabb::fromMinMax(corner, corner + Vec3::Constant(res)));
+  }
+  const Scene same(base->description(), base->geometryPtr(), std::make_shared<const Environment>(std::vector<Obstacle>{}, map),
+                   base->options());
+  const Scene& edited = *world->current().scene;
+  std::mt19937 rng(5);
+  SceneContext a = edited.makeContext(), b = same.makeContext();
+  int colliding = 0, changed = 0;
+  SceneContext c = base->makeContext();
+  for (int i = 0; i < 3000; ++i) {
+    const std::vector<double> q = randomState(same, rng);
+    const bool free = same.isFree(q.data(), b);
+    ASSERT_EQ(edited.isFree(q.data(), a), free) << "state " << i;
+    colliding += !free;
+    changed += base->isFree(q.data(), c) != free;
+  }
+  EXPECT_GT(changed, 30) << "the scanned box was to stand where the arm reaches";
+  EXPECT_LT(colliding, 3000);
 }
 
 // Readers check states on whatever snapshot is current while a writer edits; every verdict is then
