@@ -3,6 +3,7 @@
 // a state batch has the shape a scene or robot expects. Every check raises ValueError naming the
 // argument, so that bad input never reaches a query (which would call it a collision, or worse).
 #include <clearway/math.h>
+#include <clearway/shape/shape.h>
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -12,6 +13,11 @@
 namespace clearway::python {
 
 namespace py = pybind11;
+
+/// A shape held by Python (clearway.Box, Sphere, ...: narrowphase.cpp); obstacles and attached bodies take them too.
+struct PyShape {
+  Shape shape = Point();
+};
 
 /// A C-contiguous float64 array: a view of the caller's array when it already is one, else a copy.
 using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;

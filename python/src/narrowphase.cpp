@@ -17,10 +17,7 @@ namespace clearway::python {
 
 namespace {
 
-// A shape held by Python; the subclasses only name the kind and its parameters.
-struct PyShape {
-  Shape shape = Point();
-};
+// The subclasses of PyShape (convert.h) only name the kind and its parameters.
 struct PyPoint : PyShape {};
 struct PySegment : PyShape {};
 struct PyTriangle : PyShape {};

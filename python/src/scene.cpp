@@ -43,6 +43,11 @@ class PyScene {
   std::map<std::tuple<int, double, double>, std::unique_ptr<const MotionChecker>> checkers_;
 };
 
+// A scene over an edited environment, for Python.
+std::shared_ptr<PyScene> edited(const PyScene& s, const Environment& environment) {
+  return std::make_shared<PyScene>(s.scene->withEnvironment(std::make_shared<const Environment>(environment)));
+}
+
 // The reason a state is rejected, as `clearway check` prints it after "error ".
 [[noreturn]] void invalidRow(const Scene& scene, const char* name, py::ssize_t row, const double* q) {
   std::string why;
@@ -284,6 +289,70 @@ void bindScene(py::module_& m) {
            "known free (1 where free). mode: 'certified' (never steps over an obstacle), 'cast' or 'sampled:RES' (may "
            "tunnel). With report=True also the colliding pair per row, as check(). times: (N, 2) seconds at each end "
            "(moving obstacles move on meanwhile; default 0 and 0). ValueError naming an invalid end.")
+      .def_property_readonly("obstacle_names", [](const PyScene& s) {
+        std::vector<std::string> names;
+        for (const auto& o : s.scene->environment().obstacles()) names.push_back(o->name);
+        return names;
+      }, "The environment's obstacles by name (edits address them so).")
+      .def("with_obstacle",
+           [](const PyScene& s, const std::string& name, const PyShape& shape, const py::object& pose) {
+             Obstacle o;
+             o.name = name;
+             o.shape = shape.shape;
+             o.pose = toPose(pose, "pose");
+             py::gil_scoped_release release;
+             return edited(s, s.scene->environment().withObstacle(std::move(o)));
+           },
+           py::arg("name"), py::arg("shape"), py::arg("pose") = py::none(),
+           "This scene with one obstacle more (a clearway.Box, Sphere, Cylinder, ... placed by pose), as a new Scene; "
+           "this one is unchanged (the two share all else: O(log n)). ValueError for a name in use or a bad pose.")
+      .def("with_obstacle_moved",
+           [](const PyScene& s, const std::string& name, const py::object& pose) {
+             const Pose p = toPose(pose, "pose");
+             py::gil_scoped_release release;
+             return edited(s, s.scene->environment().withObstacleMoved(name, p));
+           },
+           py::arg("name"), py::arg("pose"), "This scene with the named obstacle placed at pose, as a new Scene.")
+      .def("without_obstacle",
+           [](const PyScene& s, const std::string& name) {
+             py::gil_scoped_release release;
+             return edited(s, s.scene->environment().withoutObstacle(name));
+           },
+           py::arg("name"), "This scene without the named obstacle, as a new Scene. ValueError when none has the name.")
+      .def("with_points",
+           [](const PyScene& s, const DoubleArray& points, double resolution) {
+             requireRows(points, "points", 3);
+             std::vector<Vec3> list(static_cast<std::size_t>(points.shape(0)));
+             for (std::size_t i = 0; i < list.size(); ++i)
+               list[i] = Vec3(points.at(i, 0), points.at(i, 1), points.at(i, 2));
+             py::gil_scoped_release release;
+             return edited(s, s.scene->environment().withPoints(list, resolution));
+           },
+           py::arg("points"), py::arg("resolution") = 0.0,
+           "This scene with the voxel holding each of the (N, 3) points occupied (edge `resolution` on OctoMap's grid; "
+           "0: the map's), as a new Scene. Free space is not cleared.")
+      .def("with_attached",
+           [](const PyScene& s, const std::string& name, const std::string& link, const PyShape& shape,
+              const py::object& pose, const std::vector<std::string>& touch_links) {
+             SceneDescription::AttachedSpec a;
+             a.link = link;
+             a.body.name = name;
+             a.body.shape = shape.shape;
+             a.body.pose = toPose(pose, "pose");
+             a.touch_links = touch_links;
+             py::gil_scoped_release release;
+             return std::make_shared<PyScene>(s.scene->withAttached(a));
+           },
+           py::arg("name"), py::arg("link"), py::arg("shape"), py::arg("pose") = py::none(),
+           py::arg("touch_links") = std::vector<std::string>{},
+           "This scene with a body (shape, placed by pose in the link's frame) attached to `link`, which it may touch, "
+           "as may its touch_links (MoveIt's); a new Scene. ValueError for an unknown link or a name in use.")
+      .def("without_attached",
+           [](const PyScene& s, const std::string& name) {
+             py::gil_scoped_release release;
+             return std::make_shared<PyScene>(s.scene->withoutAttached(name));
+           },
+           py::arg("name"), "This scene without the named attached body, as a new Scene.")
       .def("__repr__", [](const PyScene& s) {
         return "<clearway.Scene " + s.scene->name() + ": " + std::to_string(s.scene->dimension()) + " dof, checks " +
                s.scene->effects().toString() + ">";

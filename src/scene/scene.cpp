@@ -4,12 +4,14 @@
 
 #include <clearway/kinematics/attached_body.h>
 #include <clearway/kinematics/forward_kinematics.h>
+#include <clearway/load/mesh_loader.h>
 #include <clearway/load/robot_loader.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 namespace clearway {
 
@@ -289,6 +291,48 @@ void Scene::initEnvironment() {
       static_clearance_lower_ =
           std::min(static_clearance_lower_, failed ? 0.0 : std::max(0.0, d.lower_bound - link_padding_[i]));
     }
+}
+
+std::shared_ptr<const Scene> Scene::withAttached(const SceneDescription::AttachedSpec& spec, const LoadOptions& load) const {
+  const RobotModel& model = robot();
+  const std::string& name = spec.body.name;
+  const auto link = [&](const std::string& l) {
+    const int i = model.linkIndex(l);
+    if (i < 0) throw std::invalid_argument("attach '" + name + "': robot '" + model.name() + "' has no link '" + l + "'");
+    return i;
+  };
+  AttachedBody b;
+  b.name = name;
+  b.link = link(spec.link);
+  b.pose = spec.body.pose;
+  for (const std::string& t : spec.touch_links) b.touch_links.push_back(link(t));
+  std::vector<TriangleMesh> meshes;
+  if (spec.body.mesh_file.empty()) {
+    b.element.primitive = spec.body.shape;
+  } else {
+    b.element.mesh = 0;
+    try {
+      meshes.push_back(loadMesh(spec.body.mesh_file, spec.body.mesh_scale, nullptr, load.mesh));
+    } catch (const std::exception& e) {
+      throw std::invalid_argument("attach '" + name + "': " + e.what());
+    }
+  }
+  auto held = std::make_shared<const RobotModel>(attachBodies(model, {b}, meshes));
+  SceneDescription d = description_;
+  d.attached.push_back(spec);
+  return std::make_shared<const Scene>(d, std::make_shared<const RobotGeometry>(std::move(held), *geometry_),
+                                       environment_, options_);
+}
+
+std::shared_ptr<const Scene> Scene::withoutAttached(const std::string& name) const {
+  SceneDescription d = description_;
+  const auto it = std::find_if(d.attached.begin(), d.attached.end(),
+                               [&](const SceneDescription::AttachedSpec& a) { return a.body.name == name; });
+  if (it == d.attached.end()) throw std::invalid_argument("detach '" + name + "': no attached body has that name");
+  d.attached.erase(it);
+  auto bare = std::make_shared<const RobotModel>(detachBodies(robot(), {name}));
+  return std::make_shared<const Scene>(d, std::make_shared<const RobotGeometry>(std::move(bare), *geometry_),
+                                       environment_, options_);
 }
 
 std::shared_ptr<const Scene> Scene::withEnvironment(std::shared_ptr<const Environment> environment) const {

@@ -1,10 +1,7 @@
 #include <clearway/world/world.h>
 
 #include <clearway/detail/per_thread.h>
-#include <clearway/kinematics/attached_body.h>
-#include <clearway/load/mesh_loader.h>
 
-#include <algorithm>
 #include <stdexcept>
 #include <utility>
 
@@ -79,55 +76,17 @@ void World::setMap(std::shared_ptr<const OccupancyMap> map) {
   apply([&](const WorldSnapshot& s) { editEnvironment(s.scene->environment().withMap(std::move(map))); });
 }
 
-void World::replaceRobot(std::shared_ptr<const RobotModel> model, SceneDescription description) {
-  const WorldSnapshot now = *snapshot();
-  const Scene& old = *now.scene;
-  auto geometry = std::make_shared<const RobotGeometry>(std::move(model), old.geometry());
-  auto scene = std::make_shared<const Scene>(description, std::move(geometry), old.environmentPtr(), old.options());
+void World::replaceScene(std::shared_ptr<const Scene> scene) {
   auto checker = std::make_shared<const MotionChecker>(scene, motion_options_);
   publish(std::move(scene), std::move(checker));
 }
 
 void World::attach(const SceneDescription::AttachedSpec& spec, const LoadOptions& load) {
-  apply([&](const WorldSnapshot& s) {
-    const RobotModel& model = s.scene->robot();
-    const std::string& name = spec.body.name;
-    const auto link = [&](const std::string& l) {
-      const int i = model.linkIndex(l);
-      if (i < 0) throw std::invalid_argument("attach '" + name + "': robot '" + model.name() + "' has no link '" + l + "'");
-      return i;
-    };
-    AttachedBody b;
-    b.name = name;
-    b.link = link(spec.link);
-    b.pose = spec.body.pose;
-    for (const std::string& t : spec.touch_links) b.touch_links.push_back(link(t));
-    std::vector<TriangleMesh> meshes;
-    if (spec.body.mesh_file.empty()) {
-      b.element.primitive = spec.body.shape;
-    } else {
-      b.element.mesh = 0;
-      try {
-        meshes.push_back(loadMesh(spec.body.mesh_file, spec.body.mesh_scale, nullptr, load.mesh));
-      } catch (const std::exception& e) {
-        throw std::invalid_argument("attach '" + name + "': " + e.what());
-      }
-    }
-    SceneDescription d = s.scene->description();
-    d.attached.push_back(spec);
-    replaceRobot(std::make_shared<const RobotModel>(attachBodies(model, {b}, meshes)), std::move(d));
-  });
+  apply([&](const WorldSnapshot& s) { replaceScene(s.scene->withAttached(spec, load)); });
 }
 
 void World::detach(const std::string& name) {
-  apply([&](const WorldSnapshot& s) {
-    SceneDescription d = s.scene->description();
-    const auto it = std::find_if(d.attached.begin(), d.attached.end(),
-                                 [&](const SceneDescription::AttachedSpec& a) { return a.body.name == name; });
-    if (it == d.attached.end()) throw std::invalid_argument("detach '" + name + "': no attached body has that name");
-    d.attached.erase(it);
-    replaceRobot(std::make_shared<const RobotModel>(detachBodies(s.scene->robot(), {name})), std::move(d));
-  });
+  apply([&](const WorldSnapshot& s) { replaceScene(s.scene->withoutAttached(name)); });
 }
 
 }  // namespace clearway

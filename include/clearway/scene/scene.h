@@ -133,6 +133,15 @@ class Scene {
   /// the obstacles the scene was first built from.
   std::shared_ptr<const Scene> withEnvironment(std::shared_ptr<const Environment> environment) const;
 
+  /// This scene with a body attached to a robot link, as a scene file's robot.attached entry attaches it
+  /// (a mesh read from body.body.mesh_file with `load`): a new robot that shares every other link's
+  /// geometry. Throws std::invalid_argument for an unknown link or touch link, a name a link already has,
+  /// or a mesh that cannot be read.
+  std::shared_ptr<const Scene> withAttached(const SceneDescription::AttachedSpec& body, const LoadOptions& load = {}) const;
+  /// This scene without the named attached body (one attached by withAttached or by the scene file).
+  /// Throws std::invalid_argument when no attached body has that name.
+  std::shared_ptr<const Scene> withoutAttached(const std::string& name) const;
+
   /// parseSceneFile + the constructor.
   static std::shared_ptr<const Scene> load(const std::string& path, const SceneOptions& options = {});
 

@@ -40,7 +40,7 @@ class World {
   std::shared_ptr<const WorldSnapshot> snapshot() const;
   /// The current snapshot as this thread last took it, taken again only when an edit has published a
   /// newer one: a query's way in, one atomic load when nothing changed. Valid until this thread's next
-  /// call of current() on this world.
+  /// call of current() on this world (the thread holds it until then, even past the world's end).
   const WorldSnapshot& current() const;
   /// The current snapshot's version.
   std::uint64_t version() const noexcept { return version_.load(std::memory_order_acquire); }
@@ -55,12 +55,9 @@ class World {
   void insertPoints(const std::vector<Vec3>& points, double resolution = 0.0);
   /// Replaces the occupancy map (a changed .bt, loadOctomap); obstacles and inserted points stay.
   void setMap(std::shared_ptr<const OccupancyMap> map);
-  /// Attaches a body to a robot link, as a scene file's robot.attached entry does (a mesh is read from
-  /// body.body.mesh_file with `load`). Throws std::invalid_argument for an unknown link or touch link, a
-  /// name already used by a link, or a mesh that cannot be read.
+  /// Attaches a body to a robot link (Scene::withAttached; throws as it does).
   void attach(const SceneDescription::AttachedSpec& body, const LoadOptions& load = {});
-  /// Detaches the named attached body (one attached by attach() or by the scene file). Throws
-  /// std::invalid_argument when no attached body has that name.
+  /// Detaches the named attached body (Scene::withoutAttached; throws as it does).
   void detach(const std::string& name);
 
  private:
@@ -69,7 +66,7 @@ class World {
   void apply(Edit&& edit);
   void publish(std::shared_ptr<const Scene> scene, std::shared_ptr<const MotionChecker> motion);
   void editEnvironment(const Environment& next);
-  void replaceRobot(std::shared_ptr<const RobotModel> model, SceneDescription description);
+  void replaceScene(std::shared_ptr<const Scene> scene);  // a new robot: the motion checker built anew
 
   std::mutex edit_mutex_;          // one edit at a time
   mutable std::mutex mutex_;       // guards current_ (held only to copy or swap the pointer)
