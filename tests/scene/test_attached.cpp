@@ -6,6 +6,7 @@
 #include <clearway/scene/scene.h>
 
 #include "load/robot_files.h"
+#include "scene/arm_scene.h"
 
 #include <gtest/gtest.h>
 
@@ -16,16 +17,8 @@
 namespace clearway {
 namespace {
 
+using test::armScene;
 using test::TempDir;
-
-// Our arm (robots/arm6) holding `attached` (YAML list items, indented 4), among `obstacles`.
-std::string armScene(const std::string& attached, const std::string& obstacles) {
-  return "format: 1\nname: held\nrobot:\n  urdf: " + test::sourceRobot("arm6/arm6.urdf") + "\n  srdf: " +
-         test::sourceRobot("arm6/arm6.srdf") +
-         "\n  group: [shoulder_pan_joint, shoulder_lift_joint, elbow_joint, wrist_1_joint, wrist_2_joint, wrist_3_joint]\n" +
-         (attached.empty() ? "" : "  attached:\n" + attached) + "environment:\n  obstacles:\n" + obstacles +
-         "checks: [self, environment, continuous]\n";
-}
 
 const char* const kStick =
     "    - {name: stick, link: tool0, box: {size: [0.6, 0.02, 0.02]}, pose: {position: [0.3, 0, 0]},"

@@ -8,7 +8,9 @@
 #include <clearway/scene/scene.h>
 #include <clearway/world/world.h>
 
+#include "box_surface.h"
 #include "load/robot_files.h"
+#include "scene/arm_scene.h"
 #include "shared_data.h"
 
 #include <gtest/gtest.h>
@@ -26,17 +28,9 @@
 namespace clearway {
 namespace {
 
+using test::armScene;
+using test::boxSurface;
 using test::TempDir;
-
-// Our arm (robots/arm6) holding `attached` (YAML list items, indented 4), among `obstacles`.
-std::string armScene(const std::string& attached, const std::string& obstacles) {
-  return "format: 1\nname: world\nrobot:\n  urdf: " + test::sourceRobot("arm6/arm6.urdf") + "\n  srdf: " +
-         test::sourceRobot("arm6/arm6.srdf") +
-         "\n  group: [shoulder_pan_joint, shoulder_lift_joint, elbow_joint, wrist_1_joint, wrist_2_joint, wrist_3_joint]\n" +
-         (attached.empty() ? "" : "  attached:\n" + attached) + "environment:\n" +
-         (obstacles.empty() ? "  obstacles: []\n" : "  obstacles:\n" + obstacles) +
-         "checks: [self, environment, continuous]\n";
-}
 
 const char* const kWall = "    - {name: wall, box: {size: [0.004, 1.0, 3.0]}, pose: {position: [0.3, 0, 1.5]}}\n";
 
@@ -48,15 +42,6 @@ SceneDescription::AttachedSpec stick(double thickness = 0.02) {
   a.body.pose = Pose::translation(Vec3(0.3, 0, 0));
   a.touch_links = {"wrist_3_link"};
   return a;
-}
-
-TriangleMesh boxSurface(const Vec3& half) {
-  TriangleMesh m;
-  for (int i = 0; i < 8; ++i)
-    m.vertices.emplace_back((i & 1 ? 1 : -1) * half.x(), (i & 2 ? 1 : -1) * half.y(), (i & 4 ? 1 : -1) * half.z());
-  m.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                 {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-  return m;
 }
 
 std::vector<double> randomState(const Scene& scene, std::mt19937& rng) {
