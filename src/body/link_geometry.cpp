@@ -195,13 +195,15 @@ bool shapesIntersect(const Shape& a, const Pose& pa, const Shape& b, const Pose&
 
 // The exact part of a Mesh-mode test, in A's frame.
 bool exactIntersect(const LinkGeometry& a, const LinkGeometry& b, const Pose& b_in_a, const Tolerances& tol,
-                    double padding, double slack) noexcept {
+                    double padding, double slack, TrianglePair* witness = nullptr) noexcept {
   const std::vector<Triangle>& ta = a.triangles();
   const std::vector<Triangle>& tb = b.triangles();
   if (!ta.empty() && !tb.empty() &&
       forEachOverlap(a.tree(), b.tree(), b_in_a,
                      [&](std::int32_t i, std::int32_t j) {
-                       return trianglePairIntersects(ta[i], tb[j], b_in_a, tol, padding, slack);
+                       if (!trianglePairIntersects(ta[i], tb[j], b_in_a, tol, padding, slack)) return false;
+                       if (witness) *witness = {i, j};
+                       return true;
                      },
                      slack))
     return true;
@@ -428,11 +430,29 @@ Screen screenMeshes(const LinkGeometry& a, const Pose& pose_a, const LinkGeometr
 
 bool meshesIntersectExactly(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
                             const Tolerances& tol, double padding) noexcept {
+  return meshesIntersectExactly(a, pose_a, b, pose_b, tol, padding, nullptr);
+}
+
+bool meshesIntersectExactly(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                            const Tolerances& tol, double padding, TrianglePair* witness) noexcept {
+  if (witness) *witness = {};
   if (!pose_a.isFinite() || !pose_b.isFinite() || !validPadding(padding)) return true;
   const Pose b_in_a = relativePose(pose_a, pose_b);
   const double scale = a.boundingRadius() + b.boundingRadius() + b_in_a.t.norm();
   const double slack = padding + narrowBand(scale + padding, tol);
-  return exactIntersect(a, b, b_in_a, tol, padding, slack) || linkContained(a, b, b_in_a);
+  return exactIntersect(a, b, b_in_a, tol, padding, slack, witness) || linkContained(a, b, b_in_a);
+}
+
+bool trianglesTouch(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                    TrianglePair w, const Tolerances& tol, double padding) noexcept {
+  if (!w.valid() || w.a >= static_cast<std::int32_t>(a.triangles().size()) ||
+      w.b >= static_cast<std::int32_t>(b.triangles().size()) || !validPadding(padding))
+    return false;
+  const Pose b_in_a = relativePose(pose_a, pose_b);
+  const double scale = a.boundingRadius() + b.boundingRadius() + b_in_a.t.norm();
+  const double slack = padding + narrowBand(scale + padding, tol);
+  // (Non-finite poses fail the box test inside: false, which proves nothing.)
+  return b_in_a.isFinite() && trianglePairIntersects(a.triangles()[w.a], b.triangles()[w.b], b_in_a, tol, padding, slack);
 }
 
 bool meshesIntersect(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,

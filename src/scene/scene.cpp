@@ -17,6 +17,12 @@ namespace clearway {
 
 namespace {
 
+// The self checker before init() makes the scene's own: without tables, which would be built twice.
+SelfCollisionOptions placeholderOptions() {
+  SelfCollisionOptions o;
+  o.pair_tables = false;
+  return o;
+}
 
 }  // namespace
 
@@ -95,7 +101,7 @@ Scene::Scene(const SceneDescription& description, std::shared_ptr<const RobotGeo
       geometry_(std::move(robot)),
       environment_(environment ? std::move(environment) : std::make_shared<const Environment>()),
       filter_(geometry_->model()),
-      self_(geometry_, filter_) {
+      self_(geometry_, filter_, placeholderOptions()) {
   init();
 }
 
@@ -238,6 +244,10 @@ void Scene::init() {
   so.mode = options_.mode;
   so.tolerances = options_.tolerances;
   so.link_padding = link_padding_;
+  // Variables outside the group keep their base values in every query (computePoses writes only the group).
+  so.pair_tables = options_.pair_tables;
+  so.held = base_q_;
+  for (int v : group_variables_) so.held[v] = std::numeric_limits<double>::quiet_NaN();
   self_ = SelfCollision(geometry_, moving_filter, so);
 
   // The parts of the scene that no state changes: decided once, reported at every state.
@@ -416,7 +426,7 @@ bool Scene::isFree(const double* state, SceneContext& ctx, CollisionReport* repo
   }
   if (fx.self) {
     const long long before = ctx.self.pair_tests;
-    const LinkPair* hit = self_.firstCollision(ctx.poses.data(), ctx.self);
+    const LinkPair* hit = self_.firstCollision(ctx.poses.data(), ctx.self, ctx.q.data());
     ctx.counters.self_pair_tests += ctx.self.pair_tests - before;
     if (hit) {
       r.kind = CollisionReport::Kind::Self;

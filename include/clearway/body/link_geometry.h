@@ -21,6 +21,7 @@
 #include <clearway/tolerances.h>
 #include <clearway/tree/aabb_tree.h>
 
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -186,6 +187,18 @@ Screen screenMeshes(const LinkGeometry& a, const Pose& pose_a, const LinkGeometr
 /// the screen left Unsure; meshesIntersect's answer there.
 bool meshesIntersectExactly(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
                             const Tolerances& tol, double padding = 0.0) noexcept;
+/// Two triangles, one of each link (indices into triangles()), that touch: a witness that the links do.
+struct TrianglePair {
+  std::int32_t a = -1, b = -1;
+  bool valid() const noexcept { return a >= 0 && b >= 0; }
+};
+/// meshesIntersectExactly, also giving (when the answer is true because two triangles touch) the pair found.
+bool meshesIntersectExactly(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                            const Tolerances& tol, double padding, TrianglePair* witness) noexcept;
+/// True when the witness's triangles touch at these poses, tested as meshesIntersectExactly tests a pair:
+/// then the links intersect. False proves nothing (a witness out of range is false).
+bool trianglesTouch(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                    TrianglePair witness, const Tolerances& tol, double padding = 0.0) noexcept;
 
 /// A certified lower bound on the distance between two links from their convex parts (0 when parts
 /// touch): the least over part pairs, each pair's GJK stopping once it reaches `enough` metres or is

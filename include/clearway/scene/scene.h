@@ -115,6 +115,9 @@ struct SceneOptions {
   /// How robot and mesh files are read (package:// folders searched before the scene file's own; the
   /// COLLADA up axis).
   LoadOptions load;
+  /// Tabulate the self pairs moved by one or two joints at load (scene/pair_table.h): same verdicts,
+  /// faster queries, a longer load.
+  bool pair_tables = true;
 };
 
 class Scene {

@@ -8,6 +8,7 @@
 #include <clearway/body/enclosing.h>
 #include <clearway/body/proximity.h>
 #include <clearway/body/robot_geometry.h>
+#include <clearway/scene/pair_table.h>
 #include <clearway/tolerances.h>
 
 #include <memory>
@@ -28,6 +29,15 @@ struct SelfCollisionOptions {
   /// Metres added around each link (indexed by link; empty: none). A pair collides when its links are
   /// within padding[a] + padding[b]. Must be finite and ≥ 0.
   std::vector<double> link_padding;
+  /// Tabulate the verdicts of pairs whose relative pose depends on one or two joint variables
+  /// (scene/pair_table.h), for queries that pass the configuration. Same verdicts, built at construction.
+  bool pair_tables = true;
+  /// held[v], when finite: variable v never leaves this value in queries that pass the configuration (a
+  /// joint the scene holds), so the tables treat its joint as fixed. Empty: every variable may move.
+  std::vector<double> held;
+  PairTableOptions table_options;
+  /// Seconds all the tables may take to build (measured from the first); cells past it stay Unsure.
+  double table_seconds = 0.25;
 };
 
 /// Per-thread state of self-collision queries: one hull cache per pair and the pair that last collided.
@@ -53,13 +63,18 @@ class SelfCollision {
   const SelfCollisionOptions& options() const noexcept { return options_; }
   /// The padding of pair k (the sum of its links' paddings).
   double pairPadding(int k) const noexcept { return pair_padding_[k]; }
+  /// Pair k's table, or null when it has none.
+  const PairTable* pairTable(int k) const noexcept { return tables_.empty() ? nullptr : tables_[k].get(); }
   /// A fresh context for this checker (allocates; make one per thread and reuse it).
   SelfCollisionContext makeContext() const;
 
   /// The first colliding pair at these world link poses (one per link), or nullptr when none collides.
   /// The pair that collided in the previous query of this context is tried first (frame coherence).
-  /// Never "free" by accident: a non-finite pose collides.
-  const LinkPair* firstCollision(const Pose* link_poses, SelfCollisionContext& context) const noexcept;
+  /// Never "free" by accident: a non-finite pose collides. q (optional): the configuration the poses were
+  /// computed from (every variable of the robot, held ones at their held values), which lets the pair
+  /// tables answer; the verdict is the same with or without it.
+  const LinkPair* firstCollision(const Pose* link_poses, SelfCollisionContext& context,
+                                 const double* q = nullptr) const noexcept;
   /// Every colliding pair at these poses, appended to `out` in pair order.
   void allCollisions(const Pose* link_poses, SelfCollisionContext& context, std::vector<LinkPair>& out) const;
   /// True when pair index k collides at these poses.
@@ -78,6 +93,10 @@ class SelfCollision {
   // pairHits in two halves: the enclosing balls and the pair's cheap rungs, then (for Unsure) the triangles.
   Screen pairScreen(int k, const Pose* link_poses, SelfCollisionContext& context, bool balls_placed) const noexcept;
   bool pairExactly(int k, const Pose* link_poses) const noexcept;
+  // Pair k's table verdict at q (Unsure without a table or q).
+  PairTable::Verdict tabled(int k, const double* q) const noexcept {
+    return q && !tables_.empty() && tables_[k] ? tables_[k]->lookup(q) : PairTable::Verdict::Unsure;
+  }
   // Records pair k as the last hit and returns it.
   const LinkPair* hit(int k, SelfCollisionContext& context) const noexcept;
   // Places the context's balls when it has them (a context made by makeContext); false otherwise.
@@ -86,6 +105,8 @@ class SelfCollision {
   std::shared_ptr<const RobotGeometry> geometry_;
   std::vector<LinkPair> pairs_;
   std::vector<double> pair_padding_;
+  std::vector<std::shared_ptr<const PairTable>> tables_;  // per pair when options_.pair_tables
+  std::vector<int> with_table_;                          // the pairs that have one
   SelfCollisionOptions options_;
 };
 

@@ -1,0 +1,85 @@
+#pragma once
+// Certified verdicts of one self pair whose relative pose depends on one or two joint variables (a link
+// and its grandchild, a wrist and the gripper it turns), tabulated over those variables at load.
+//
+// Each cell of the table is a box of joint values around a centre c with half-widths h. Every point of
+// the lower link moves, relative to the upper one, by at most δ = Σ h_k·ρ_k as the variables range over
+// the cell, where ρ_k is the largest distance of the lower link's hull from joint k's axis (exact for the
+// lower joint, whose axis the hull turns about; at the cell's value of the lower joint for the upper
+// one), or 1 for a slide. So a pair certified more than padding + δ apart at c is apart everywhere in the
+// cell (Free), and a pair whose cores overlap by more than δ at c overlaps everywhere in it (Colliding).
+// Other cells are Unsure and the pair is checked as before, after one triangle test of the pair that
+// touched at the cell's centre. A coarse grid is refined where it is unsure.
+#include <clearway/body/link_geometry.h>
+#include <clearway/kinematics/robot_model.h>
+#include <clearway/tolerances.h>
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace clearway {
+
+/// How finely a pair table is cut: cells per variable of the coarse grid, then at most this many (rounded
+/// down to a power of two) within an unsure coarse cell, reached by halving where still unsure.
+struct PairTableOptions {
+  int coarse_one = 64, fine_one = 16;   ///< a pair moved by one variable
+  int coarse_two = 16, fine_two = 4;    ///< a pair moved by two
+  /// Cell centres checked at most, per table (each a distance query at load): a level of halving that
+  /// would pass it is not begun, and its cells stay Unsure.
+  long max_checks = 20000;
+  /// No table for a pair whose probe (one coarse cell in 4 per variable) settles less than this share.
+  double min_probe_share = 0.25;
+  /// No cell is checked after this moment (the cells left stay Unsure): large meshes near each other
+  /// make each check dear, and the verdicts never depend on how far a table got.
+  std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+};
+
+class PairTable {
+ public:
+  enum class Verdict : std::uint8_t { Unsure, Free, Colliding };
+
+  /// The table of links a and b (geometries ga, gb), checked with `padding` in `mode`; null when their
+  /// relative pose depends on other than one or two revolute, continuous or prismatic, non-mimic joints
+  /// (a prismatic one with finite limits). held[v], when finite, fixes variable v at that value (a joint
+  /// the scene holds is then fixed); empty: every variable moves.
+  static std::unique_ptr<const PairTable> build(const RobotModel& model, int a, const LinkGeometry& ga, int b,
+                                                const LinkGeometry& gb, double padding, GeometryMode mode,
+                                                const Tolerances& tol, const std::vector<double>& held = {},
+                                                const PairTableOptions& options = {});
+
+  /// The verdict at the full variable vector q (held variables at their held values): Free and Colliding
+  /// hold at every configuration of the cell holding q; Unsure for the other cells, and for values outside
+  /// the table (beyond the limits, not finite). For an Unsure cell whose centre collides through two
+  /// triangles, `witness` (optional) receives them (a's, b's): likely to touch near the centre too, they
+  /// are worth one triangle test (trianglesTouch) before the search.
+  Verdict lookup(const double* q, TrianglePair* witness = nullptr) const noexcept;
+
+  /// The variables the pair's relative pose depends on (one or two).
+  const std::vector<int>& variables() const noexcept { return var_; }
+  /// The share of the variables' range (by volume) whose cells are certified Free or Colliding.
+  double certifiedShare() const noexcept { return certified_; }
+  /// How many cell centres were checked to build the table.
+  int cellsChecked() const noexcept { return checked_; }
+
+ private:
+  PairTable() = default;
+  // Cell coordinates of variable k's value x (in coarse cells), or −1 when outside the table.
+  double coordinate(int k, double x) const noexcept;
+
+  std::vector<int> var_;          // per dimension: the variable
+  std::vector<char> periodic_;    // per dimension: a full turn (values reduced to [−π, π])
+  std::vector<double> lo_, inv_;  // per dimension: the range's low end and coarse cells per unit
+  std::vector<int> n_;            // per dimension: coarse cells
+  int fine_ = 1;                  // fine cells per dimension of a refined coarse cell
+  // Per coarse cell (first dimension fastest): ≥ 0 the first of its fine cells in fine_cells_, else
+  // −1 − Verdict.
+  std::vector<std::int32_t> coarse_;
+  std::vector<Verdict> fine_cells_;
+  std::vector<TrianglePair> witness_;  // per fine cell
+  double certified_ = 0.0;
+  int checked_ = 0;
+};
+
+}  // namespace clearway

@@ -1,0 +1,291 @@
+#include <clearway/scene/pair_table.h>
+
+#include <clearway/body/proximity.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace clearway {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// Added to every cell's half-width (radians or metres): far above the rounding of a value's cell
+// coordinate and of reducing a turn to [−π, π] with the double 2π (below 1e-13 for values up to
+// kMaxTurn, beyond which a turn is not looked up).
+constexpr double kValueSlack = 1e-9;
+constexpr double kMaxTurn = 1e3;
+
+// A joint of the chain that the table's variables move.
+struct Moved {
+  const Joint* joint;
+  int var;
+  bool periodic;
+  double lo, hi;
+};
+
+Pose jointMotion(const Joint& j, double x) {
+  Pose m;
+  if (j.type == JointType::Prismatic) m.t = x * j.axis;
+  else m.R = Eigen::AngleAxisd(x, j.axis).toRotationMatrix();
+  return m;
+}
+
+double axisDistance(const Vec3& p, const Vec3& u) { return (p - p.dot(u) * u).norm(); }
+
+bool isAncestor(const RobotModel& model, int ancestor, int link) {
+  for (int l = link; l >= 0; l = model.parentLink(l))
+    if (l == ancestor) return true;
+  return false;
+}
+
+// Builds one table: the chain up → down as fixed[0]·M₀(x₀)·fixed[1]·(M₁(x₁)·fixed[2]).
+struct Builder {
+  const LinkGeometry& up;
+  const LinkGeometry& down;
+  std::vector<Moved> moved;
+  std::vector<Pose> fixed;
+  double padding;
+  GeometryMode mode;
+  const Tolerances& tol;
+  BodyPair pair;
+  double reach_last = 0.0;  // ρ of the lowest moved joint (configuration-independent)
+
+  Builder(const LinkGeometry& u, const LinkGeometry& d, double pad, GeometryMode m, const Tolerances& t)
+      : up(u), down(d), padding(pad), mode(m), tol(t), pair(u, d) {}
+
+  Pose relative(const double* x) const {
+    Pose p = fixed[0];
+    for (std::size_t k = 0; k < moved.size(); ++k) p = p * jointMotion(*moved[k].joint, x[k]) * fixed[k + 1];
+    return p;
+  }
+
+  // The largest distance of the lower link's hull from joint k's axis, with the joints below k at x.
+  double reach(std::size_t k, const double* x) const {
+    if (moved[k].joint->type == JointType::Prismatic) return 1.0;
+    Pose below = fixed[k + 1];
+    for (std::size_t i = k + 1; i < moved.size(); ++i) below = below * jointMotion(*moved[i].joint, x[i]) * fixed[i + 1];
+    double r = 0.0;
+    for (const Vec3& v : down.hull().vertices()) r = std::max(r, axisDistance(below * v, moved[k].joint->axis));
+    return r * (1.0 + 1e-9) + 1e-12;
+  }
+
+  // The verdict for the cell centred at x with half-widths h; for an Unsure one, when `witness` is given,
+  // the two triangles that touch at x (invalid when none do). Only the finest cells (`finest`) climb to
+  // the triangles: a larger cell's wide margin would send a search through most of them, and its halves
+  // are cheaper to settle.
+  PairTable::Verdict cell(const double* x, const double* h, bool finest, TrianglePair* witness) {
+    double delta = 0.0;
+    for (std::size_t k = 0; k < moved.size(); ++k) {
+      const double r = k + 1 == moved.size() ? reach_last : reach(k, x);
+      delta += (h[k] * (1.0 + 1e-9) + kValueSlack) * r;
+    }
+    const Pose t = relative(x);
+    if (!t.isFinite() || !std::isfinite(delta)) return PairTable::Verdict::Unsure;
+    // The rounding of this pose against the one forward kinematics computes, and of the bounds below.
+    const double scale = up.boundingRadius() + down.boundingRadius() + t.t.norm();
+    const double margin = 1e-9 + 1e-7 * scale;
+    for (const LinkGeometry::Ball& a : up.cores())
+      for (const LinkGeometry::Ball& b : down.cores())
+        if ((a.center - t * b.center).norm() + delta + margin < a.radius + b.radius) return PairTable::Verdict::Colliding;
+    const double need = padding + delta + margin;
+    BoundQuery q;
+    q.enough = need;
+    q.mode = finest ? mode : GeometryMode::Hull;
+    q.within = need;  // the triangles' question is whether they lie within it: no distance is measured
+    q.near = 0.0;
+    if (pair.lowerBound(Pose::identity(), t, tol, q) > need) return PairTable::Verdict::Free;
+    if (witness && mode == GeometryMode::Mesh) meshesIntersectExactly(up, Pose::identity(), down, t, tol, padding, witness);
+    return PairTable::Verdict::Unsure;
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<const PairTable> PairTable::build(const RobotModel& model, int a, const LinkGeometry& ga, int b,
+                                                  const LinkGeometry& gb, double padding, GeometryMode mode,
+                                                  const Tolerances& tol, const std::vector<double>& held,
+                                                  const PairTableOptions& options) {
+  int up = a, down = b;
+  if (!isAncestor(model, a, b)) {
+    if (!isAncestor(model, b, a)) return nullptr;
+    std::swap(up, down);
+  }
+  std::vector<int> chain;
+  for (int l = down; l != up; l = model.parentLink(l)) chain.push_back(model.links()[l].parent_joint);
+  std::reverse(chain.begin(), chain.end());
+
+  const auto heldValue = [&](int var) {
+    return var >= 0 && var < static_cast<int>(held.size()) && std::isfinite(held[var]) ? held[var] : NAN;
+  };
+  Builder bld(up == a ? ga : gb, up == a ? gb : ga, padding, mode, tol);
+  Pose cur = Pose::identity();
+  for (int ji : chain) {
+    const Joint& j = model.joints()[ji];
+    cur = cur * j.origin;
+    if (j.type == JointType::Fixed) continue;
+    const bool turns = j.type == JointType::Revolute || j.type == JointType::Continuous;
+    if (!turns && j.type != JointType::Prismatic) {  // planar, floating: only when held
+      return nullptr;
+    }
+    const int leader = j.isMimic() ? model.joint(j.mimic.joint).first_variable : j.first_variable;
+    const double value = heldValue(leader);
+    if (std::isfinite(value)) {
+      cur = cur * jointMotion(j, j.isMimic() ? j.mimic.multiplier * value + j.mimic.offset : value);
+      continue;
+    }
+    if (j.isMimic() || leader < 0 || bld.moved.size() == 2 || std::abs(j.axis.norm() - 1.0) > 1e-9) return nullptr;
+    const JointVariable& v = model.variables()[leader];
+    Moved m{&j, leader, false, v.lower, v.upper};
+    if (turns && !(v.upper - v.lower < 2.0 * kPi)) m = {&j, leader, true, -kPi, kPi};
+    if (!(m.hi - m.lo > 1e-9) || !std::isfinite(m.hi - m.lo)) return nullptr;
+    bld.fixed.push_back(cur);
+    bld.moved.push_back(m);
+    cur = Pose::identity();
+  }
+  if (bld.moved.empty()) return nullptr;  // a rigid pair: decided once by the scene
+  bld.fixed.push_back(cur);
+
+  std::unique_ptr<PairTable> t(new PairTable());
+  const int dims = static_cast<int>(bld.moved.size());
+  const int coarse = dims == 1 ? options.coarse_one : options.coarse_two;
+  // Fine cells per coarse one: a power of two, for the halving below.
+  t->fine_ = 1;
+  while (t->fine_ * 2 <= (dims == 1 ? options.fine_one : options.fine_two)) t->fine_ *= 2;
+  for (const Moved& m : bld.moved) {
+    t->var_.push_back(m.var);
+    t->periodic_.push_back(m.periodic);
+    t->lo_.push_back(m.lo);
+    t->n_.push_back(std::max(1, coarse));
+    t->inv_.push_back(t->n_.back() / (m.hi - m.lo));
+  }
+  {
+    const double x[2] = {0.0, 0.0};
+    bld.reach_last = bld.reach(dims - 1, x);
+  }
+  const auto width = [&](int k) { return (bld.moved[k].hi - bld.moved[k].lo) / t->n_[k]; };
+  const int n0 = t->n_[0], n1 = dims == 2 ? t->n_[1] : 1;
+  const int f = t->fine_, f1 = dims == 2 ? f : 1;
+  long budget = options.max_checks;
+  // A region of coarse cell `coarse`: fine cells [j, j + size) per dimension.
+  struct Region {
+    int coarse, j0, j1, size;
+  };
+  std::vector<TrianglePair> witnesses(static_cast<std::size_t>(n0) * n1 * f * f1);
+  const auto check = [&](const Region& r) {
+    const int i[2] = {r.coarse % n0, r.coarse / n0}, j[2] = {r.j0, r.j1};
+    double x[2], h[2];
+    for (int k = 0; k < dims; ++k) {
+      x[k] = bld.moved[k].lo + (i[k] + (j[k] + 0.5 * r.size) / f) * width(k);
+      h[k] = 0.5 * r.size * width(k) / f;
+    }
+    ++t->checked_;
+    --budget;
+    TrianglePair w;
+    const Verdict v = bld.cell(x, h, r.size == 1, r.size == 1 ? &w : nullptr);
+    // In the pair's order (a, b), as lookup gives it.
+    if (w.valid()) witnesses[(static_cast<std::size_t>(r.coarse) * f1 + r.j1) * f + r.j0] = up == a ? w : TrianglePair{w.b, w.a};
+    return v;
+  };
+  // Level by level, halving the regions still unsure: those far from contact settle after a split or
+  // two, only those near it reach the finest size, and a budget that runs out leaves the whole table
+  // equally fine rather than one end of it. The lower joint varies slowest: neighbours share warm starts.
+  std::vector<Verdict> cells(static_cast<std::size_t>(n0) * n1 * f * f1, Verdict::Unsure);
+  const auto fill = [&](const Region& r, Verdict v) {
+    const std::size_t base = static_cast<std::size_t>(r.coarse) * f * f1;
+    for (int y = r.j1; y < r.j1 + (dims == 2 ? r.size : 1); ++y)
+      for (int x = r.j0; x < r.j0 + r.size; ++x) cells[base + static_cast<std::size_t>(y) * f + x] = v;
+  };
+  const auto split = [&](const Region& r, std::vector<Region>& out) {
+    const int half = r.size / 2;
+    for (int b1 = 0; b1 < (dims == 2 ? 2 : 1); ++b1)
+      for (int b0 = 0; b0 < 2; ++b0) out.push_back({r.coarse, r.j0 + b0 * half, r.j1 + b1 * half, half});
+  };
+  const auto refine = [&](std::vector<Region> level) {
+    std::vector<Region> next;
+    while (!level.empty() && budget >= static_cast<long>(level.size())) {
+      next.clear();
+      for (const Region& r : level) {
+        if (std::chrono::steady_clock::now() > options.deadline) return;
+        const Verdict v = check(r);
+        if (v != Verdict::Unsure) fill(r, v);
+        else if (r.size > 1) split(r, next);
+      }
+      level.swap(next);
+    }
+  };
+  const auto share = [&](const std::vector<int>& coarse_cells) {
+    const std::size_t per = static_cast<std::size_t>(f) * f1;
+    double settled = 0.0;
+    for (int c : coarse_cells)
+      for (std::size_t k = c * per; k < (c + 1) * per; ++k) settled += cells[k] != Verdict::Unsure;
+    return coarse_cells.empty() ? 1.0 : settled / (per * coarse_cells.size());
+  };
+  // A probe first, every kProbe-th coarse cell per dimension refined in full: a pair that stays near
+  // contact over its whole range (a link turning about an axis through its neighbour) settles too little
+  // to pay for the rest.
+  constexpr int kProbe = 4;
+  std::vector<int> probe;
+  std::vector<Region> probe_cells, rest;
+  for (int c = 0; c < n0 * n1; ++c) {
+    const bool probed = c % n0 % kProbe == 0 && c / n0 % kProbe == 0;
+    (probed ? probe_cells : rest).push_back({c, 0, 0, f});
+    if (probed) probe.push_back(c);
+  }
+  refine(probe_cells);
+  if (share(probe) < options.min_probe_share) return nullptr;
+  refine(rest);
+  // Blocks all of one verdict fold into their coarse cell.
+  const std::size_t per = static_cast<std::size_t>(f) * f1;
+  double certified = 0.0;
+  for (int c = 0; c < n0 * n1; ++c) {
+    const auto first = cells.begin() + static_cast<std::ptrdiff_t>(c * per), last = first + static_cast<std::ptrdiff_t>(per);
+    certified += static_cast<double>(std::count_if(first, last, [](Verdict w) { return w != Verdict::Unsure; })) / per;
+    const auto wfirst = witnesses.begin() + static_cast<std::ptrdiff_t>(c * per), wlast = wfirst + static_cast<std::ptrdiff_t>(per);
+    if (std::all_of(first, last, [&](Verdict w) { return w == *first; }) &&
+        std::none_of(wfirst, wlast, [](const TrianglePair& w) { return w.valid(); })) {
+      t->coarse_.push_back(-1 - static_cast<std::int32_t>(*first));
+    } else {
+      t->coarse_.push_back(static_cast<std::int32_t>(t->fine_cells_.size()));
+      t->fine_cells_.insert(t->fine_cells_.end(), first, last);
+      t->witness_.insert(t->witness_.end(), wfirst, wlast);
+    }
+  }
+  t->certified_ = certified / (static_cast<double>(n0) * n1);
+  return t;
+}
+
+double PairTable::coordinate(int k, double x) const noexcept {
+  if (periodic_[k]) {
+    if (!(std::abs(x) <= kMaxTurn)) return -1.0;
+    x = std::remainder(x, 2.0 * kPi);
+  }
+  const double u = (x - lo_[k]) * inv_[k];
+  return u >= 0.0 && u <= n_[k] ? u : -1.0;  // (NaN fails)
+}
+
+PairTable::Verdict PairTable::lookup(const double* q, TrianglePair* witness) const noexcept {
+  if (witness) *witness = {};
+  const int dims = static_cast<int>(var_.size());
+  double u[2];
+  int i[2];
+  int cell = 0, stride = 1;
+  for (int k = 0; k < dims; ++k) {
+    u[k] = coordinate(k, q[var_[k]]);
+    if (u[k] < 0.0) return Verdict::Unsure;
+    i[k] = std::min(static_cast<int>(u[k]), n_[k] - 1);
+    cell += i[k] * stride;
+    stride *= n_[k];
+  }
+  const std::int32_t e = coarse_[cell];
+  if (e < 0) return static_cast<Verdict>(-1 - e);
+  int at = 0;
+  stride = 1;
+  for (int k = 0; k < dims; ++k) {
+    at += std::min(static_cast<int>((u[k] - i[k]) * fine_), fine_ - 1) * stride;
+    stride *= fine_;
+  }
+  if (witness) *witness = witness_[e + at];
+  return fine_cells_[e + at];
+}
+
+}  // namespace clearway

@@ -1,0 +1,290 @@
+// Pair tables (scene/pair_table.h): every cell they call Free or Colliding is so at every configuration
+// of it, borders included, on our robots and the shared ones; a witness that touches means a collision;
+// scenes answer state by state as they do without tables; and only pairs moved by one or two joints get one.
+#include <clearway/kinematics/forward_kinematics.h>
+#include <clearway/load/robot_loader.h>
+#include <clearway/scene/pair_table.h>
+#include <clearway/scene/scene.h>
+#include <clearway/scene/self_collision.h>
+
+#include "load/robot_files.h"
+#include "scene/arm_scene.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+namespace clearway {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+struct Tally {
+  long free = 0, colliding = 0, unsure = 0, witnessed = 0;
+};
+
+// Random configurations within the limits (±π for unbounded joints), with some values of the tables'
+// variables put on a cell border, or a hair either side of one (the coarsest cells' borders are those
+// of every finer cell too).
+std::vector<double> randomConfiguration(const RobotModel& m, std::mt19937_64& rng) {
+  std::vector<double> q(m.variableCount());
+  for (int v = 0; v < m.variableCount(); ++v) {
+    const JointVariable& var = m.variables()[v];
+    const double lo = std::isfinite(var.lower) ? var.lower : -M_PI, hi = std::isfinite(var.upper) ? var.upper : M_PI;
+    q[v] = std::uniform_real_distribution<double>(lo, hi)(rng);
+    if (rng() % 4 == 0) {  // onto a border of a 256-cell grid, which holds every grid of the tables
+      const double w = (hi - lo) / 256;
+      const double k = std::floor((q[v] - lo) / w);
+      const double nudge[3] = {0.0, 1e-12, -1e-12};
+      q[v] = std::clamp(lo + k * w + nudge[rng() % 3], lo, hi);
+    }
+  }
+  return q;
+}
+
+// Every table of `checker` against meshesIntersect (the exact verdict) at `states` configurations.
+Tally checkTables(const RobotModel& model, const SelfCollision& checker, int states, std::uint64_t seed,
+                  const std::vector<double>& held = {}) {
+  Tally t;
+  std::mt19937_64 rng(seed);
+  std::vector<Pose> poses(model.linkCount());
+  const RobotGeometry& g = checker.geometry();
+  for (int s = 0; s < states; ++s) {
+    std::vector<double> q = randomConfiguration(model, rng);
+    for (std::size_t v = 0; v < held.size(); ++v)
+      if (std::isfinite(held[v])) q[v] = held[v];
+    computeLinkPoses(model, q.data(), poses.data());
+    for (int k = 0; k < static_cast<int>(checker.pairs().size()); ++k) {
+      const PairTable* table = checker.pairTable(k);
+      if (!table) continue;
+      const LinkPair& p = checker.pairs()[k];
+      TrianglePair w;
+      const PairTable::Verdict v = table->lookup(q.data(), &w);
+      const bool exact = meshesIntersect(*g.link(p.a), poses[p.a], *g.link(p.b), poses[p.b],
+                                         checker.options().tolerances, checker.options().mode, checker.pairPadding(k));
+      const std::string where = "state " + std::to_string(s) + " pair " + model.link(p.a).name + "/" + model.link(p.b).name;
+      if (v == PairTable::Verdict::Free) {
+        ++t.free;
+        EXPECT_FALSE(exact) << where << ": the table says free";
+      } else if (v == PairTable::Verdict::Colliding) {
+        ++t.colliding;
+        EXPECT_TRUE(exact) << where << ": the table says colliding";
+      } else {
+        ++t.unsure;
+        if (w.valid() && trianglesTouch(*g.link(p.a), poses[p.a], *g.link(p.b), poses[p.b], w,
+                                        checker.options().tolerances, checker.pairPadding(k))) {
+          ++t.witnessed;
+          EXPECT_TRUE(exact) << where << ": the witness touches";
+        }
+      }
+    }
+  }
+  std::printf("%ld free, %ld colliding, %ld unsure (%ld proved colliding by their witness)\n", t.free, t.colliding,
+              t.unsure, t.witnessed);
+  return t;
+}
+
+TEST(PairTable, PandaCellsHoldWhatTheyCertify) {
+  CLEARWAY_SHARED_ROBOT_OR_SKIP(urdf, "panda/panda.urdf");
+  auto model = std::make_shared<const RobotModel>(loadRobot(urdf, ""));
+  auto geometry = std::make_shared<const RobotGeometry>(model);
+  // The fingers held (as the shared scenes hold them): the pairs with the fingers are moved by two joints.
+  SelfCollisionOptions options;
+  options.table_seconds = 1e3;  // whole tables even under sanitizers: the test asks how much they settle
+  options.held.assign(model->variableCount(), NAN);
+  for (int v = 0; v < model->variableCount(); ++v)
+    if (model->variables()[v].name.find("finger") != std::string::npos) options.held[v] = 0.02;
+  const SelfCollision checker(geometry, CollisionFilter(*model), options);
+  int tables = 0;
+  for (int k = 0; k < static_cast<int>(checker.pairs().size()); ++k) tables += checker.pairTable(k) != nullptr;
+  EXPECT_GE(tables, 4);
+  const Tally t = checkTables(*model, checker, 3000, 11, options.held);
+  EXPECT_GT(t.free, 10 * t.unsure) << "the tables should settle most lookups";
+  EXPECT_GT(t.witnessed, 0);
+}
+
+TEST(PairTable, PaddedAndHullModeCellsHold) {
+  CLEARWAY_SHARED_ROBOT_OR_SKIP(urdf, "panda/panda.urdf");
+  auto model = std::make_shared<const RobotModel>(loadRobot(urdf, ""));
+  auto geometry = std::make_shared<const RobotGeometry>(model);
+  SelfCollisionOptions padded;
+  padded.link_padding.assign(model->linkCount(), 0.01);
+  const Tally p = checkTables(*model, SelfCollision(geometry, CollisionFilter(*model), padded), 1500, 12);
+  EXPECT_GT(p.free, 0);
+  SelfCollisionOptions hull;
+  hull.mode = GeometryMode::Hull;
+  const Tally h = checkTables(*model, SelfCollision(geometry, CollisionFilter(*model), hull), 1500, 13);
+  EXPECT_GT(h.free, 0);
+  EXPECT_EQ(h.witnessed, 0) << "hull mode has no triangles to witness";
+}
+
+TEST(PairTable, OurRobotsCellsHold) {
+  for (const char* rel : {"arm6/arm6.urdf", "twin_arm/twin_arm.urdf"}) {
+    SCOPED_TRACE(rel);
+    auto model = std::make_shared<const RobotModel>(loadRobot(test::sourceRobot(rel), ""));
+    SelfCollisionOptions options;
+    options.table_seconds = 1e3;
+    const SelfCollision checker(std::make_shared<const RobotGeometry>(model), CollisionFilter(*model), options);
+    const Tally t = checkTables(*model, checker, 2000, 14);
+    EXPECT_GT(t.free + t.colliding, 0);
+  }
+}
+
+TEST(PairTable, Ur5CellsHold) {
+  CLEARWAY_SHARED_ROBOT_OR_SKIP(urdf, "ur5/ur5.urdf");
+  auto model = std::make_shared<const RobotModel>(loadRobot(urdf, ""));
+  const SelfCollision checker(std::make_shared<const RobotGeometry>(model), CollisionFilter(*model));
+  const Tally t = checkTables(*model, checker, 500, 15);
+  EXPECT_GT(t.free, 0);
+}
+
+// Scenes with and without tables: the same verdict at every state, self and environment together.
+void sameVerdicts(const SceneDescription& d, int states, std::uint64_t seed) {
+  SceneOptions without;
+  without.pair_tables = false;
+  const Scene fast(d), plain(d, without);
+  SceneContext a = fast.makeContext(), b = plain.makeContext();
+  std::mt19937_64 rng(seed);
+  std::vector<double> x(fast.dimension());
+  int colliding = 0;
+  for (int s = 0; s < states; ++s) {
+    for (int i = 0; i < fast.dimension(); ++i) x[i] = std::uniform_real_distribution<double>(fast.lower(i), fast.upper(i))(rng);
+    const bool f = fast.isFree(x.data(), a);
+    ASSERT_EQ(f, plain.isFree(x.data(), b)) << "state " << s;
+    colliding += !f;
+  }
+  std::printf("%d of %d states collide\n", colliding, states);
+  EXPECT_GT(colliding, states / 20);
+  EXPECT_GT(states - colliding, states / 20);
+}
+
+TEST(PairTable, SharedScenesAnswerAsWithoutTables) {
+  CLEARWAY_SHARED_OR_SKIP(scenes, "scenes");
+  for (const char* rel : {"box_panda/box_panda_0001.yaml", "bookshelf_small_panda/bookshelf_small_panda_0002.octomap.yaml",
+                          "cage_ur5/cage_ur5_0001.yaml"}) {
+    SCOPED_TRACE(rel);
+    const SceneDescription d = parseSceneFile(scenes + "/" + rel);
+    sameVerdicts(d, std::string(rel).find("ur5") != std::string::npos ? 800 : 3000, 21);
+  }
+}
+
+TEST(PairTable, ArmSceneAnswersAsWithoutTablesPaddedOrNot) {
+  SceneDescription d = parseSceneText(test::armScene("", ""), "<arm>", "");
+  sameVerdicts(d, 4000, 22);
+  d.padding = 0.01;
+  sameVerdicts(d, 4000, 23);
+}
+
+// Base bar, a hub turning about z, an arm bar on the hub (tests/scene/test_self_collision.cpp's scissors),
+// with the joint `type`; the base–arm pair is moved by that one joint.
+std::shared_ptr<const RobotModel> scissors(JointType type, double lower, double upper, bool mimic = false) {
+  std::vector<Link> links(mimic ? 4 : 3);
+  links[0].name = "base";
+  links[0].collisions.push_back({Pose::translation(Vec3(1.0, 0, 0)), Shape(Box(Vec3(0.5, 0.05, 0.05))), -1});
+  links[1].name = "hub";
+  links[1].parent_joint = 0;
+  links[1].collisions.push_back({Pose(), Shape(Sphere(0.05)), -1});
+  links[2].name = "arm";
+  links[2].parent_joint = 1;
+  links[2].collisions.push_back({Pose::translation(Vec3(0.6, 0, 0)), Shape(Box(Vec3(0.4, 0.05, 0.05))), -1});
+  std::vector<Joint> joints(mimic ? 3 : 2);
+  joints[0].name = "swing";
+  joints[0].type = type;
+  joints[0].parent_link = 0;
+  joints[0].child_link = 1;
+  joints[0].axis = Vec3::UnitZ();
+  joints[0].lower = lower;
+  joints[0].upper = upper;
+  joints[1].name = "weld";
+  joints[1].type = JointType::Fixed;
+  joints[1].parent_link = 1;
+  joints[1].child_link = 2;
+  if (mimic) {  // a finger on the arm that follows the swing: the base–finger pair moves by a mimic
+    links[3].name = "finger";
+    links[3].parent_joint = 2;
+    links[3].collisions.push_back({Pose::translation(Vec3(0.1, 0, 0)), Shape(Box(Vec3(0.05, 0.05, 0.05))), -1});
+    joints[2].name = "follow";
+    joints[2].type = JointType::Revolute;
+    joints[2].parent_link = 2;
+    joints[2].child_link = 3;
+    joints[2].origin = Pose::translation(Vec3(1.0, 0, 0));
+    joints[2].axis = Vec3::UnitZ();
+    joints[2].lower = -M_PI;
+    joints[2].upper = M_PI;
+    joints[2].mimic.joint = 0;
+  }
+  return std::make_shared<const RobotModel>("scissors", std::move(links), std::move(joints), std::vector<TriangleMesh>{});
+}
+
+TEST(PairTable, OneJointPairAgreesWithGeometryOverTheTurnAndBeyond) {
+  for (const auto& [type, lo, hi] : {std::tuple{JointType::Revolute, -2.0, 2.5}, std::tuple{JointType::Continuous, -kInf, kInf},
+                                     std::tuple{JointType::Revolute, -7.0, 7.0}}) {
+    auto model = scissors(type, lo, hi);
+    auto geometry = std::make_shared<const RobotGeometry>(model);
+    SelfCollisionOptions options;
+    options.table_seconds = 1e3;
+    const SelfCollision checker(geometry, CollisionFilter(*model), options);
+    ASSERT_EQ(checker.pairs().size(), 1u);
+    const PairTable* table = checker.pairTable(0);
+    ASSERT_NE(table, nullptr);
+    EXPECT_EQ(table->variables(), std::vector<int>{0});
+    EXPECT_GT(table->certifiedShare(), 0.8);
+    std::vector<Pose> poses(3);
+    const double from = std::isfinite(lo) ? lo : -20.0, to = std::isfinite(hi) ? hi : 20.0;
+    int settled = 0;
+    for (int i = 0; i <= 20000; ++i) {
+      const double q = from + (to - from) * i / 20000;
+      computeLinkPoses(*model, &q, poses.data());
+      const bool exact = meshesIntersect(*geometry->link(0), poses[0], *geometry->link(2), poses[2], Tolerances{}, GeometryMode::Mesh);
+      const PairTable::Verdict v = table->lookup(&q);
+      if (v == PairTable::Verdict::Unsure) continue;
+      ++settled;
+      EXPECT_EQ(v == PairTable::Verdict::Colliding, exact) << "q = " << q;
+    }
+    EXPECT_GT(settled, 16000);
+    // Beyond the limits, not finite, or a turn too large to reduce safely: Unsure.
+    for (double q : {std::nan(""), kInf, -kInf, 1e6})
+      EXPECT_EQ(table->lookup(&q), PairTable::Verdict::Unsure) << q;
+    if (type == JointType::Revolute && hi < 3.0) {
+      const double beyond = hi + 0.1;
+      EXPECT_EQ(table->lookup(&beyond), PairTable::Verdict::Unsure);
+    }
+  }
+}
+
+TEST(PairTable, OnlyPairsMovedByOneOrTwoPlainJoints) {
+  // A mimic joint on the chain: no table for the pair it moves.
+  {
+    auto model = scissors(JointType::Revolute, -2.0, 2.0, true);
+    auto g = std::make_shared<const RobotGeometry>(model);
+    EXPECT_EQ(PairTable::build(*model, 0, *g->link(0), 3, *g->link(3), 0.0, GeometryMode::Mesh, Tolerances{}), nullptr);
+    EXPECT_NE(PairTable::build(*model, 0, *g->link(0), 2, *g->link(2), 0.0, GeometryMode::Mesh, Tolerances{}), nullptr);
+    // Held, the swing is fixed: the pair is rigid, decided once by the scene, and has no table either.
+    EXPECT_EQ(PairTable::build(*model, 0, *g->link(0), 3, *g->link(3), 0.0, GeometryMode::Mesh, Tolerances{}, {0.5}), nullptr);
+  }
+  // arm6: tables only for pairs with one or two joints between them on one branch.
+  auto model = std::make_shared<const RobotModel>(loadRobot(test::sourceRobot("arm6/arm6.urdf"), ""));
+  const SelfCollision checker(std::make_shared<const RobotGeometry>(model), CollisionFilter(*model));
+  int with = 0;
+  for (int k = 0; k < static_cast<int>(checker.pairs().size()); ++k) {
+    const LinkPair& p = checker.pairs()[k];
+    int moving = -1;
+    for (int up : {p.a, p.b}) {
+      const int down = up == p.a ? p.b : p.a;
+      int n = 0;
+      int l = down;
+      for (; l >= 0 && l != up; l = model->parentLink(l))
+        n += model->joint(model->link(l).parent_joint).type != JointType::Fixed;
+      if (l == up) moving = n;
+    }
+    // (A pair may lack a table it could have: one whose probe settled too little.)
+    if (checker.pairTable(k)) EXPECT_TRUE(moving == 1 || moving == 2) << model->link(p.a).name << "/" << model->link(p.b).name;
+    with += checker.pairTable(k) != nullptr;
+  }
+  EXPECT_GT(with, 0);
+}
+
+}  // namespace
+}  // namespace clearway
