@@ -447,6 +447,22 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
   }
 
   if (options_.mode == MotionMode::Cast) castAhead(q0, q1, t0, n_items, ctx, r);
+  // Self items whose tables prove them apart along the whole segment are not swept.
+  bool ends_set = false;
+  for (int k = 0; k < std::min(n_items, env_begin_); ++k) {
+    if (item_tables_[k].empty() || items_[k].group >= 0) continue;
+    if (!ends_set) {
+      const std::vector<int>& group = sc.groupVariables();
+      for (int e = 0; e < 2; ++e) {
+        ctx.ends[e] = ctx.scene.q;  // (the variables outside the group at their held values)
+        for (std::size_t i = 0; i < group.size(); ++i) ctx.ends[e][group[i]] = (e ? q1 : q0)[i];
+      }
+      ends_set = true;
+    }
+    bool apart = true;
+    for (const auto& t : item_tables_[k]) apart = apart && t->freeAlong(ctx.ends[0].data(), ctx.ends[1].data());
+    if (apart) ctx.safe_until[k] = 2.0;  // (beyond 1: covered)
+  }
   Sweep sweep{*this, ctx, r, q0, q1};
   sweep.t0 = t0, sweep.t1 = t1;
   sweep.verdict_only = !locate_contact;

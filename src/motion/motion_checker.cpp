@@ -7,6 +7,7 @@
 #include <clearway/narrowphase/ray_cast.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -79,6 +80,34 @@ MotionChecker::MotionChecker(std::shared_ptr<const Scene> scene, MotionOptions o
     if (joint.type == JointType::Floating && v == joint.first_variable + 3) quaternions_.push_back(i);
   }
   buildItems();
+  buildItemTables();
+}
+
+void MotionChecker::buildItemTables() {
+  const Scene& sc = *scene_;
+  item_tables_.assign(env_begin_, {});
+  if (options_.mode == MotionMode::Sampled || !sc.options().pair_tables) return;
+  const SelfCollisionOptions& so = sc.selfCollision().options();
+  PairTableOptions table = so.table_options;
+  const auto budget = std::chrono::duration<double>(std::max(0.0, std::min(so.table_seconds, 1e6)));
+  table.deadline = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(budget);
+  const double margin = 2.0 * options_.contact_distance;
+  for (int k = 0; k < env_begin_; ++k) {
+    const Item& item = items_[k];
+    if (item.group >= 0) continue;  // (a member: its group's list holds its table)
+    std::vector<std::shared_ptr<const PairTable>> list;
+    const int first = item.first < item.last ? item.first : k, last = item.first < item.last ? item.last : k + 1;
+    for (int m = first; m < last; ++m) {
+      auto t = PairTable::shared(sc.geometryPtr(), items_[m].a, items_[m].b, items_[m].padding + margin,
+                                 sc.options().mode, sc.options().tolerances, so.held, table);
+      if (!t) {
+        list.clear();
+        break;
+      }
+      list.push_back(std::move(t));
+    }
+    item_tables_[k] = std::move(list);
+  }
 }
 
 MotionChecker::MotionChecker(const MotionChecker& base, std::shared_ptr<const Scene> scene)

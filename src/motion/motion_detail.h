@@ -13,6 +13,7 @@ namespace clearway::motion_detail {
 struct Scratch {
   SceneContext scene;
   std::vector<double> q, dq;
+  std::vector<double> ends[2];  // the segment's ends as full variable vectors (for the pair tables)
   std::vector<double> safe_until;  // per item: where its coverage starts (Cast: where its shape cast reached)
   std::vector<double> bound;       // per item: its motion bound for this segment
   std::vector<double> first_reach; // per item: how far its first measurement (in the middle) clears, −1: none

@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <mutex>
+#include <tuple>
 
 namespace clearway {
 namespace {
@@ -99,7 +102,65 @@ struct Builder {
   }
 };
 
+// Tables already built, for checkers of the same robot geometry with the same settings (scenes that share
+// a loaded robot, one after another or at once; a scene and its edits): a table depends on nothing else.
+// An entry lives as long as its geometry (the address is then that geometry's alone).
+struct TableCache {
+  struct Key {
+    const RobotGeometry* address;
+    int a, b;
+    std::vector<double> settings;  // padding, mode, tolerances, grid, held values
+    bool operator<(const Key& o) const {
+      return std::tie(address, a, b, settings) < std::tie(o.address, o.a, o.b, o.settings);
+    }
+  };
+  struct Entry {
+    std::weak_ptr<const RobotGeometry> geometry;
+    std::shared_ptr<const PairTable> table;  // null: the pair gets none
+  };
+  std::mutex mutex;
+  std::map<Key, Entry> tables;
+};
+
+TableCache& tableCache() {
+  static TableCache cache;
+  return cache;
+}
+
+std::vector<double> tableSettings(double padding, GeometryMode mode, const Tolerances& t,
+                                  const std::vector<double>& held, const PairTableOptions& p) {
+  std::vector<double> s = {padding, static_cast<double>(mode), t.gjk_relative, t.gjk_absolute,
+                           static_cast<double>(t.gjk_max_iterations), t.cast_relative,
+                           static_cast<double>(t.cast_max_iterations), t.epa_relative,
+                           static_cast<double>(t.epa_max_iterations), static_cast<double>(p.coarse_one),
+                           static_cast<double>(p.fine_one), static_cast<double>(p.coarse_two),
+                           static_cast<double>(p.fine_two), static_cast<double>(p.max_checks), p.min_probe_share};
+  for (double h : held) s.push_back(std::isfinite(h) ? h : -std::numeric_limits<double>::infinity());
+  return s;
+}
+
 }  // namespace
+
+std::shared_ptr<const PairTable> PairTable::shared(const std::shared_ptr<const RobotGeometry>& geometry, int a, int b,
+                                                   double padding, GeometryMode mode, const Tolerances& tol,
+                                                   const std::vector<double>& held, const PairTableOptions& options) {
+  if (!geometry || !geometry->link(a) || !geometry->link(b)) return nullptr;
+  TableCache& cache = tableCache();
+  TableCache::Key key{geometry.get(), a, b, tableSettings(padding, mode, tol, held, options)};
+  {
+    const std::lock_guard<std::mutex> lock(cache.mutex);
+    const auto it = cache.tables.find(key);
+    if (it != cache.tables.end() && !it->second.geometry.expired()) return it->second.table;
+  }
+  std::shared_ptr<const PairTable> t =
+      build(geometry->model(), a, *geometry->link(a), b, *geometry->link(b), padding, mode, tol, held, options);
+  const std::lock_guard<std::mutex> lock(cache.mutex);
+  // Entries of robots gone are dropped as new ones come.
+  for (auto it = cache.tables.begin(); it != cache.tables.end();)
+    it = it->second.geometry.expired() ? cache.tables.erase(it) : std::next(it);
+  cache.tables[std::move(key)] = {geometry, t};
+  return t;
+}
 
 std::unique_ptr<const PairTable> PairTable::build(const RobotModel& model, int a, const LinkGeometry& ga, int b,
                                                   const LinkGeometry& gb, double padding, GeometryMode mode,
@@ -286,6 +347,78 @@ PairTable::Verdict PairTable::lookup(const double* q, TrianglePair* witness) con
   }
   if (witness) *witness = witness_[e + at];
   return fine_cells_[e + at];
+}
+
+}  // namespace clearway
+
+namespace clearway {
+
+PairTable::Verdict PairTable::fineCell(const int* c) const noexcept {
+  const int dims = static_cast<int>(var_.size());
+  int cell = 0, at = 0, stride = 1, fine_stride = 1;
+  for (int k = 0; k < dims; ++k) {
+    cell += c[k] / fine_ * stride;
+    at += c[k] % fine_ * fine_stride;
+    stride *= n_[k];
+    fine_stride *= fine_;
+  }
+  const std::int32_t e = coarse_[cell];
+  return e < 0 ? static_cast<Verdict>(-1 - e) : fine_cells_[e + at];
+}
+
+bool PairTable::freeAlong(const double* q0, const double* q1) const noexcept {
+  // A walk through the fine cells the segment crosses (Amanatides–Woo), in fine-cell units; a turn is
+  // walked unrolled, its cells taken modulo the turn. A crossing misordered by rounding near a corner
+  // visits a neighbour of the cell it skips, within far less than the slack every cell's check added.
+  const int dims = static_cast<int>(var_.size());
+  double u[2] = {0.0, 0.0}, d[2] = {0.0, 0.0}, next[2], delta[2];
+  int c[2] = {0, 0}, step[2] = {0, 0}, cells[2] = {1, 1};
+  long budget = 2;  // cells the walk may visit: those between its ends, plus its first
+  for (int k = 0; k < dims; ++k) {
+    cells[k] = n_[k] * fine_;
+    double a = q0[var_[k]], b = q1[var_[k]];
+    if (periodic_[k]) {
+      if (!(std::abs(a) <= kMaxTurn && std::abs(b) <= kMaxTurn)) return false;
+      const double r = std::remainder(a, 2.0 * kPi);
+      b = r + (b - a);
+      a = r;
+    } else if (!(a >= lo_[k] && a <= lo_[k] + n_[k] / inv_[k] && b >= lo_[k] && b <= lo_[k] + n_[k] / inv_[k])) {
+      return false;  // (the segment lies within the range when its ends do)
+    }
+    const double scale = inv_[k] * fine_;
+    u[k] = (a - lo_[k]) * scale;
+    d[k] = (b - a) * scale;
+    if (!std::isfinite(u[k]) || !std::isfinite(d[k])) return false;
+    const double start = std::floor(u[k]);
+    c[k] = static_cast<int>(start);
+    if (d[k] > 0.0) {
+      step[k] = 1;
+      next[k] = (start + 1.0 - u[k]) / d[k];
+      delta[k] = 1.0 / d[k];
+    } else if (d[k] < 0.0) {
+      step[k] = -1;
+      next[k] = (u[k] - start) / -d[k];
+      delta[k] = -1.0 / d[k];
+    } else {
+      next[k] = delta[k] = std::numeric_limits<double>::infinity();
+    }
+    budget += static_cast<long>(std::abs(std::floor(u[k] + d[k]) - start)) + 1;
+  }
+  if (budget > 64L * (cells[0] + cells[1])) return false;  // many turns: not worth the walk
+  for (; budget > 0; --budget) {
+    int at[2];
+    for (int k = 0; k < 2; ++k) {
+      at[k] = k < dims ? c[k] % cells[k] : 0;
+      if (at[k] < 0) at[k] += cells[k];
+      if (k < dims && !periodic_[k]) at[k] = std::clamp(c[k], 0, cells[k] - 1);  // an end on the far border
+    }
+    if (fineCell(at) != Verdict::Free) return false;
+    const int k = dims == 2 && next[1] < next[0] ? 1 : 0;
+    if (!(next[k] <= 1.0)) return true;  // the walk reached q1's cell
+    c[k] += step[k];
+    next[k] += delta[k];
+  }
+  return false;  // (rounding took more steps than the cells between the ends: not proved)
 }
 
 }  // namespace clearway

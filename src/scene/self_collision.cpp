@@ -3,9 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
-#include <mutex>
-#include <tuple>
 #include <stdexcept>
 #include <string>
 
@@ -13,43 +10,6 @@ namespace clearway {
 namespace {
 constexpr double kNoCutoff = std::numeric_limits<double>::infinity();
 
-// Tables already built, for checkers of the same robot geometry with the same settings (scenes that share
-// a loaded robot, one after another or at once; a scene and its edits): a table depends on nothing else.
-// An entry lives as long as its geometry (the address is then that geometry's alone).
-struct TableCache {
-  struct Key {
-    const RobotGeometry* address;
-    int a, b;
-    std::vector<double> settings;  // padding, mode, tolerances, grid, held values
-    bool operator<(const Key& o) const {
-      return std::tie(address, a, b, settings) < std::tie(o.address, o.a, o.b, o.settings);
-    }
-  };
-  struct Entry {
-    std::weak_ptr<const RobotGeometry> geometry;
-    std::shared_ptr<const PairTable> table;  // null: the pair gets none
-  };
-  std::mutex mutex;
-  std::map<Key, Entry> tables;
-};
-
-TableCache& tableCache() {
-  static TableCache cache;
-  return cache;
-}
-
-std::vector<double> tableSettings(double padding, const SelfCollisionOptions& o) {
-  const Tolerances& t = o.tolerances;
-  const PairTableOptions& p = o.table_options;
-  std::vector<double> s = {padding, static_cast<double>(o.mode), t.gjk_relative, t.gjk_absolute,
-                           static_cast<double>(t.gjk_max_iterations), t.cast_relative,
-                           static_cast<double>(t.cast_max_iterations), t.epa_relative,
-                           static_cast<double>(t.epa_max_iterations), static_cast<double>(p.coarse_one),
-                           static_cast<double>(p.fine_one), static_cast<double>(p.coarse_two),
-                           static_cast<double>(p.fine_two), static_cast<double>(p.max_checks), p.min_probe_share};
-  for (double h : o.held) s.push_back(std::isfinite(h) ? h : -std::numeric_limits<double>::infinity());
-  return s;
-}
 }  // namespace
 
 SelfCollision::SelfCollision(std::shared_ptr<const RobotGeometry> geometry, const CollisionFilter& filter,
@@ -79,30 +39,9 @@ SelfCollision::SelfCollision(std::shared_ptr<const RobotGeometry> geometry, cons
     const auto budget = std::chrono::duration<double>(std::max(0.0, std::min(options_.table_seconds, 1e6)));
     table.deadline = std::min(table.deadline, std::chrono::steady_clock::now() +
                                                    std::chrono::duration_cast<std::chrono::steady_clock::duration>(budget));
-    TableCache& cache = tableCache();
-    for (std::size_t k = 0; k < pairs_.size(); ++k) {
-      const TableCache::Key key{geometry_.get(), pairs_[k].a, pairs_[k].b, tableSettings(pair_padding_[k], options_)};
-      {
-        const std::lock_guard<std::mutex> lock(cache.mutex);
-        const auto it = cache.tables.find(key);
-        if (it != cache.tables.end() && !it->second.geometry.expired()) {
-          tables_.push_back(it->second.table);
-          continue;
-        }
-      }
-      std::shared_ptr<const PairTable> t =
-          PairTable::build(geometry_->model(), pairs_[k].a, *geometry_->link(pairs_[k].a), pairs_[k].b,
-                           *geometry_->link(pairs_[k].b), pair_padding_[k], options_.mode, options_.tolerances,
-                           options_.held, table);
-      {
-        const std::lock_guard<std::mutex> lock(cache.mutex);
-        // Entries of robots gone are dropped as new ones come.
-        for (auto it = cache.tables.begin(); it != cache.tables.end();)
-          it = it->second.geometry.expired() ? cache.tables.erase(it) : std::next(it);
-        cache.tables[key] = {geometry_, t};
-      }
-      tables_.push_back(std::move(t));
-    }
+    for (std::size_t k = 0; k < pairs_.size(); ++k)
+      tables_.push_back(PairTable::shared(geometry_, pairs_[k].a, pairs_[k].b, pair_padding_[k], options_.mode,
+                                          options_.tolerances, options_.held, table));
   }
   for (std::size_t k = 0; k < tables_.size(); ++k)
     if (tables_[k]) with_table_.push_back(static_cast<int>(k));

@@ -9,10 +9,12 @@
 
 #include "load/robot_files.h"
 #include "scene/arm_scene.h"
+#include "scene/scissors.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <random>
 
@@ -140,6 +142,61 @@ TEST(PairTable, Ur5CellsHold) {
   EXPECT_GT(t.free, 0);
 }
 
+// freeAlong walks every cell a segment crosses: where it says free, every one of 4,000 points along the
+// segment looks up Free and the exact pair is apart there; and it says free for most segments whose points
+// all look up Free (the rest touch a cell not Free between two points).
+TEST(PairTable, SegmentsAreWalkedThroughEveryCellTheyCross) {
+  struct Case {
+    std::string urdf;
+    std::uint64_t seed;
+  };
+  std::vector<Case> cases = {{test::sourceRobot("arm6/arm6.urdf"), 31}};
+  const std::string panda = test::sharedRobot("panda/panda.urdf");
+  if (!panda.empty() && std::filesystem::exists(panda)) cases.push_back({panda, 32});
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.urdf);
+    auto model = std::make_shared<const RobotModel>(loadRobot(c.urdf, ""));
+    auto geometry = std::make_shared<const RobotGeometry>(model);
+    SelfCollisionOptions options;
+    options.table_seconds = 1e3;
+    const SelfCollision checker(geometry, CollisionFilter(*model), options);
+    std::mt19937_64 rng(c.seed);
+    std::vector<Pose> poses(model->linkCount());
+    int said_free = 0, all_points_free = 0, walked = 0;
+    for (int k = 0; k < static_cast<int>(checker.pairs().size()); ++k) {
+      const PairTable* table = checker.pairTable(k);
+      if (!table) continue;
+      const LinkPair& p = checker.pairs()[k];
+      for (int s = 0; s < 150; ++s) {
+        const std::vector<double> q0 = randomConfiguration(*model, rng);
+        std::vector<double> q1 = randomConfiguration(*model, rng), q(q0.size());
+        for (std::size_t v = 0; v < q0.size(); ++v) q1[v] = q0[v] + (q1[v] - q0[v]) * (s % 3 == 0 ? 1.0 : 0.1);
+        const bool free = table->freeAlong(q0.data(), q1.data());
+        bool points = true;
+        for (int i = 0; i <= 4000; ++i) {
+          for (std::size_t v = 0; v < q.size(); ++v) q[v] = q0[v] + (q1[v] - q0[v]) * (i / 4000.0);
+          const bool cell_free = table->lookup(q.data()) == PairTable::Verdict::Free;
+          points = points && cell_free;
+          if (free) {
+            ASSERT_TRUE(cell_free) << "segment " << s << " point " << i << ": walked free through a cell that is not";
+            if (i % 200 == 0) {
+              computeLinkPoses(*model, q.data(), poses.data());
+              EXPECT_FALSE(meshesIntersect(*geometry->link(p.a), poses[p.a], *geometry->link(p.b), poses[p.b],
+                                           Tolerances{}, GeometryMode::Mesh, checker.pairPadding(k)));
+            }
+          }
+        }
+        ++walked;
+        said_free += free;
+        all_points_free += points;
+      }
+    }
+    std::printf("%d segments: %d walked free, %d free at every point\n", walked, said_free, all_points_free);
+    EXPECT_GT(said_free, walked / 4);
+    EXPECT_GE(said_free, all_points_free * 9 / 10);
+  }
+}
+
 // Scenes with and without tables: the same verdict at every state, self and environment together.
 void sameVerdicts(const SceneDescription& d, int states, std::uint64_t seed) {
   SceneOptions without;
@@ -177,51 +234,10 @@ TEST(PairTable, ArmSceneAnswersAsWithoutTablesPaddedOrNot) {
   sameVerdicts(d, 4000, 23);
 }
 
-// Base bar, a hub turning about z, an arm bar on the hub (tests/scene/test_self_collision.cpp's scissors),
-// with the joint `type`; the base–arm pair is moved by that one joint.
-std::shared_ptr<const RobotModel> scissors(JointType type, double lower, double upper, bool mimic = false) {
-  std::vector<Link> links(mimic ? 4 : 3);
-  links[0].name = "base";
-  links[0].collisions.push_back({Pose::translation(Vec3(1.0, 0, 0)), Shape(Box(Vec3(0.5, 0.05, 0.05))), -1});
-  links[1].name = "hub";
-  links[1].parent_joint = 0;
-  links[1].collisions.push_back({Pose(), Shape(Sphere(0.05)), -1});
-  links[2].name = "arm";
-  links[2].parent_joint = 1;
-  links[2].collisions.push_back({Pose::translation(Vec3(0.6, 0, 0)), Shape(Box(Vec3(0.4, 0.05, 0.05))), -1});
-  std::vector<Joint> joints(mimic ? 3 : 2);
-  joints[0].name = "swing";
-  joints[0].type = type;
-  joints[0].parent_link = 0;
-  joints[0].child_link = 1;
-  joints[0].axis = Vec3::UnitZ();
-  joints[0].lower = lower;
-  joints[0].upper = upper;
-  joints[1].name = "weld";
-  joints[1].type = JointType::Fixed;
-  joints[1].parent_link = 1;
-  joints[1].child_link = 2;
-  if (mimic) {  // a finger on the arm that follows the swing: the base–finger pair moves by a mimic
-    links[3].name = "finger";
-    links[3].parent_joint = 2;
-    links[3].collisions.push_back({Pose::translation(Vec3(0.1, 0, 0)), Shape(Box(Vec3(0.05, 0.05, 0.05))), -1});
-    joints[2].name = "follow";
-    joints[2].type = JointType::Revolute;
-    joints[2].parent_link = 2;
-    joints[2].child_link = 3;
-    joints[2].origin = Pose::translation(Vec3(1.0, 0, 0));
-    joints[2].axis = Vec3::UnitZ();
-    joints[2].lower = -M_PI;
-    joints[2].upper = M_PI;
-    joints[2].mimic.joint = 0;
-  }
-  return std::make_shared<const RobotModel>("scissors", std::move(links), std::move(joints), std::vector<TriangleMesh>{});
-}
-
 TEST(PairTable, OneJointPairAgreesWithGeometryOverTheTurnAndBeyond) {
   for (const auto& [type, lo, hi] : {std::tuple{JointType::Revolute, -2.0, 2.5}, std::tuple{JointType::Continuous, -kInf, kInf},
                                      std::tuple{JointType::Revolute, -7.0, 7.0}}) {
-    auto model = scissors(type, lo, hi);
+    auto model = test::scissors({0.1, type, lo, hi});
     auto geometry = std::make_shared<const RobotGeometry>(model);
     SelfCollisionOptions options;
     options.table_seconds = 1e3;
@@ -255,9 +271,9 @@ TEST(PairTable, OneJointPairAgreesWithGeometryOverTheTurnAndBeyond) {
 }
 
 TEST(PairTable, OnlyPairsMovedByOneOrTwoPlainJoints) {
-  // A mimic joint on the chain: no table for the pair it moves.
+  // The scissors' finger follows the swing through a mimic joint: no table for the pair it moves.
   {
-    auto model = scissors(JointType::Revolute, -2.0, 2.0, true);
+    auto model = test::scissors({0.1, JointType::Revolute, -2.0, 2.0, true});
     auto g = std::make_shared<const RobotGeometry>(model);
     EXPECT_EQ(PairTable::build(*model, 0, *g->link(0), 3, *g->link(3), 0.0, GeometryMode::Mesh, Tolerances{}), nullptr);
     EXPECT_NE(PairTable::build(*model, 0, *g->link(0), 2, *g->link(2), 0.0, GeometryMode::Mesh, Tolerances{}), nullptr);

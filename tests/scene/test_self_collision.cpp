@@ -5,6 +5,7 @@
 #include <clearway/scene/self_collision.h>
 
 #include "load/robot_files.h"
+#include "scene/scissors.h"
 #include "tree/mesh_reference.h"
 
 #include <gtest/gtest.h>
@@ -15,34 +16,6 @@
 
 namespace clearway {
 namespace {
-
-// A base bar lying along x from 0.5 to 1.5, a hub (sphere) turning about z at the origin, and an arm
-// bar from 0.2 to 1.0 fixed to the hub: base and arm are not adjacent (the hub between them has
-// geometry), so the pair is checked, and they meet when the arm swings over the base bar.
-std::shared_ptr<const RobotModel> scissors(double arm_width = 0.1) {
-  std::vector<Link> links(3);
-  links[0].name = "base";
-  links[0].collisions.push_back({Pose::translation(Vec3(1.0, 0, 0)), Shape(Box(Vec3(0.5, 0.05, 0.05))), -1});
-  links[1].name = "hub";
-  links[1].parent_joint = 0;
-  links[1].collisions.push_back({Pose(), Shape(Sphere(0.05)), -1});
-  links[2].name = "arm";
-  links[2].parent_joint = 1;
-  links[2].collisions.push_back({Pose::translation(Vec3(0.6, 0, 0)), Shape(Box(Vec3(0.4, arm_width / 2, 0.05))), -1});
-  std::vector<Joint> joints(2);
-  joints[0].name = "swing";
-  joints[0].type = JointType::Revolute;
-  joints[0].parent_link = 0;
-  joints[0].child_link = 1;
-  joints[0].axis = Vec3::UnitZ();
-  joints[0].lower = -M_PI;
-  joints[0].upper = M_PI;
-  joints[1].name = "weld";
-  joints[1].type = JointType::Fixed;
-  joints[1].parent_link = 1;
-  joints[1].child_link = 2;
-  return std::make_shared<const RobotModel>("scissors", std::move(links), std::move(joints), std::vector<TriangleMesh>{});
-}
 
 // 2D reference: do the rectangles [x0, x1] × [−w, w] (base) and the arm's [0.2, 1.0] × [−a, a] turned
 // by θ intersect? Separating axis theorem over the 4 edge normals, in plain trigonometry.
@@ -67,7 +40,7 @@ bool rectanglesMeet(double theta, double half_arm_width) {
 }
 
 TEST(CollisionFilter, AdjacentSrdfAndGeometryless) {
-  const auto model = scissors();
+  const auto model = test::scissors();
   CollisionFilter f(*model);
   EXPECT_FALSE(f.enabled(0, 1));
   EXPECT_EQ(f.reason(0, 1), "Adjacent");
@@ -98,7 +71,7 @@ TEST(CollisionFilter, PandaHonoursSrdf) {
 }
 
 TEST(SelfCollision, ScissorsMatchesTheAnalyticAnswer) {
-  const auto model = scissors();
+  const auto model = test::scissors();
   auto geometry = std::make_shared<const RobotGeometry>(model);
   const SelfCollision checker(geometry, CollisionFilter(*model));
   ASSERT_EQ(checker.pairs().size(), 1u);
@@ -121,7 +94,7 @@ TEST(SelfCollision, ScissorsMatchesTheAnalyticAnswer) {
 }
 
 TEST(SelfCollision, PaddingWidensTheContact) {
-  const auto model = scissors();
+  const auto model = test::scissors();
   auto geometry = std::make_shared<const RobotGeometry>(model);
   // At θ = π/2 the arm points along y: its near corner (x = −0.05 … 0.05, y = 0.2) is 0.15 from the base
   // bar's top face (y = 0.05) along y, but the bar starts at x = 0.5: the gap is the corner distance
@@ -149,7 +122,7 @@ TEST(SelfCollision, PaddingWidensTheContact) {
 }
 
 TEST(SelfCollision, NonFinitePoseCollides) {
-  const auto model = scissors();
+  const auto model = test::scissors();
   const SelfCollision checker(std::make_shared<const RobotGeometry>(model), CollisionFilter(*model));
   SelfCollisionContext ctx = checker.makeContext();
   const double theta = std::nan("");

@@ -21,7 +21,9 @@
 // asked. Links joined by joints the group does not move (a gripper on its flange) are one rigid body:
 // two bodies whose every link pair is checked are measured as one item on their merged hulls, and a body
 // against the environment likewise, until the merged hulls come within contact; the member pairs then
-// cover that interval. Every ball is at least contact_distance / B wide, so the loops end; a cap on the
+// cover that interval. A self item whose pairs are tabulated (scene/pair_table.h) over joints that keep
+// them more than padding + 2·contact_distance apart in every cell the segment crosses is not swept at all.
+// Every ball is at least contact_distance / B wide, so the loops end; a cap on the
 // number of distance queries ends them too (reported as a collision).
 #include <clearway/scene/scene.h>
 
@@ -222,6 +224,11 @@ class MotionChecker {
   CollisionReport rigid_collision_;  // a self pair within one rigid body that collides (then every state does)
   double obstacle_speed_ = 0.0;   // the fastest obstacle's speed (m/s)
   std::vector<int> quaternions_;  // state entries where a floating joint's quaternion starts (qx)
+  // Per self item (group or pair): its pairs' tables (scene/pair_table.h) built with the padding plus twice
+  // the contact distance, when every pair has one (else empty): an item they prove apart along the whole
+  // segment is not swept.
+  std::vector<std::vector<std::shared_ptr<const PairTable>>> item_tables_;
+  void buildItemTables();
 };
 
 }  // namespace clearway

@@ -11,6 +11,7 @@
 // Other cells are Unsure and the pair is checked as before, after one triangle test of the pair that
 // touched at the cell's centre. A coarse grid is refined where it is unsure.
 #include <clearway/body/link_geometry.h>
+#include <clearway/body/robot_geometry.h>
 #include <clearway/kinematics/robot_model.h>
 #include <clearway/tolerances.h>
 
@@ -49,12 +50,24 @@ class PairTable {
                                                 const Tolerances& tol, const std::vector<double>& held = {},
                                                 const PairTableOptions& options = {});
 
+  /// build() for the geometry's links a and b, or the table already built for them with the same
+  /// settings while the geometry lives (scenes sharing a loaded robot share their tables). Thread-safe.
+  static std::shared_ptr<const PairTable> shared(const std::shared_ptr<const RobotGeometry>& geometry, int a, int b,
+                                                 double padding, GeometryMode mode, const Tolerances& tol,
+                                                 const std::vector<double>& held = {},
+                                                 const PairTableOptions& options = {});
+
   /// The verdict at the full variable vector q (held variables at their held values): Free and Colliding
   /// hold at every configuration of the cell holding q; Unsure for the other cells, and for values outside
   /// the table (beyond the limits, not finite). For an Unsure cell whose centre collides through two
   /// triangles, `witness` (optional) receives them (a's, b's): likely to touch near the centre too, they
   /// are worth one triangle test (trianglesTouch) before the search.
   Verdict lookup(const double* q, TrianglePair* witness = nullptr) const noexcept;
+
+  /// True when every cell the straight segment q0 → q1 (full variable vectors, held variables at their held
+  /// values) passes through is Free: the pair is then apart along all of it. False proves nothing (a segment
+  /// leaving the table, through a cell not Free, or crossing more cells than the table has per turn).
+  bool freeAlong(const double* q0, const double* q1) const noexcept;
 
   /// The variables the pair's relative pose depends on (one or two).
   const std::vector<int>& variables() const noexcept { return var_; }
@@ -67,6 +80,8 @@ class PairTable {
   PairTable() = default;
   // Cell coordinates of variable k's value x (in coarse cells), or −1 when outside the table.
   double coordinate(int k, double x) const noexcept;
+  // The verdict of fine cell (c[0], c[1]) (fine cells per dimension: n_[k]·fine_, each index in range).
+  Verdict fineCell(const int* c) const noexcept;
 
   std::vector<int> var_;          // per dimension: the variable
   std::vector<char> periodic_;    // per dimension: a full turn (values reduced to [−π, π])
