@@ -74,9 +74,14 @@ struct Builder {
 
   // The verdict for the cell centred at x with half-widths h; for an Unsure one, when `witness` is given,
   // the two triangles that touch at x (invalid when none do). Only the finest cells (`finest`) climb to
-  // the triangles: a larger cell's wide margin would send a search through most of them, and its halves
-  // are cheaper to settle.
+  // the triangles (while the table's count of such checks lasts): a larger cell's wide margin would send
+  // a search through most of them, and its halves are cheaper to settle.
+  long exact_left = 0;  // cells that may still climb to the triangles
+
   PairTable::Verdict cell(const double* x, const double* h, bool finest, TrianglePair* witness) {
+    finest = finest && exact_left > 0;
+    if (finest) --exact_left;
+    if (!finest) witness = nullptr;
     double delta = 0.0;
     for (std::size_t k = 0; k < moved.size(); ++k) {
       const double r = k + 1 == moved.size() ? reach_last : reach(k, x);
@@ -134,7 +139,8 @@ std::vector<double> tableSettings(double padding, GeometryMode mode, const Toler
                            static_cast<double>(t.cast_max_iterations), t.epa_relative,
                            static_cast<double>(t.epa_max_iterations), static_cast<double>(p.coarse_one),
                            static_cast<double>(p.fine_one), static_cast<double>(p.coarse_two),
-                           static_cast<double>(p.fine_two), static_cast<double>(p.max_checks), p.min_probe_share};
+                           static_cast<double>(p.fine_two), static_cast<double>(p.max_checks), p.min_probe_share,
+                           static_cast<double>(p.max_exact_checks), static_cast<double>(p.max_exact_triangles)};
   for (double h : held) s.push_back(std::isfinite(h) ? h : -std::numeric_limits<double>::infinity());
   return s;
 }
@@ -179,6 +185,10 @@ std::unique_ptr<const PairTable> PairTable::build(const RobotModel& model, int a
     return var >= 0 && var < static_cast<int>(held.size()) && std::isfinite(held[var]) ? held[var] : NAN;
   };
   Builder bld(up == a ? ga : gb, up == a ? gb : ga, padding, mode, tol);
+  const auto small = [&](const LinkGeometry& g) {
+    return g.triangles().size() <= static_cast<std::size_t>(std::max(0, options.max_exact_triangles));
+  };
+  bld.exact_left = small(ga) && small(gb) ? options.max_exact_checks : 0;
   Pose cur = Pose::identity();
   for (int ji : chain) {
     const Joint& j = model.joints()[ji];

@@ -292,7 +292,7 @@ TEST(PairTable, OnlyPairsMovedByOneOrTwoPlainJoints) {
       int n = 0;
       int l = down;
       for (; l >= 0 && l != up; l = model->parentLink(l))
-        n += model->joint(model->link(l).parent_joint).type != JointType::Fixed;
+        if (model->link(l).parent_joint >= 0) n += model->joint(model->link(l).parent_joint).type != JointType::Fixed;
       if (l == up) moving = n;
     }
     // (A pair may lack a table it could have: one whose probe settled too little.)

@@ -32,8 +32,14 @@ struct PairTableOptions {
   long max_checks = 20000;
   /// No table for a pair whose probe (one coarse cell in 4 per variable) settles less than this share.
   double min_probe_share = 0.25;
-  /// No cell is checked after this moment (the cells left stay Unsure): large meshes near each other
-  /// make each check dear, and the verdicts never depend on how far a table got.
+  /// Cells checked down to the triangles (the finest, near contact) at most, per table, and only for links
+  /// of at most max_exact_triangles triangles each: past either, cells are checked on the hulls alone. A
+  /// search among many triangles within a wide padding is what makes a table dear; counted, not timed, a
+  /// table is the same on every machine (and so is which colliding pair a check reports).
+  long max_exact_checks = 2000;
+  int max_exact_triangles = 4096;
+  /// No cell is checked after this moment (the cells left stay Unsure). None by default: a deadline makes
+  /// the tables, though never the verdicts, depend on the machine's speed.
   std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
 };
 

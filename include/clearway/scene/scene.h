@@ -118,8 +118,8 @@ struct SceneOptions {
   /// Tabulate the self pairs moved by one or two joints at load (scene/pair_table.h): same verdicts,
   /// faster queries, a longer load.
   bool pair_tables = true;
-  /// Seconds the tables may take to build (SelfCollisionOptions::table_seconds).
-  double pair_table_seconds = 0.25;
+  /// Seconds the tables may take to build (SelfCollisionOptions::table_seconds): none by default.
+  double pair_table_seconds = std::numeric_limits<double>::infinity();
 };
 
 class Scene {

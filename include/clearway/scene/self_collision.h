@@ -11,6 +11,7 @@
 #include <clearway/scene/pair_table.h>
 #include <clearway/tolerances.h>
 
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -36,8 +37,9 @@ struct SelfCollisionOptions {
   /// joint the scene holds), so the tables treat its joint as fixed. Empty: every variable may move.
   std::vector<double> held;
   PairTableOptions table_options;
-  /// Seconds all the tables may take to build (measured from the first); cells past it stay Unsure.
-  double table_seconds = 0.25;
+  /// Seconds all the tables may take to build (measured from the first); cells past it stay Unsure. None
+  /// by default (table_options bounds their work by counts, the same on every machine).
+  double table_seconds = std::numeric_limits<double>::infinity();
 };
 
 /// Per-thread state of self-collision queries: one hull cache per pair and the pair that last collided.
