@@ -14,6 +14,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 namespace clearway {
@@ -224,6 +225,22 @@ bool validPadding(double padding) noexcept { return padding >= 0.0 && std::isfin
 
 // True when the bounding spheres (centres given in one frame) are farther apart than the padding and
 // the band (of the pair's scale, as in the exact tests).
+// A box containing the shape, in its own frame (exact for boxes, cylinders and cones).
+Aabb localBox(const Shape& shape) noexcept {
+  return std::visit(
+      [](const auto& s) -> Aabb {
+        using S = std::decay_t<decltype(s)>;
+        if constexpr (std::is_same_v<S, Box>) return Aabb::fromCenterHalf(Vec3::Zero(), s.half);
+        else if constexpr (std::is_same_v<S, Sphere>) return Aabb::fromCenterHalf(Vec3::Zero(), Vec3::Constant(s.r));
+        else if constexpr (std::is_same_v<S, Capsule> || std::is_same_v<S, Cylinder> || std::is_same_v<S, Cone>) {
+          return Aabb::fromCenterHalf(Vec3::Zero(), Vec3(s.r, s.r, s.h + s.radius()));
+        } else {
+          return placedBox(s, Pose::identity());
+        }
+      },
+      shape);
+}
+
 bool spheresApart(const Vec3& ca, double ra, const Vec3& cb, double rb, double padding, const Tolerances& tol) noexcept {
   const double reach = ra + rb + padding;
   const double scale = ca.norm() + cb.norm() + reach;
@@ -468,6 +485,12 @@ bool shapeIntersectsLink(const Shape& shape, const Pose& pose_shape, const LinkG
   if (spheresApart(pose_shape.t, boundingRadius(shape), pose_link * link.sphereCenter(), link.sphereRadius(), padding,
                    tol))
     return false;
+  // The shape's own box against the link's box, both oriented (15 axes): obstacles are mostly boxes, often
+  // turned, so this clears most of what their world boxes let through, at a third of a GJK call.
+  const Pose shape_in_link = relativePose(pose_link, pose_shape);
+  const double scale = link.boundingRadius() + shape_in_link.t.norm() + boundingRadius(shape);
+  const double slack = padding + narrowBand(scale + padding, tol);
+  if (detail::OrientedBoxTest(shape_in_link, slack, scale).separated<true>(link.bounds(), localBox(shape))) return false;
   SimplexCache scratch;
   SimplexCache& cache = hull_cache ? *hull_cache : scratch;
   const bool hulls = std::visit(
@@ -478,11 +501,7 @@ bool shapeIntersectsLink(const Shape& shape, const Pose& pose_shape, const LinkG
       shape);
   if (!hulls) return false;
   if (mode == GeometryMode::Hull) return true;
-  // In the link's frame.
-  const Pose shape_in_link = relativePose(pose_link, pose_shape);
-  const double scale = link.boundingRadius() + shape_in_link.t.norm() + boundingRadius(shape);
   if (coreMeetsShape(shape, shape_in_link, link)) return true;
-  const double slack = padding + narrowBand(scale + padding, tol);
   if (shapeIntersectsTriangles(shape, shape_in_link, link, tol, padding, slack)) return true;
   for (const auto& p : link.primitives())
     if (shapesIntersect(shape, shape_in_link, p.shape, p.pose, tol, padding)) return true;

@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 
@@ -382,9 +383,10 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
   const double slack = padding + bandOf(scale_ + maxAbs(link_box) + padding, tol);
   const Aabb query = link_box.inflated(slack);
 
-  // The link's box as an oriented box in the world (A = world, B = the link frame): the voxels' first cull.
-  const detail::OrientedBoxTest obb(pose, slack, scale_ + maxAbs(link_box));
-  const detail::OrientedBoxTest::PlacedB placed_link = obb.place(link.bounds());
+  // The link's box as an oriented box in the world (A = world, B = the link frame): the voxels' first cull,
+  // set up at the first voxel (most links near obstacles meet none).
+  std::optional<detail::OrientedBoxTest> obb;
+  detail::OrientedBoxTest::PlacedB placed_link;
   SimplexCache cache;  // one for all voxels: they are axis-aligned, so the last separating axis starts the next well
   int passed[kFewVoxels];
   int n_passed = 0;
@@ -400,7 +402,11 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
     }
     double c[3], h[3];
     detail::OrientedBoxTest::centerHalf(*item.voxel, c, h);
-    if (obb.separated<false>(c, h, placed_link)) return false;
+    if (!obb) {
+      obb.emplace(pose, slack, scale_ + maxAbs(link_box));
+      placed_link = obb->place(link.bounds());
+    }
+    if (obb->separated<false>(c, h, placed_link)) return false;
     if (counters) ++counters->voxel_tests;
     if (!shapeIntersectsLink(Box(Vec3(h[0], h[1], h[2])), Pose::translation(Vec3(c[0], c[1], c[2])), link, pose, tol,
                              GeometryMode::Hull, padding, &cache))

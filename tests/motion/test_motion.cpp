@@ -365,7 +365,9 @@ TEST(MotionCertified, EveryCapEndsInACollision) {
   TempDir dir;
   const std::string obstacles =
       "    - {name: post, cylinder: {radius: 0.03, length: 1}, pose: {position: [0, 1.2, 0]}}\n"
-      "    - {name: rod, box: {size: [0.02, 0.02, 1]}, pose: {position: [-0.9, -0.9, 0]}}\n";
+      "    - {name: rod, box: {size: [0.02, 0.02, 1]}, pose: {position: [-0.9, -0.9, 0]}}\n"
+      // A ball: oriented boxes clear states near boxes and posts without GJK, but not within its box's corners.
+      "    - {name: ball, sphere: {radius: 0.2}, pose: {position: [0.3, -1.3, 0]}}\n";
   const auto scene = planarScene(dir, obstacles);
   SceneOptions no_iterations;
   no_iterations.tolerances.gjk_max_iterations = 0;

@@ -357,6 +357,47 @@ TEST(LinkGeometry, SpheresAndCapsulesAgainstMeshesMatchBruteForce) {
   EXPECT_GT(free, 25);
 }
 
+// Boxes, cylinders and cones against meshes: shapeIntersectsLink first compares the shape's own box with
+// the link's (oriented, 15 axes), so it must give the answer of the same primitive as a link, whose path
+// compares it with each triangle and never with that box. Poses are drawn so that a third of the cases
+// fall between the boxes' overlap and the shapes' contact, where only the later rungs decide.
+TEST(LinkGeometry, OrientedBoxRungKeepsEveryVerdict) {
+  const std::vector<TestMesh> meshes = generatedMeshes();
+  std::mt19937_64 rng(37);
+  std::uniform_real_distribution<double> size(0.005, 0.12), unit(0.0, 1.0);
+  const Tolerances tol;
+  int collide = 0, free = 0, boxes_overlap_but_free = 0;
+  for (const TestMesh& m : meshes) {
+    const LinkGeometry g(m.mesh);
+    for (int c = 0; c < 400; ++c) {
+      const double a = size(rng), b = size(rng), padding = c % 3 == 0 ? 0.02 * unit(rng) : 0.0;
+      const Shape shape = c % 3 == 0 ? Shape(Box(Vec3(a, b, size(rng)))) : c % 3 == 1 ? Shape(Cylinder(a, b)) : Shape(Cone(a, b));
+      // Centred near a vertex, at 0.4 to 1.4 times the shape's reach: mostly near contact.
+      const Pose pl = randomPoseNear(rng, 0.5);
+      const Vec3& v = m.mesh.vertices[static_cast<std::size_t>(unit(rng) * m.mesh.vertices.size()) % m.mesh.vertices.size()];
+      Pose ps = randomPoseNear(rng, 0.0);
+      ps.t = pl * v + tree_ref::randomInBall(rng, 1.0).normalized() * (0.4 + unit(rng)) * boundingRadius(shape);
+      const bool got = shapeIntersectsLink(shape, ps, g, pl, tol, GeometryMode::Mesh, padding);
+      CollisionElement e;
+      e.primitive = shape;
+      const LinkGeometry prim({e}, {});
+      EXPECT_EQ(meshesIntersect(prim, ps, g, pl, tol, GeometryMode::Mesh, padding), got) << m.name << " case " << c;
+      EXPECT_TRUE(shapeIntersectsLink(shape, ps, g, pl, tol, GeometryMode::Hull, padding) || !got);
+      ++(got ? collide : free);
+      const Pose shape_in_link = relativePose(pl, ps);
+      std::visit(
+          [&](const auto& s) {
+            const Aabb box = placedBox(s, shape_in_link);  // the shape's world box, in the link's frame
+            boxes_overlap_but_free += !got && overlaps(box.inflated(padding), g.bounds());
+          },
+          shape);
+    }
+  }
+  EXPECT_GT(collide, 500);
+  EXPECT_GT(free, 300);
+  EXPECT_GT(boxes_overlap_but_free, 100);  // (a margin shrunk by 0.1 mm fails this test)
+}
+
 TEST(LinkGeometry, PrimitivesAgainstPrimitives) {
   std::vector<CollisionElement> ea(1), eb(1);
   ea[0].primitive = Shape(Box(Vec3(0.1, 0.1, 0.1)));

@@ -5,6 +5,7 @@
 #include <clearway/math.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace clearway {
@@ -75,12 +76,30 @@ inline double boxDistance(const Aabb& a, const Aabb& b) noexcept {
 /// widened by a few roundings so that the containment survives floating point.
 inline Aabb transformed(const Aabb& box, const Pose& pose) noexcept {
   if (box.isEmpty()) return box;
-  const Vec3 c = pose * box.center();
-  const Vec3 h = pose.R.cwiseAbs() * box.halfExtents();
-  // R·c + t and |R|·h each carry a relative rounding of a few ulps of |R||c| + |t| and |R|h.
-  const double slack = 8.0 * std::numeric_limits<double>::epsilon() *
-                       (pose.R.cwiseAbs() * box.center().cwiseAbs() + pose.t.cwiseAbs() + h).maxCoeff();
-  return Aabb::fromCenterHalf(c, h.array() + slack);
+  // Written out in scalars: Eigen's fixed-size products here cost three times as much (every link of
+  // every state check places its box).
+  double c[3], h[3], ac[3];
+  for (int k = 0; k < 3; ++k) {
+    c[k] = 0.5 * (box.min[k] + box.max[k]);
+    h[k] = 0.5 * (box.max[k] - box.min[k]);
+    ac[k] = std::abs(c[k]);
+  }
+  Aabb out;
+  double size = 0.0;
+  double wc[3], wh[3];
+  for (int i = 0; i < 3; ++i) {
+    const double a0 = std::abs(pose.R(i, 0)), a1 = std::abs(pose.R(i, 1)), a2 = std::abs(pose.R(i, 2));
+    wc[i] = pose.R(i, 0) * c[0] + pose.R(i, 1) * c[1] + pose.R(i, 2) * c[2] + pose.t[i];
+    wh[i] = a0 * h[0] + a1 * h[1] + a2 * h[2];
+    size = std::max(size, a0 * ac[0] + a1 * ac[1] + a2 * ac[2] + std::abs(pose.t[i]) + wh[i]);
+  }
+  // R·c + t and |R|·h each carry a relative rounding of a few ulps of |R||c| + |t| and |R|h (a NaN stays).
+  const double slack = 8.0 * std::numeric_limits<double>::epsilon() * size;
+  for (int i = 0; i < 3; ++i) {
+    out.min[i] = wc[i] - (wh[i] + slack);
+    out.max[i] = wc[i] + (wh[i] + slack);
+  }
+  return out;
 }
 
 }  // namespace clearway
