@@ -57,6 +57,12 @@ Pose turned(const Pose& parent, const Pose& origin, const Vec3& u, double angle)
   return p;
 }
 
+// cos and sin of one angle (one libm call where the platform has sincos).
+inline void sincosOf(double angle, double* c, double* s) noexcept {
+  *c = std::cos(angle);
+  *s = std::sin(angle);
+}
+
 // A mimic joint's value: its leader's times the multiplier, plus the offset.
 double mimicValue(const RobotModel& model, const Joint& j, const double* q) noexcept {
   return j.mimic.multiplier * q[model.joint(j.mimic.joint).first_variable] + j.mimic.offset;
@@ -79,16 +85,44 @@ void planarBasis(const Vec3& axis, Vec3* u, Vec3* v) noexcept {
 }
 
 void computeLinkPose(const RobotModel& model, const double* q, Pose* link_poses, int i) noexcept {
-  const std::vector<Joint>& joints = model.joints();
-  const Joint& j = joints[model.links()[i].parent_joint];
-  if (j.type == JointType::Revolute || j.type == JointType::Continuous) {
-    link_poses[i] = turned(link_poses[j.parent_link], j.origin, j.axis, j.isMimic() ? mimicValue(model, j, q) : q[j.first_variable]);
+  using Kind = detail::KinematicStep::Kind;
+  const detail::KinematicStep& st = model.kinematicStep(i);
+  const Pose& parent = link_poses[st.parent];
+  if (st.kind == Kind::TurnZ) {
+    // parent · origin · Rot(±z, angle), written out in scalars (column-major): M = parent.R · origin.R,
+    // t = parent.R · origin.t + parent.t, then only M's first two columns turn. The compiler does not
+    // inline Eigen's fixed-size products here, and this runs for most links of every state checked.
+    const double angle = st.mimic ? st.multiplier * q[st.variable] + st.offset : q[st.variable];
+    double c, s;
+    sincosOf(angle, &c, &s);
+    s *= st.axis_sign;
+    const double* P = parent.R.data();
+    const double* O = st.origin.R.data();
+    const double* ot = st.origin.t.data();
+    double M[9];
+    for (int col = 0; col < 3; ++col)
+      for (int r = 0; r < 3; ++r) M[3 * col + r] = P[r] * O[3 * col] + P[3 + r] * O[3 * col + 1] + P[6 + r] * O[3 * col + 2];
+    Pose& out = link_poses[i];
+    double* R = out.R.data();
+    for (int r = 0; r < 3; ++r) {
+      out.t[r] = P[r] * ot[0] + P[3 + r] * ot[1] + P[6 + r] * ot[2] + parent.t[r];
+      R[r] = c * M[r] + s * M[3 + r];
+      R[3 + r] = c * M[3 + r] - s * M[r];
+      R[6 + r] = M[6 + r];
+    }
     return;
   }
-  const Pose frame = link_poses[j.parent_link] * j.origin;
-  if (j.type == JointType::Fixed) {
-    link_poses[i] = frame;
-  } else if (j.isMimic()) {
+  if (st.kind == Kind::Fixed) {
+    link_poses[i] = parent * st.origin;
+    return;
+  }
+  const Joint& j = model.joints()[model.links()[i].parent_joint];
+  if (st.kind == Kind::Turn) {
+    link_poses[i] = turned(parent, j.origin, j.axis, j.isMimic() ? mimicValue(model, j, q) : q[j.first_variable]);
+    return;
+  }
+  const Pose frame = parent * j.origin;
+  if (j.isMimic()) {
     const double value = mimicValue(model, j, q);
     link_poses[i] = frame * jointMotion(j, &value);
   } else {

@@ -125,6 +125,27 @@ RobotModel::RobotModel(std::string name, std::vector<Link> links, std::vector<Jo
       variables_.push_back(v);
     }
   }
+  steps_.resize(links_.size());
+  for (int i = 1; i < n_links; ++i) {
+    const Joint& j = joints_[links_[i].parent_joint];
+    detail::KinematicStep& s = steps_[i];
+    s.parent = j.parent_link;
+    s.origin = j.origin;
+    s.axis = j.axis;
+    s.mimic = j.isMimic();
+    s.variable = s.mimic ? joints_[j.mimic.joint].first_variable : j.first_variable;
+    if (s.mimic) s.multiplier = j.mimic.multiplier, s.offset = j.mimic.offset;
+    using Kind = detail::KinematicStep::Kind;
+    if (j.type == JointType::Fixed) {
+      s.kind = Kind::Fixed;
+    } else if (j.type == JointType::Revolute || j.type == JointType::Continuous) {
+      const bool z = j.axis.x() == 0.0 && j.axis.y() == 0.0 && std::abs(j.axis.z()) == 1.0;
+      s.kind = z ? Kind::TurnZ : Kind::Turn;
+      s.axis_sign = z ? j.axis.z() : 1.0;
+    } else {
+      s.kind = Kind::Other;
+    }
+  }
   for (int i = 0; i < variableCount(); ++i)
     if (!variable_index_.emplace(variables_[i].name, i).second)
       fail(name_, "two joint variables named '" + variables_[i].name + "'");

@@ -7,6 +7,7 @@
 #include <clearway/math.h>
 #include <clearway/shape/shape.h>
 
+#include <cstdint>
 #include <limits>
 #include <optional>
 #include <string>
@@ -88,6 +89,22 @@ struct DisabledCollision {
   std::string reason;
 };
 
+namespace detail {
+/// One link's step of forward kinematics, folded at load: its parent joint's frame and motion with
+/// the lookups done (forward_kinematics.cpp reads it; nothing else should).
+struct KinematicStep {
+  enum class Kind : std::uint8_t { Root, Fixed, TurnZ, Turn, Other };
+  Kind kind = Kind::Root;
+  int parent = -1;         ///< the parent link
+  int variable = -1;       ///< the q entry the joint's value comes from (a mimic's leader's)
+  double multiplier = 1.0, offset = 0.0;  ///< value = multiplier · q[variable] + offset (mimics only)
+  bool mimic = false;
+  double axis_sign = 1.0;  ///< TurnZ: the axis is axis_sign · z
+  Pose origin;
+  Vec3 axis = Vec3::UnitX();
+};
+}  // namespace detail
+
 class RobotModel {
  public:
   /// Checks and freezes a robot. Links must be in topological order (link 0 the root, without parent
@@ -124,6 +141,8 @@ class RobotModel {
   int jointIndex(const std::string& name) const;
   /// Index in q of the variable of that name (a one-variable joint's name, or "joint/x" etc.), -1 if none.
   int variableIndex(const std::string& name) const;
+  /// Link i's step of forward kinematics (computeLinkPose); step 0 is the root's.
+  const detail::KinematicStep& kinematicStep(int i) const noexcept { return steps_[static_cast<std::size_t>(i)]; }
 
  private:
   std::string name_;
@@ -134,6 +153,7 @@ class RobotModel {
   std::vector<DisabledCollision> disabled_;
   std::vector<std::string> load_warnings_;
   std::unordered_map<std::string, int> link_index_, joint_index_, variable_index_;
+  std::vector<detail::KinematicStep> steps_;
 };
 
 /// Pairs (a, b), a < b, of links that both have collision geometry and are adjacent as MoveIt's Setup
