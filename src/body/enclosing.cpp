@@ -27,17 +27,27 @@ EnclosingBalls::EnclosingBalls(const RobotGeometry& geometry) : geometry_(&geome
 }
 
 void EnclosingBalls::place(const Pose* link_poses) noexcept {
+  // Most pairs are cleared by their bounding balls, so parts wait until a pair needs them.
+  poses_ = link_poses;
   for (std::size_t i = 0; i < links_.size(); ++i) {
-    const Link& l = links_[i];
-    const Pose& pose = link_poses[i];
-    for (int k = l.first; k < l.first + l.count; ++k) centers_[k] = pose * local_[k];
+    Link& l = links_[i];
+    if (l.count == 0) continue;
+    centers_[l.first] = link_poses[i] * local_[l.first];
+    l.parts_placed = l.count == 1;
   }
 }
 
-bool EnclosingBalls::apart(int a, int b, double padding, const Tolerances& tol) const noexcept {
+void EnclosingBalls::placeParts(int link) noexcept {
+  Link& l = links_[link];
+  const Pose& pose = poses_[link];
+  for (int k = l.first + 1; k < l.first + l.count; ++k) centers_[k] = pose * local_[k];
+  l.parts_placed = true;
+}
+
+bool EnclosingBalls::apart(int a, int b, double padding, const Tolerances& tol) noexcept {
   const Link& la = links_[a];
   const Link& lb = links_[b];
-  if (la.count == 0 || lb.count == 0) return false;
+  if (la.count == 0 || lb.count == 0 || !poses_) return false;  // (never placed: nothing proved)
   // As spheresApart in link_geometry.cpp: the band grows with the coordinates' size; a NaN compares false.
   const double band = std::max(tol.gjk_absolute, 64.0 * std::numeric_limits<double>::epsilon());
   const auto ballsApart = [&](int i, int j) {
@@ -47,6 +57,8 @@ bool EnclosingBalls::apart(int a, int b, double padding, const Tolerances& tol) 
   };
   if (ballsApart(la.first, lb.first)) return true;
   if (la.count == 1 && lb.count == 1) return false;
+  if (!la.parts_placed) placeParts(a);
+  if (!lb.parts_placed) placeParts(b);
   // The union of a link's parts contains it: every part ball of one apart from every part ball of the other.
   const int ia = la.first + (la.count > 1), ib = lb.first + (lb.count > 1);
   for (int i = ia; i < la.first + la.count; ++i)

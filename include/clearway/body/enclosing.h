@@ -21,18 +21,23 @@ class EnclosingBalls {
 
   /// True when sized for this robot's geometry (a default-made layer is for none).
   bool madeFor(const RobotGeometry& geometry) const noexcept { return geometry_ == &geometry; }
-  /// Places every link's balls by its world pose (one per link, indexed as the robot's links).
+  /// Places every link's bounding ball by its world pose (one per link, indexed as the robot's links);
+  /// a link's parts' balls are placed when a pair first needs them, from the same poses, which must
+  /// therefore stay unchanged until the next place().
   void place(const Pose* link_poses) noexcept;
   /// True when links a and b, as last placed, are certainly more than `padding` metres apart (beyond the
   /// narrow phase's band: tol.gjk_absolute of their size). False proves nothing; a non-finite pose, or
   /// a link without geometry, is never apart.
-  bool apart(int a, int b, double padding, const Tolerances& tol) const noexcept;
+  bool apart(int a, int b, double padding, const Tolerances& tol) noexcept;
 
  private:
   struct Link {
     int first = 0;  // its balls in centers_/radii_: [first] the bounding ball, then the parts' balls
     int count = 0;
+    bool parts_placed = false;  // since the last place()
   };
+  void placeParts(int link) noexcept;
+  const Pose* poses_ = nullptr;  // as last placed
   const RobotGeometry* geometry_ = nullptr;
   std::vector<Link> links_;
   std::vector<Vec3> local_;    // ball centres, link frame
