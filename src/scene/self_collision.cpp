@@ -53,6 +53,7 @@ SelfCollisionContext SelfCollision::makeContext() const {
   for (const LinkPair& p : pairs_) c.bodies.emplace_back(*geometry_->link(p.a), *geometry_->link(p.b));
   c.balls = EnclosingBalls(*geometry_);
   c.unsure.reserve(pairs_.size());
+  c.table_free.assign(pairs_.size(), 0);
   return c;
 }
 
@@ -91,11 +92,15 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
   // The tables first: a pair they prove colliding ends the query before any geometry is placed.
   // A witness (two triangles that touched at the centre of the pair's unsure cell) proves a collision
   // with one triangle test where the search would spend hundreds.
+  // Each verdict is kept for the pass below (a context of another checker looks the tables up again).
+  const bool kept = ctx.table_free.size() == pairs_.size();
+  if (kept) std::fill(ctx.table_free.begin(), ctx.table_free.end(), std::uint8_t{0});
   if (q)
     for (int k : with_table_) {
       TrianglePair w;
       const PairTable::Verdict v = tables_[k]->lookup(q, &w);
       if (v == PairTable::Verdict::Colliding) return hit(k, ctx);
+      if (kept) ctx.table_free[k] = v == PairTable::Verdict::Free;
       const LinkPair& p = pairs_[k];
       if (w.valid() && trianglesTouch(*geometry_->link(p.a), poses[p.a], *geometry_->link(p.b), poses[p.b], w,
                                       options_.tolerances, pair_padding_[k]))
@@ -104,7 +109,10 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
   const bool balls = placeBalls(poses, ctx);
   // A pair that collided a moment ago probably still does: trying it first ends most colliding queries
   // of a planner exploring near an obstacle after one pair test.
-  if (ctx.last_hit >= 0 && ctx.last_hit < n && tabled(ctx.last_hit, q) != PairTable::Verdict::Free &&
+  const auto tableFree = [&](int k) {
+    return kept ? ctx.table_free[k] != 0 : tabled(k, q) == PairTable::Verdict::Free;
+  };
+  if (ctx.last_hit >= 0 && ctx.last_hit < n && !tableFree(ctx.last_hit) &&
       pairHits(ctx.last_hit, poses, ctx, balls))
     return &pairs_[ctx.last_hit];
   // Two passes: the cheap rungs for every pair first, so that a collision they settle (overlapping cores)
@@ -112,7 +120,7 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
   const bool two_pass = static_cast<int>(ctx.unsure.capacity()) >= n;  // (else pushing would allocate)
   if (two_pass) ctx.unsure.clear();
   for (int k = 0; k < n; ++k) {
-    if (k == ctx.last_hit || tabled(k, q) == PairTable::Verdict::Free) continue;
+    if (k == ctx.last_hit || tableFree(k)) continue;
     if (!two_pass) {
       if (pairHits(k, poses, ctx, balls)) return hit(k, ctx);
       continue;

@@ -12,6 +12,7 @@
 #include <clearway/tolerances.h>
 
 #include <limits>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -47,6 +48,7 @@ struct SelfCollisionContext {
   std::vector<BodyPair> bodies;  ///< per checked pair: its two links' geometry and warm starts
   EnclosingBalls balls;          ///< the links' enclosing balls at the current query's poses
   std::vector<int> unsure;       ///< pairs the cheap rungs left to the triangles (scratch of one query)
+  std::vector<std::uint8_t> table_free;  ///< per pair: its table called it Free at this query's q (scratch)
   int last_hit = -1;
   long long pair_tests = 0;  ///< pairs that reached the narrow phase (bounding spheres not apart), cumulative
 };
