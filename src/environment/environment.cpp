@@ -379,7 +379,12 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
     h.voxel = (*map_voxels)[v];
     return report(h);
   };
-  const Aabb link_box = transformed(link.bounds(), pose);
+  // The box of the link's bounding ball: a dozen operations where placing its box costs ten times more,
+  // and as tight for most links (R·c + t rounds by a few ulps of |c| + |t|).
+  const Vec3 centre = pose * link.sphereCenter();
+  const double reach = link.sphereRadius() * (1.0 + 1e-12) + 8.0 * std::numeric_limits<double>::epsilon() *
+                                                             (link.sphereCenter().norm() + pose.t.norm());
+  const Aabb link_box = Aabb::fromCenterHalf(centre, Vec3::Constant(reach));
   const double slack = padding + bandOf(scale_ + maxAbs(link_box) + padding, tol);
   const Aabb query = link_box.inflated(slack);
 
