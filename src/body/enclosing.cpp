@@ -24,6 +24,7 @@ EnclosingBalls::EnclosingBalls(const RobotGeometry& geometry) : geometry_(&geome
     links_[i].count = static_cast<int>(local_.size()) - links_[i].first;
   }
   centers_.assign(local_.size(), Vec3::Constant(std::numeric_limits<double>::quiet_NaN()));
+  norms_.assign(local_.size(), std::numeric_limits<double>::quiet_NaN());
 }
 
 void EnclosingBalls::place(const Pose* link_poses) noexcept {
@@ -33,6 +34,7 @@ void EnclosingBalls::place(const Pose* link_poses) noexcept {
     Link& l = links_[i];
     if (l.count == 0) continue;
     centers_[l.first] = link_poses[i] * local_[l.first];
+    norms_[l.first] = centers_[l.first].norm();
     l.parts_placed = l.count == 1;
   }
 }
@@ -40,7 +42,10 @@ void EnclosingBalls::place(const Pose* link_poses) noexcept {
 void EnclosingBalls::placeParts(int link) noexcept {
   Link& l = links_[link];
   const Pose& pose = poses_[link];
-  for (int k = l.first + 1; k < l.first + l.count; ++k) centers_[k] = pose * local_[k];
+  for (int k = l.first + 1; k < l.first + l.count; ++k) {
+    centers_[k] = pose * local_[k];
+    norms_[k] = centers_[k].norm();
+  }
   l.parts_placed = true;
 }
 
@@ -52,7 +57,7 @@ bool EnclosingBalls::apart(int a, int b, double padding, const Tolerances& tol) 
   const double band = std::max(tol.gjk_absolute, 64.0 * std::numeric_limits<double>::epsilon());
   const auto ballsApart = [&](int i, int j) {
     const double reach = radii_[i] + radii_[j] + padding;
-    const double limit = reach + band * (centers_[i].norm() + centers_[j].norm() + reach);
+    const double limit = reach + band * (norms_[i] + norms_[j] + reach);
     return (centers_[i] - centers_[j]).squaredNorm() > limit * limit;
   };
   if (ballsApart(la.first, lb.first)) return true;

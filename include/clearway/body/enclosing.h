@@ -42,6 +42,7 @@ class EnclosingBalls {
   std::vector<Link> links_;
   std::vector<Vec3> local_;    // ball centres, link frame
   std::vector<Vec3> centers_;  // ball centres, world frame (as last placed)
+  std::vector<double> norms_;   // |centre|, which sizes the rounding band
   std::vector<double> radii_;
 };
 
