@@ -7,7 +7,6 @@
 #include <clearway/narrowphase/ray_cast.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -88,9 +87,7 @@ void MotionChecker::buildItemTables() {
   item_tables_.assign(env_begin_, {});
   if (options_.mode == MotionMode::Sampled || !sc.options().pair_tables) return;
   const SelfCollisionOptions& so = sc.selfCollision().options();
-  PairTableOptions table = so.table_options;
-  const auto budget = std::chrono::duration<double>(std::max(0.0, std::min(so.table_seconds, 1e6)));
-  table.deadline = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(budget);
+  const PairTableOptions table = so.table_options.within(so.table_seconds);
   const double margin = 2.0 * options_.contact_distance;
   for (int k = 0; k < env_begin_; ++k) {
     const Item& item = items_[k];

@@ -9,6 +9,14 @@
 #include <tuple>
 
 namespace clearway {
+
+PairTableOptions PairTableOptions::within(double seconds) const {
+  PairTableOptions o = *this;
+  const auto budget = std::chrono::duration<double>(std::max(0.0, std::min(seconds, 1e6)));  // (NaN: 0)
+  o.deadline = std::min(deadline, std::chrono::steady_clock::now() +
+                                      std::chrono::duration_cast<std::chrono::steady_clock::duration>(budget));
+  return o;
+}
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;

@@ -35,10 +35,7 @@ SelfCollision::SelfCollision(std::shared_ptr<const RobotGeometry> geometry, cons
     pair_padding_.push_back(pad[a] + pad[b]);
   }
   if (options_.pair_tables) {
-    PairTableOptions table = options_.table_options;
-    const auto budget = std::chrono::duration<double>(std::max(0.0, std::min(options_.table_seconds, 1e6)));
-    table.deadline = std::min(table.deadline, std::chrono::steady_clock::now() +
-                                                   std::chrono::duration_cast<std::chrono::steady_clock::duration>(budget));
+    const PairTableOptions table = options_.table_options.within(options_.table_seconds);
     for (std::size_t k = 0; k < pairs_.size(); ++k)
       tables_.push_back(PairTable::shared(geometry_, pairs_[k].a, pairs_[k].b, pair_padding_[k], options_.mode,
                                           options_.tolerances, options_.held, table));

@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -304,3 +305,18 @@ TEST(PairTable, OnlyPairsMovedByOneOrTwoPlainJoints) {
 
 }  // namespace
 }  // namespace clearway
+
+TEST(PairTable, BudgetBringsTheDeadlineForward) {
+  using Clock = std::chrono::steady_clock;
+  const clearway::PairTableOptions none;
+  const Clock::time_point before = Clock::now();
+  for (const double budget : {0.0, -1.0, std::nan("")}) {
+    const Clock::time_point deadline = none.within(budget).deadline;  // (before the now() it is compared with)
+    EXPECT_LE(deadline, Clock::now()) << budget;
+  }
+  EXPECT_GE(none.within(60.0).deadline, before + std::chrono::seconds(60));
+  EXPECT_GE(none.within(std::numeric_limits<double>::infinity()).deadline, before + std::chrono::hours(24));
+  clearway::PairTableOptions soon;
+  soon.deadline = before;
+  EXPECT_EQ(soon.within(60.0).deadline, before);  // never later than it was
+}

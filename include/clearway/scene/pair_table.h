@@ -41,6 +41,9 @@ struct PairTableOptions {
   /// No cell is checked after this moment (the cells left stay Unsure). None by default: a deadline makes
   /// the tables, though never the verdicts, depend on the machine's speed.
   std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+  /// These options with the deadline brought forward to `seconds` from now, if that is sooner (a
+  /// budget beyond 10⁶ s counts as 10⁶ s; a negative or NaN one as 0).
+  PairTableOptions within(double seconds) const;
 };
 
 class PairTable {
