@@ -223,9 +223,7 @@ bool exactIntersect(const LinkGeometry& a, const LinkGeometry& b, const Pose& b_
 
 bool validPadding(double padding) noexcept { return padding >= 0.0 && std::isfinite(padding); }
 
-// True when the bounding spheres (centres given in one frame) are farther apart than the padding and
-// the band (of the pair's scale, as in the exact tests).
-// A box containing the shape, in its own frame (exact for boxes, cylinders and cones).
+// A box containing the shape, in its own frame (exact for boxes, spheres, capsules, cylinders and cones).
 Aabb localBox(const Shape& shape) noexcept {
   return std::visit(
       [](const auto& s) -> Aabb {
@@ -241,6 +239,8 @@ Aabb localBox(const Shape& shape) noexcept {
       shape);
 }
 
+// True when the bounding spheres (centres given in one frame) are farther apart than the padding and
+// the band (of the pair's scale, as in the exact tests).
 bool spheresApart(const Vec3& ca, double ra, const Vec3& cb, double rb, double padding, const Tolerances& tol) noexcept {
   const double reach = ra + rb + padding;
   const double scale = ca.norm() + cb.norm() + reach;

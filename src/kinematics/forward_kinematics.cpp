@@ -35,21 +35,14 @@ Pose jointMotion(const Joint& j, const double* v) noexcept {
 }
 
 // parent · origin · Rot(u, angle) without forming the rotation (the inner loop of every motion check):
-// M · Rot = c·M + s·M[u]× + (1 − c)·(M u) uᵀ with M = parent.R · origin.R, column by column; about ±z
-// (most robots' axes) only the first two columns turn.
+// M · Rot = c·M + s·M[u]× + (1 − c)·(M u) uᵀ with M = parent.R · origin.R, column by column (axes along
+// ±z, most robots', take computeLinkPose's shorter path).
 Pose turned(const Pose& parent, const Pose& origin, const Vec3& u, double angle) noexcept {
   Pose p;
   const Mat3 M = parent.R * origin.R;
   p.t = parent.R * origin.t + parent.t;
   const double c = std::cos(angle), s = std::sin(angle);
   const Vec3 m0 = M.col(0), m1 = M.col(1), m2 = M.col(2);
-  if (u.x() == 0.0 && u.y() == 0.0 && std::abs(u.z()) == 1.0) {
-    const double sz = s * u.z();
-    p.R.col(0) = c * m0 + sz * m1;
-    p.R.col(1) = c * m1 - sz * m0;
-    p.R.col(2) = m2;
-    return p;
-  }
   const Vec3 w = (1.0 - c) * (M * u);
   p.R.col(0) = c * m0 + s * (u.z() * m1 - u.y() * m2) + u.x() * w;
   p.R.col(1) = c * m1 + s * (u.x() * m2 - u.z() * m0) + u.y() * w;
@@ -61,6 +54,11 @@ Pose turned(const Pose& parent, const Pose& origin, const Vec3& u, double angle)
 inline void sincosOf(double angle, double* c, double* s) noexcept {
   *c = std::cos(angle);
   *s = std::sin(angle);
+}
+
+// The value of a one-variable joint's step (a mimic's: its leader's times the multiplier, plus the offset).
+inline double stepValue(const detail::KinematicStep& st, const double* q) noexcept {
+  return st.mimic ? st.multiplier * q[st.variable] + st.offset : q[st.variable];
 }
 
 // A mimic joint's value: its leader's times the multiplier, plus the offset.
@@ -92,7 +90,7 @@ void computeLinkPose(const RobotModel& model, const double* q, Pose* link_poses,
     // parent · origin · Rot(±z, angle), written out in scalars (column-major): M = parent.R · origin.R,
     // t = parent.R · origin.t + parent.t, then only M's first two columns turn. The compiler does not
     // inline Eigen's fixed-size products here, and this runs for most links of every state checked.
-    const double angle = st.mimic ? st.multiplier * q[st.variable] + st.offset : q[st.variable];
+    const double angle = stepValue(st, q);
     double c, s;
     sincosOf(angle, &c, &s);
     s *= st.axis_sign;
@@ -116,11 +114,11 @@ void computeLinkPose(const RobotModel& model, const double* q, Pose* link_poses,
     link_poses[i] = parent * st.origin;
     return;
   }
-  const Joint& j = model.joints()[model.links()[i].parent_joint];
   if (st.kind == Kind::Turn) {
-    link_poses[i] = turned(parent, j.origin, j.axis, j.isMimic() ? mimicValue(model, j, q) : q[j.first_variable]);
+    link_poses[i] = turned(parent, st.origin, st.axis, stepValue(st, q));
     return;
   }
+  const Joint& j = model.joints()[model.links()[i].parent_joint];
   const Pose frame = parent * j.origin;
   if (j.isMimic()) {
     const double value = mimicValue(model, j, q);

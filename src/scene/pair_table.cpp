@@ -17,6 +17,7 @@ PairTableOptions PairTableOptions::within(double seconds) const {
                                       std::chrono::duration_cast<std::chrono::steady_clock::duration>(budget));
   return o;
 }
+
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;

@@ -11,8 +11,8 @@
 #include <clearway/scene/pair_table.h>
 #include <clearway/tolerances.h>
 
-#include <limits>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <vector>
 
