@@ -4,6 +4,8 @@
 #include <limits>
 #include <sstream>
 
+#include "kinematics/sincos.h"
+
 namespace clearway {
 namespace {
 
@@ -41,19 +43,14 @@ Pose turned(const Pose& parent, const Pose& origin, const Vec3& u, double angle)
   Pose p;
   const Mat3 M = parent.R * origin.R;
   p.t = parent.R * origin.t + parent.t;
-  const double c = std::cos(angle), s = std::sin(angle);
+  double c, s;
+  detail::sinCos(angle, &s, &c);
   const Vec3 m0 = M.col(0), m1 = M.col(1), m2 = M.col(2);
   const Vec3 w = (1.0 - c) * (M * u);
   p.R.col(0) = c * m0 + s * (u.z() * m1 - u.y() * m2) + u.x() * w;
   p.R.col(1) = c * m1 + s * (u.x() * m2 - u.z() * m0) + u.y() * w;
   p.R.col(2) = c * m2 + s * (u.y() * m0 - u.x() * m1) + u.z() * w;
   return p;
-}
-
-// cos and sin of one angle (one libm call where the platform has sincos).
-inline void sincosOf(double angle, double* c, double* s) noexcept {
-  *c = std::cos(angle);
-  *s = std::sin(angle);
 }
 
 // The value of a one-variable joint's step (a mimic's: its leader's times the multiplier, plus the offset).
@@ -92,7 +89,7 @@ void computeLinkPose(const RobotModel& model, const double* q, Pose* link_poses,
     // inline Eigen's fixed-size products here, and this runs for most links of every state checked.
     const double angle = stepValue(st, q);
     double c, s;
-    sincosOf(angle, &c, &s);
+    detail::sinCos(angle, &s, &c);
     s *= st.axis_sign;
     const double* P = parent.R.data();
     const double* O = st.origin.R.data();
