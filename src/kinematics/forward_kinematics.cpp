@@ -83,24 +83,27 @@ void computeLinkPose(const RobotModel& model, const double* q, Pose* link_poses,
   using Kind = detail::KinematicStep::Kind;
   const detail::KinematicStep& st = model.kinematicStep(i);
   const Pose& parent = link_poses[st.parent];
-  if (st.kind == Kind::TurnZ) {
-    // parent · origin · Rot(±z, angle), written out in scalars (column-major): M = parent.R · origin.R,
-    // t = parent.R · origin.t + parent.t, then only M's first two columns turn. The compiler does not
-    // inline Eigen's fixed-size products here, and this runs for most links of every state checked.
-    const double angle = stepValue(st, q);
-    double c, s;
-    detail::sinCos(angle, &s, &c);
-    s *= st.axis_sign;
+  // Fixed, TurnZ and Slide steps are written out in scalars (column-major): the compiler does not inline
+  // Eigen's fixed-size products here, and they run for most links of every state checked.
+  // M = parent.R · origin.R; t = parent.R · (origin.t + shift) + parent.t.
+  const auto place = [&](const Vec3& shift, double* M, Pose& out) {
     const double* P = parent.R.data();
     const double* O = st.origin.R.data();
-    const double* ot = st.origin.t.data();
-    double M[9];
     for (int col = 0; col < 3; ++col)
       for (int r = 0; r < 3; ++r) M[3 * col + r] = P[r] * O[3 * col] + P[3 + r] * O[3 * col + 1] + P[6 + r] * O[3 * col + 2];
-    Pose& out = link_poses[i];
+    const double o0 = st.origin.t[0] + shift[0], o1 = st.origin.t[1] + shift[1], o2 = st.origin.t[2] + shift[2];
+    for (int r = 0; r < 3; ++r) out.t[r] = P[r] * o0 + P[3 + r] * o1 + P[6 + r] * o2 + parent.t[r];
+  };
+  Pose& out = link_poses[i];
+  if (st.kind == Kind::TurnZ) {
+    // parent · origin · Rot(±z, angle): only M's first two columns turn.
+    double c, s;
+    detail::sinCos(stepValue(st, q), &s, &c);
+    s *= st.axis_sign;
+    double M[9];
+    place(Vec3::Zero(), M, out);
     double* R = out.R.data();
     for (int r = 0; r < 3; ++r) {
-      out.t[r] = P[r] * ot[0] + P[3 + r] * ot[1] + P[6 + r] * ot[2] + parent.t[r];
       R[r] = c * M[r] + s * M[3 + r];
       R[3 + r] = c * M[3 + r] - s * M[r];
       R[6 + r] = M[6 + r];
@@ -108,7 +111,11 @@ void computeLinkPose(const RobotModel& model, const double* q, Pose* link_poses,
     return;
   }
   if (st.kind == Kind::Fixed) {
-    link_poses[i] = parent * st.origin;
+    place(Vec3::Zero(), out.R.data(), out);
+    return;
+  }
+  if (st.kind == Kind::Slide) {  // parent · origin · Trans(value · axis)
+    place(stepValue(st, q) * st.axis, out.R.data(), out);
     return;
   }
   if (st.kind == Kind::Turn) {

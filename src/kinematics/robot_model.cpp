@@ -142,6 +142,9 @@ RobotModel::RobotModel(std::string name, std::vector<Link> links, std::vector<Jo
       const bool z = j.axis.x() == 0.0 && j.axis.y() == 0.0 && std::abs(j.axis.z()) == 1.0;
       s.kind = z ? Kind::TurnZ : Kind::Turn;
       s.axis_sign = z ? j.axis.z() : 1.0;
+    } else if (j.type == JointType::Prismatic) {
+      s.kind = Kind::Slide;
+      s.axis = j.origin.R * j.axis;
     } else {
       s.kind = Kind::Other;
     }

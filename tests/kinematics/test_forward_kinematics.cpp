@@ -160,6 +160,62 @@ TEST(ForwardKinematics, RevoluteAboutAnyAxisMatchesTheRotationMatrix) {
   }
 }
 
+TEST(ForwardKinematics, EveryStepKindMatchesTheComposedChain) {
+  // Revolute about ±z and skew axes, prismatic along skew axes (one a mimic of another), fixed joints, each
+  // with a turned origin: every pose equals origin · motion composed down the chain, whichever of the
+  // load-time step kinds computes it.
+  struct Spec {
+    const char* type;
+    const char* axis;
+    const char* mimic;  // the leader joint, or null
+  };
+  const Spec specs[] = {{"revolute", "0 0 1", nullptr},  {"prismatic", "0.3 -0.5 0.8", nullptr},
+                        {"fixed", "1 0 0", nullptr},     {"revolute", "-2 1 0.5", nullptr},
+                        {"prismatic", "0 1 0", "j1"},    {"revolute", "0 0 -1", nullptr},
+                        {"fixed", "1 0 0", nullptr},     {"prismatic", "0 0 1", nullptr},
+                        {"revolute", "1 0 0", "j0"}};
+  const int n = static_cast<int>(std::size(specs));
+  TempDir dir;
+  std::string urdf = "<robot name=\"kinds\"><link name=\"l0\"/>";
+  for (int k = 0; k < n; ++k) {
+    const std::string type = specs[k].type;
+    urdf += "<link name=\"l" + std::to_string(k + 1) + "\"/><joint name=\"j" + std::to_string(k) + "\" type=\"" + type +
+            "\"><parent link=\"l" + std::to_string(k) + "\"/><child link=\"l" + std::to_string(k + 1) +
+            "\"/><origin xyz=\"0.1 " + std::to_string(0.2 * k) + " -0.3\" rpy=\"0.4 " + std::to_string(-0.3 * k) +
+            " 1.2\"/>";
+    if (type != "fixed")
+      urdf += std::string("<axis xyz=\"") + specs[k].axis + "\"/><limit lower=\"-4\" upper=\"4\" velocity=\"1\" effort=\"1\"/>";
+    if (specs[k].mimic) urdf += std::string("<mimic joint=\"") + specs[k].mimic + "\" multiplier=\"-1.5\" offset=\"0.25\"/>";
+    urdf += "</joint>";
+  }
+  urdf += "</robot>";
+  const RobotModel m = loadRobot(dir.write("kinds.urdf", urdf));
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-4.0, 4.0);
+  for (int trial = 0; trial < 50; ++trial) {
+    std::vector<double> q(m.variableCount());
+    for (double& v : q) v = u(rng);
+    const std::vector<Pose> p = poses(m, q);
+    Pose expected = Pose::identity();
+    for (int k = 0; k < n; ++k) {
+      const Joint& j = m.joint(m.jointIndex("j" + std::to_string(k)));
+      const std::string type = specs[k].type;
+      double value = 0.0;
+      if (specs[k].mimic) {
+        value = -1.5 * q[m.joint(m.jointIndex(specs[k].mimic)).first_variable] + 0.25;
+      } else if (type != "fixed") {
+        value = q[j.first_variable];
+      }
+      Pose motion;
+      if (type == "revolute") motion.R = Eigen::AngleAxisd(value, j.axis).toRotationMatrix();
+      if (type == "prismatic") motion.t = value * j.axis;
+      expected = expected * j.origin * motion;
+      expectPose(p[m.linkIndex("l" + std::to_string(k + 1))], expected.R, expected.t, 1e-13,
+                 "joint " + std::to_string(k) + " (" + type + ")");
+    }
+  }
+}
+
 TEST(ForwardKinematics, PlanarJointAboutAnotherAxis) {
   // A plane with normal x: (x, y) move along the basis planarBasis gives, θ turns about x.
   TempDir dir;

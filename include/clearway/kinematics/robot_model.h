@@ -93,7 +93,7 @@ namespace detail {
 /// One link's step of forward kinematics, folded at load: its parent joint's frame and motion with
 /// the lookups done (forward_kinematics.cpp reads it; nothing else should).
 struct KinematicStep {
-  enum class Kind : std::uint8_t { Root, Fixed, TurnZ, Turn, Other };
+  enum class Kind : std::uint8_t { Root, Fixed, TurnZ, Turn, Slide, Other };
   Kind kind = Kind::Root;
   int parent = -1;         ///< the parent link
   int variable = -1;       ///< the q entry the joint's value comes from (a mimic's leader's)
@@ -101,7 +101,7 @@ struct KinematicStep {
   bool mimic = false;
   double axis_sign = 1.0;  ///< TurnZ: the axis is axis_sign · z
   Pose origin;
-  Vec3 axis = Vec3::UnitX();
+  Vec3 axis = Vec3::UnitX();  ///< Turn: the joint's axis; Slide: origin.R · axis (slides along it before parent.R)
 };
 }  // namespace detail
 
