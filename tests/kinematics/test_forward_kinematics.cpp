@@ -127,43 +127,10 @@ TEST(ForwardKinematics, EveryJointType) {
   expectPose(p[m.linkIndex("fx")], rotX(M_PI / 2), Vec3(0, 0, 3), 1e-15, "fixed");
 }
 
-TEST(ForwardKinematics, RevoluteAboutAnyAxisMatchesTheRotationMatrix) {
-  // A chain of revolute joints about ±z (the fast path), x, and skew axes, each with a turned origin;
-  // also a mimic. Every pose equals origin · AngleAxis(q, axis) composed down the chain.
-  TempDir dir;
-  const char* axes[] = {"0 0 1", "0 0 -1", "1 0 0", "0.3 -0.5 0.8", "0 1 0", "-2 1 0.5"};
-  std::string urdf = "<robot name=\"axes\"><link name=\"l0\"/>";
-  for (int k = 0; k < 6; ++k) {
-    urdf += "<link name=\"l" + std::to_string(k + 1) + "\"/><joint name=\"j" + std::to_string(k) +
-            "\" type=\"revolute\"><parent link=\"l" + std::to_string(k) + "\"/><child link=\"l" + std::to_string(k + 1) +
-            "\"/><origin xyz=\"0.1 " + std::to_string(0.2 * k) + " 0.3\" rpy=\"0.4 " + std::to_string(-0.3 * k) +
-            " 1.2\"/><axis xyz=\"" + axes[k] + "\"/><limit lower=\"-4\" upper=\"4\" velocity=\"1\" effort=\"1\"/>" +
-            (k == 5 ? "<mimic joint=\"j1\" multiplier=\"-1.5\" offset=\"0.25\"/>" : "") + "</joint>";
-  }
-  urdf += "</robot>";
-  const RobotModel m = loadRobot(dir.write("axes.urdf", urdf));
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> u(-4.0, 4.0);
-  for (int trial = 0; trial < 50; ++trial) {
-    std::vector<double> q(m.variableCount());
-    for (double& v : q) v = u(rng);
-    const std::vector<Pose> p = poses(m, q);
-    Pose expected = Pose::identity();
-    for (int k = 0; k < 6; ++k) {
-      const Joint& j = m.joint(m.jointIndex("j" + std::to_string(k)));
-      const double angle = k == 5 ? -1.5 * q[1] + 0.25 : q[j.first_variable];
-      Pose motion;
-      motion.R = Eigen::AngleAxisd(angle, j.axis).toRotationMatrix();
-      expected = expected * j.origin * motion;
-      expectPose(p[m.linkIndex("l" + std::to_string(k + 1))], expected.R, expected.t, 1e-13, axes[k]);
-    }
-  }
-}
-
 TEST(ForwardKinematics, EveryStepKindMatchesTheComposedChain) {
-  // Revolute about ±z and skew axes, prismatic along skew axes (one a mimic of another), fixed joints, each
-  // with a turned origin: every pose equals origin · motion composed down the chain, whichever of the
-  // load-time step kinds computes it.
+  // Revolute about ±z, x, y and skew axes (two mimics), prismatic along skew axes (one a mimic of another)
+  // and fixed joints, each with a turned origin: every pose equals origin · motion composed down the chain,
+  // whichever of the load-time step kinds computes it.
   struct Spec {
     const char* type;
     const char* axis;
@@ -173,7 +140,8 @@ TEST(ForwardKinematics, EveryStepKindMatchesTheComposedChain) {
                         {"fixed", "1 0 0", nullptr},     {"revolute", "-2 1 0.5", nullptr},
                         {"prismatic", "0 1 0", "j1"},    {"revolute", "0 0 -1", nullptr},
                         {"fixed", "1 0 0", nullptr},     {"prismatic", "0 0 1", nullptr},
-                        {"revolute", "1 0 0", "j0"}};
+                        {"revolute", "1 0 0", "j0"},     {"revolute", "0 1 0", nullptr},
+                        {"revolute", "0.3 -0.5 0.8", "j3"}};
   const int n = static_cast<int>(std::size(specs));
   TempDir dir;
   std::string urdf = "<robot name=\"kinds\"><link name=\"l0\"/>";
