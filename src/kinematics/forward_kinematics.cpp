@@ -36,23 +36,6 @@ Pose jointMotion(const Joint& j, const double* v) noexcept {
   return m;
 }
 
-// parent · origin · Rot(u, angle) without forming the rotation (the inner loop of every motion check):
-// M · Rot = c·M + s·M[u]× + (1 − c)·(M u) uᵀ with M = parent.R · origin.R, column by column (axes along
-// ±z, most robots', take computeLinkPose's shorter path).
-Pose turned(const Pose& parent, const Pose& origin, const Vec3& u, double angle) noexcept {
-  Pose p;
-  const Mat3 M = parent.R * origin.R;
-  p.t = parent.R * origin.t + parent.t;
-  double c, s;
-  detail::sinCos(angle, &s, &c);
-  const Vec3 m0 = M.col(0), m1 = M.col(1), m2 = M.col(2);
-  const Vec3 w = (1.0 - c) * (M * u);
-  p.R.col(0) = c * m0 + s * (u.z() * m1 - u.y() * m2) + u.x() * w;
-  p.R.col(1) = c * m1 + s * (u.x() * m2 - u.z() * m0) + u.y() * w;
-  p.R.col(2) = c * m2 + s * (u.y() * m0 - u.x() * m1) + u.z() * w;
-  return p;
-}
-
 // The value of a one-variable joint's step (a mimic's: its leader's times the multiplier, plus the offset).
 inline double stepValue(const detail::KinematicStep& st, const double* q) noexcept {
   return st.mimic ? st.multiplier * q[st.variable] + st.offset : q[st.variable];
@@ -83,8 +66,8 @@ void computeLinkPose(const RobotModel& model, const double* q, Pose* link_poses,
   using Kind = detail::KinematicStep::Kind;
   const detail::KinematicStep& st = model.kinematicStep(i);
   const Pose& parent = link_poses[st.parent];
-  // Fixed, TurnZ and Slide steps are written out in scalars (column-major): the compiler does not inline
-  // Eigen's fixed-size products here, and they run for most links of every state checked.
+  // parent · origin, written out in scalars (column-major) for every step but Other: the compiler does not
+  // inline Eigen's fixed-size products here, and this runs for every link of every state checked.
   // M = parent.R · origin.R; t = parent.R · (origin.t + shift) + parent.t.
   const auto place = [&](const Vec3& shift, double* M, Pose& out) {
     const double* P = parent.R.data();
@@ -119,7 +102,18 @@ void computeLinkPose(const RobotModel& model, const double* q, Pose* link_poses,
     return;
   }
   if (st.kind == Kind::Turn) {
-    link_poses[i] = turned(parent, st.origin, st.axis, stepValue(st, q));
+    // parent · origin · Rot(u, angle) without forming the rotation: M · Rot = c·M + s·M[u]× + (1 − c)·(M u) uᵀ,
+    // column by column.
+    double c, s;
+    detail::sinCos(stepValue(st, q), &s, &c);
+    Mat3 M;
+    place(Vec3::Zero(), M.data(), out);
+    const Vec3& u = st.axis;
+    const Vec3 m0 = M.col(0), m1 = M.col(1), m2 = M.col(2);
+    const Vec3 w = (1.0 - c) * (M * u);
+    out.R.col(0) = c * m0 + s * (u.z() * m1 - u.y() * m2) + u.x() * w;
+    out.R.col(1) = c * m1 + s * (u.x() * m2 - u.z() * m0) + u.y() * w;
+    out.R.col(2) = c * m2 + s * (u.y() * m0 - u.x() * m1) + u.z() * w;
     return;
   }
   const Joint& j = model.joints()[model.links()[i].parent_joint];
