@@ -7,6 +7,7 @@ if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 packages=(
   build-essential cmake git pkg-config
   libeigen3-dev                      # geometry
+  libhwy-dev                         # SIMD lanes (Highway, run-time dispatch)
   liburdfdom-dev libassimp-dev libtinyxml2-dev  # robots: URDF, meshes, SRDF
   liboctomap-dev                     # environment: OctoMap
   libompl-dev libboost-serialization-dev libboost-filesystem-dev libboost-system-dev  # OMPL plugin

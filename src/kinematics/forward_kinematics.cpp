@@ -36,11 +36,6 @@ Pose jointMotion(const Joint& j, const double* v) noexcept {
   return m;
 }
 
-// The value of a one-variable joint's step (a mimic's: its leader's times the multiplier, plus the offset).
-inline double stepValue(const detail::KinematicStep& st, const double* q) noexcept {
-  return st.mimic ? st.multiplier * q[st.variable] + st.offset : q[st.variable];
-}
-
 // A mimic joint's value: its leader's times the multiplier, plus the offset.
 double mimicValue(const RobotModel& model, const Joint& j, const double* q) noexcept {
   return j.mimic.multiplier * q[model.joint(j.mimic.joint).first_variable] + j.mimic.offset;
@@ -81,7 +76,7 @@ void computeLinkPose(const RobotModel& model, const double* q, Pose* link_poses,
   if (st.kind == Kind::TurnZ) {
     // parent · origin · Rot(±z, angle): only M's first two columns turn.
     double c, s;
-    detail::sinCos(stepValue(st, q), &s, &c);
+    detail::sinCos(st.value(q), &s, &c);
     s *= st.axis_sign;
     double M[9];
     place(Vec3::Zero(), M, out);
@@ -98,22 +93,24 @@ void computeLinkPose(const RobotModel& model, const double* q, Pose* link_poses,
     return;
   }
   if (st.kind == Kind::Slide) {  // parent · origin · Trans(value · axis)
-    place(stepValue(st, q) * st.axis, out.R.data(), out);
+    place(st.value(q) * st.axis, out.R.data(), out);
     return;
   }
   if (st.kind == Kind::Turn) {
     // parent · origin · Rot(u, angle) without forming the rotation: M · Rot = c·M + s·M[u]× + (1 − c)·(M u) uᵀ,
-    // column by column.
+    // column by column. Written out in scalars, in the order the lanes (kinematic_lanes.cpp) repeat.
     double c, s;
-    detail::sinCos(stepValue(st, q), &s, &c);
-    Mat3 M;
-    place(Vec3::Zero(), M.data(), out);
-    const Vec3& u = st.axis;
-    const Vec3 m0 = M.col(0), m1 = M.col(1), m2 = M.col(2);
-    const Vec3 w = (1.0 - c) * (M * u);
-    out.R.col(0) = c * m0 + s * (u.z() * m1 - u.y() * m2) + u.x() * w;
-    out.R.col(1) = c * m1 + s * (u.x() * m2 - u.z() * m0) + u.y() * w;
-    out.R.col(2) = c * m2 + s * (u.y() * m0 - u.x() * m1) + u.z() * w;
+    detail::sinCos(st.value(q), &s, &c);
+    double M[9];
+    place(Vec3::Zero(), M, out);
+    const double ux = st.axis[0], uy = st.axis[1], uz = st.axis[2];
+    double* R = out.R.data();
+    for (int r = 0; r < 3; ++r) {
+      const double w = (1.0 - c) * (M[r] * ux + M[3 + r] * uy + M[6 + r] * uz);
+      R[r] = c * M[r] + s * (uz * M[3 + r] - uy * M[6 + r]) + ux * w;
+      R[3 + r] = c * M[3 + r] + s * (ux * M[6 + r] - uz * M[r]) + uy * w;
+      R[6 + r] = c * M[6 + r] + s * (uy * M[r] - ux * M[3 + r]) + uz * w;
+    }
     return;
   }
   const Joint& j = model.joints()[model.links()[i].parent_joint];

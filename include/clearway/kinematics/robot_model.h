@@ -102,6 +102,8 @@ struct KinematicStep {
   double axis_sign = 1.0;  ///< TurnZ: the axis is axis_sign · z
   Pose origin;
   Vec3 axis = Vec3::UnitX();  ///< Turn: the joint's axis; Slide: origin.R · axis (slides along it before parent.R)
+  /// The joint's value in q (a mimic's: its leader's times the multiplier, plus the offset).
+  double value(const double* q) const noexcept { return mimic ? multiplier * q[variable] + offset : q[variable]; }
 };
 }  // namespace detail
 

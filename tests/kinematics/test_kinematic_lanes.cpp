@@ -1,0 +1,184 @@
+// KinematicLanes against computeLinkPoses, bit for bit, with the lanes forced to every SIMD target this
+// machine offers (and the portable one): our robots (every joint type among them, planar and floating
+// ones in the flyer and the rover), the shared Panda and UR5, batches of every length around the width,
+// angles far beyond the joint ranges (where sin and cos fall back to libm), and NaN.
+#include <clearway/kinematics/forward_kinematics.h>
+#include <clearway/kinematics/kinematic_lanes.h>
+#include <clearway/load/robot_loader.h>
+
+#include "load/robot_files.h"
+
+#include <gtest/gtest.h>
+#include <hwy/targets.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <iterator>
+#include <random>
+#include <string>
+#include <vector>
+
+using namespace clearway;
+
+namespace {
+
+// Restores the CPU's own targets when a test ends, however it ends.
+struct ForcedTarget {
+  explicit ForcedTarget(std::int64_t t) { hwy::SetSupportedTargetsForTest(t); }
+  ~ForcedTarget() { hwy::SetSupportedTargetsForTest(0); }
+};
+
+bool sameBits(double a, double b) {
+  return std::isnan(a) ? std::isnan(b) : std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+// Every pose of every state of `states` from the lanes equals the scalar one, on every target.
+void expectLanesEqualScalar(const RobotModel& m, const std::vector<std::vector<double>>& states, const std::string& what) {
+  const int n = static_cast<int>(states.size());
+  std::vector<std::vector<Pose>> scalar(n, std::vector<Pose>(m.linkCount()));
+  for (int s = 0; s < n; ++s) computeLinkPoses(m, states[s].data(), scalar[s].data());
+  std::vector<const double*> q(n);
+  for (int s = 0; s < n; ++s) q[s] = states[s].data();
+  const std::vector<std::int64_t> targets = hwy::SupportedAndGeneratedTargets();
+  ASSERT_FALSE(targets.empty());
+  for (const std::int64_t target : targets) {
+    const ForcedTarget forced(target);
+    ASSERT_STREQ(KinematicLanes::targetName(), hwy::TargetName(target));
+    const int w = KinematicLanes::width();
+    ASSERT_TRUE(w >= 1 && w <= KinematicLanes::kMaxLanes) << w;
+    KinematicLanes lanes(m);
+    // Batches of every length up to two passes and one: full passes and a partial last one.
+    for (int count = 1; count <= std::min(n, 2 * w + 1); ++count) {
+      for (int first = 0; first + count <= n; first += count) {
+        std::vector<std::vector<Pose>> out(count, std::vector<Pose>(m.linkCount()));
+        std::vector<Pose*> o(count);
+        for (int s = 0; s < count; ++s) o[s] = out[s].data();
+        lanes.compute(q.data() + first, count, o.data());
+        for (int s = 0; s < count; ++s)
+          for (int i = 0; i < m.linkCount(); ++i) {
+            const Pose& a = out[s][i];
+            const Pose& b = scalar[first + s][i];
+            for (int k = 0; k < 9; ++k)
+              ASSERT_TRUE(sameBits(a.R.data()[k], b.R.data()[k]))
+                  << what << ", target " << hwy::TargetName(target) << ", batch of " << count << ", state "
+                  << first + s << ", link " << m.link(i).name << ", R[" << k << "] = " << a.R.data()[k] << " vs "
+                  << b.R.data()[k];
+            for (int k = 0; k < 3; ++k)
+              ASSERT_TRUE(sameBits(a.t[k], b.t[k]))
+                  << what << ", target " << hwy::TargetName(target) << ", batch of " << count << ", state "
+                  << first + s << ", link " << m.link(i).name << ", t[" << k << "]";
+          }
+      }
+    }
+  }
+}
+
+// States within the limits (continuous and unbounded variables within ±4), and a few far outside.
+std::vector<std::vector<double>> randomStates(const RobotModel& m, int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<std::vector<double>> out(n, std::vector<double>(m.variableCount()));
+  for (int s = 0; s < n; ++s)
+    for (int v = 0; v < m.variableCount(); ++v) {
+      const JointVariable& var = m.variables()[v];
+      const double lo = std::isfinite(var.lower) ? var.lower : -4.0, hi = std::isfinite(var.upper) ? var.upper : 4.0;
+      double x = lo + (hi - lo) * u(rng);
+      if (s % 7 == 3) x *= 1e5;  // past 2^16 rad: sin and cos from libm
+      out[s][v] = x;
+    }
+  return out;
+}
+
+// A chain of every joint kind, each with an origin whose every coordinate and angle is nonzero (so that
+// no term of a product vanishes and a change in the order of the sums shows), planar and floating
+// joints between turning ones, and mimics of a revolute and a prismatic joint.
+std::string everyKindChain() {
+  const char* kinds[][3] = {{"revolute", "0 0 1", ""},          {"prismatic", "0.3 -0.5 0.8", ""},
+                            {"revolute", "0 0 -1", ""},         {"fixed", "", ""},
+                            {"continuous", "-2 1 0.5", ""},     {"planar", "0 0 1", ""},
+                            {"revolute", "1 0 0", "j0"},        {"floating", "", ""},
+                            {"prismatic", "0 1 0", "j1"},       {"revolute", "0.3 -0.5 0.8", "j4"},
+                            {"planar", "0.6 0.8 0", ""},        {"revolute", "0 1 0", ""}};
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const auto num = [&] { return std::to_string(u(rng) * 0.7 + (u(rng) < 0 ? -0.3 : 0.3)); };
+  std::string urdf = "<robot name=\"chain\"><link name=\"l0\"/>";
+  for (int k = 0; k < static_cast<int>(std::size(kinds)); ++k) {
+    const std::string type = kinds[k][0], n = std::to_string(k);
+    urdf += "<link name=\"l" + std::to_string(k + 1) + "\"/><joint name=\"j" + n + "\" type=\"" + type +
+            "\"><parent link=\"l" + n + "\"/><child link=\"l" + std::to_string(k + 1) + "\"/><origin xyz=\"" + num() +
+            " " + num() + " " + num() + "\" rpy=\"" + num() + " " + num() + " " + num() + "\"/>";
+    if (*kinds[k][1]) urdf += std::string("<axis xyz=\"") + kinds[k][1] + "\"/>";
+    if (type == "revolute" || type == "prismatic")
+      urdf += "<limit lower=\"-3\" upper=\"3\" velocity=\"1\" effort=\"1\"/>";
+    if (*kinds[k][2]) urdf += std::string("<mimic joint=\"") + kinds[k][2] + "\" multiplier=\"-1.5\" offset=\"0.25\"/>";
+    urdf += "</joint>";
+  }
+  return urdf + "</robot>";
+}
+
+}  // namespace
+
+TEST(KinematicLanes, EveryJointKindBitForBitOnEveryTarget) {
+  test::TempDir dir;
+  const RobotModel m = loadRobot(dir.write("chain.urdf", everyKindChain()));
+  std::vector<std::vector<double>> states = randomStates(m, 41, 23);
+  for (auto& s : states)  // unit quaternions for the floating joint (variables 5..11: x y z qx qy qz qw)
+    for (const Joint& j : m.joints())
+      if (j.type == JointType::Floating) {
+        double* r = s.data() + j.first_variable + 3;
+        const double norm = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3]);
+        for (int k = 0; k < 4; ++k) r[k] /= norm;
+      }
+  expectLanesEqualScalar(m, states, "every-kind chain");
+}
+
+TEST(KinematicLanes, OurRobotsBitForBitOnEveryTarget) {
+  for (const char* rel : {"arm6/arm6.urdf", "planar_arm/planar_arm.urdf", "flyer/flyer.urdf", "rover/rover.urdf",
+                          "twin_arm/twin_arm.urdf"}) {
+    const RobotModel m = loadRobot(test::sourceRobot(rel));
+    expectLanesEqualScalar(m, randomStates(m, 29, 5), rel);
+  }
+}
+
+TEST(KinematicLanes, SharedRobotsBitForBitOnEveryTarget) {
+  for (const char* rel : {"panda/panda.urdf", "ur5/ur5.urdf"}) {
+    CLEARWAY_SHARED_ROBOT_OR_SKIP(urdf, rel);
+    const RobotModel m = loadRobot(urdf);
+    expectLanesEqualScalar(m, randomStates(m, 37, 11), rel);
+  }
+}
+
+TEST(KinematicLanes, TurnsInEveryQuadrantAndAtTheRangeEdge) {
+  // Continuous joints (unbounded), one about z and one about a skew axis, at angles k·π/2 + δ for k across
+  // the whole range of the inline sin and cos and both sides of its edge (2^16), where libm takes over.
+  test::TempDir dir;
+  const RobotModel m = loadRobot(dir.write(
+      "turns.urdf",
+      "<robot name=\"turns\"><link name=\"a\"/><link name=\"b\"/><link name=\"c\"/>"
+      "<joint name=\"z\" type=\"continuous\"><parent link=\"a\"/><child link=\"b\"/><axis xyz=\"0 0 1\"/></joint>"
+      "<joint name=\"skew\" type=\"continuous\"><parent link=\"b\"/><child link=\"c\"/>"
+      "<origin xyz=\"0.1 0.2 0.3\" rpy=\"0.3 -0.2 0.1\"/><axis xyz=\"0.2 -0.7 0.4\"/></joint></robot>"));
+  std::vector<std::vector<double>> states;
+  const double deltas[] = {0.0, 1e-9, -0.3, 0.7, -0.78, 0.785398};
+  for (long k = -41700; k <= 41700; k += 139)
+    states.push_back({k * M_PI / 2 + deltas[k % 6 < 0 ? -(k % 6) : k % 6], -k * M_PI / 2 - deltas[(k / 7 % 6 + 6) % 6]});
+  for (const double edge : {0x1p16, std::nextafter(0x1p16, 0.0), std::nextafter(0x1p16, 1e300)})
+    for (const double sign : {1.0, -1.0}) states.push_back({sign * edge, -sign * edge});
+  expectLanesEqualScalar(m, states, "continuous turns");
+}
+
+TEST(KinematicLanes, NaNGivesTheScalarNaNPoses) {
+  const RobotModel m = loadRobot(test::sourceRobot("arm6/arm6.urdf"));
+  std::vector<std::vector<double>> states = randomStates(m, 9, 3);
+  states[2][1] = std::nan("");
+  states[5][0] = std::numeric_limits<double>::infinity();
+  expectLanesEqualScalar(m, states, "arm6 with NaN and infinity");
+}
+
+TEST(KinematicLanes, ChoosesTheWidestTargetOffered) {
+  // Unforced, the lanes are the CPU's best compiled target (the first Highway lists).
+  EXPECT_STREQ(KinematicLanes::targetName(), hwy::TargetName(hwy::SupportedAndGeneratedTargets().front()));
+  std::printf("lanes: %s, %d doubles\n", KinematicLanes::targetName(), KinematicLanes::width());
+}
