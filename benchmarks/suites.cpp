@@ -23,6 +23,7 @@
 #include <ompl/util/Console.h>
 
 #include <algorithm>
+#include <memory>
 #include <cstring>
 #include <cmath>
 #include <filesystem>
@@ -181,7 +182,7 @@ void randomState(const Scene& scene, Rng& rng, double* q) {
   }
 }
 
-// ---- states: one joint vector at a time, exact meshes, convex hulls and FCL ----------------------------
+// ---- states: one joint vector at a time (and 64 to a call), exact meshes, convex hulls and FCL -------------
 
 void statesCase(const SuiteCase& c, const SuiteConfig& config, std::vector<SuiteRow>& rows) {
   const SceneDescription d = parseSceneFile(c.file);
@@ -207,6 +208,15 @@ void statesCase(const SuiteCase& c, const SuiteConfig& config, std::vector<Suite
     rows.push_back(r);
   };
   row("clearway", "mesh", bestNs(count, [&](std::size_t i) { verdict[i] = !mesh->isFree(&states[i * n], ctx); }));
+  // The same states 64 to a call (Scene::areFree: kinematics in SIMD lanes), as a roadmap planner would.
+  constexpr std::size_t kBatch = 64;
+  std::unique_ptr<bool[]> batch_free(new bool[kBatch]);
+  row("clearway", "mesh-batch", bestNs(count, [&](std::size_t i) {
+        if (i % kBatch != 0) return;
+        const std::size_t k = std::min(kBatch, count - i);
+        mesh->areFree(&states[i * n], static_cast<int>(k), ctx, batch_free.get());
+        for (std::size_t j = 0; j < k; ++j) verdict[i + j] = !batch_free[j];
+      }));
   SceneContext hull_ctx = hull.makeContext();
   row("clearway", "hull", bestNs(count, [&](std::size_t i) { verdict[i] = !hull.isFree(&states[i * n], hull_ctx); }));
 #ifdef CLEARWAY_HAVE_FCL

@@ -35,7 +35,7 @@ namespace fs = std::filesystem;
 
 const char* const kBenchHelp =
     "SUITE: narrowphase (GJK distance by tolerance, Clearway and FCL's two solvers), states (one state:\n"
-    "exact meshes, convex hulls, FCL OBBRSS), motions (certified by contact distance, OMPL's sampling by\n"
+    "exact meshes, convex hulls, FCL OBBRSS; mesh-batch: 64 states per call), motions (certified by contact distance, OMPL's sampling by\n"
     "resolution over Clearway and over FCL, against a dense reference), plan (RRTConnect with each\n"
     "checker: one OMPL benchmark log per problem in DIR/plan, the checkers as planners side by side for\n"
     "Planner Arena), or all. Default: narrowphase states motions.\n"

@@ -358,6 +358,10 @@ SceneContext Scene::makeContext() const {
   c.q = base_q_;
   c.poses.resize(robot().linkCount());
   c.self = self_.makeContext();
+  c.lanes.emplace(robot());
+  c.lane_q.reserve(base_q_.size() * KinematicLanes::kMaxLanes);
+  for (int l = 0; l < KinematicLanes::kMaxLanes; ++l) c.lane_q.insert(c.lane_q.end(), base_q_.begin(), base_q_.end());
+  c.lane_poses.resize(static_cast<std::size_t>(robot().linkCount()) * KinematicLanes::kMaxLanes);
   return c;
 }
 
@@ -412,11 +416,17 @@ bool Scene::isFree(const double* state, SceneContext& ctx, CollisionReport* repo
   const Effects& fx = description_.effects;
   if (!fx.self && !fx.environment) return true;
   computePoses(state, ctx);
+  return posedFree(ctx.poses.data(), ctx.q.data(), ctx, r, t);
+}
+
+bool Scene::posedFree(const Pose* poses, const double* q, SceneContext& ctx, CollisionReport& r,
+                      double t) const noexcept {
+  const Effects& fx = description_.effects;
   if (fx.environment && !environment_->empty()) {
     const double time = fx.moving ? t : 0.0;
     for (int i : env_links_) {
       EnvironmentHit hit;
-      if (environment_->linkIntersects(*geometry_->link(i), ctx.poses[i], options_.tolerances, options_.mode,
+      if (environment_->linkIntersects(*geometry_->link(i), poses[i], options_.tolerances, options_.mode,
                                        link_padding_[i], time, &hit, &ctx.counters.environment)) {
         r.kind = CollisionReport::Kind::Environment;
         r.link = i;
@@ -427,7 +437,7 @@ bool Scene::isFree(const double* state, SceneContext& ctx, CollisionReport* repo
   }
   if (fx.self) {
     const long long before = ctx.self.pair_tests;
-    const LinkPair* hit = self_.firstCollision(ctx.poses.data(), ctx.self, ctx.q.data());
+    const LinkPair* hit = self_.firstCollision(poses, ctx.self, q);
     ctx.counters.self_pair_tests += ctx.self.pair_tests - before;
     if (hit) {
       r.kind = CollisionReport::Kind::Self;
@@ -437,6 +447,51 @@ bool Scene::isFree(const double* state, SceneContext& ctx, CollisionReport* repo
     }
   }
   return true;
+}
+
+void Scene::areFree(const double* states, int count, SceneContext& ctx, bool* free, double t) const noexcept {
+  const RobotModel& model = robot();
+  const int dim = dimension();
+  // A context made for another robot (or before lanes existed) takes the states one at a time.
+  if (!ctx.lanes || !ctx.lanes->madeFor(model) || ctx.poses.size() != static_cast<std::size_t>(model.linkCount())) {
+    for (int s = 0; s < count; ++s) free[s] = isFree(states + static_cast<std::ptrdiff_t>(s) * dim, ctx, nullptr, t);
+    return;
+  }
+  const Effects& fx = description_.effects;
+  const int width = std::min(KinematicLanes::width(), KinematicLanes::kMaxLanes);
+  const int variables = model.variableCount(), links = model.linkCount();
+  const double* lane_q[KinematicLanes::kMaxLanes];
+  Pose* lane_poses[KinematicLanes::kMaxLanes];
+  int pending[KinematicLanes::kMaxLanes];  // the states in the lanes
+  int n = 0;
+  const auto flush = [&] {
+    ctx.lanes->compute(lane_q, n, lane_poses);
+    for (int l = 0; l < n; ++l) {
+      CollisionReport r;
+      free[pending[l]] = posedFree(lane_poses[l], lane_q[l], ctx, r, t);
+    }
+    n = 0;
+  };
+  for (int s = 0; s < count; ++s) {
+    const double* state = states + static_cast<std::ptrdiff_t>(s) * dim;
+    ++ctx.counters.states;
+    if (!withinBounds(state)) {
+      ++ctx.counters.invalid_states;
+      free[s] = false;
+      continue;
+    }
+    if (static_collision_.kind != CollisionReport::Kind::None || (!fx.self && !fx.environment)) {
+      free[s] = static_collision_.kind == CollisionReport::Kind::None;
+      continue;
+    }
+    double* q = ctx.lane_q.data() + static_cast<std::ptrdiff_t>(n) * variables;
+    for (std::size_t i = 0; i < group_variables_.size(); ++i) q[group_variables_[i]] = state[i];
+    lane_q[n] = q;
+    lane_poses[n] = ctx.lane_poses.data() + static_cast<std::ptrdiff_t>(n) * links;
+    pending[n++] = s;
+    if (n == width) flush();
+  }
+  if (n > 0) flush();
 }
 
 bool Scene::isFree(const std::vector<double>& state, CollisionReport* report, double t) const {

@@ -86,7 +86,7 @@ TEST(BenchTool, ShardsMergeIntoTheUnshardedRun) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::vector<std::string> all = rowsWithoutTime(dir + "/all/results.csv");
   const std::vector<std::string> merged = rowsWithoutTime(dir + "/merged/results.csv");
-  EXPECT_GE(all.size(), haveSharedScenes() ? 39u : 36u);  // 18 distance rows per family, 3 per problem
+  EXPECT_GE(all.size(), haveSharedScenes() ? 44u : 36u);  // 18 distance rows per family, 4 per problem
   EXPECT_EQ(all, merged);
   // The same derived files as an unsharded run.
   for (const char* f : {"summary.csv", "table.txt", "plots.gp"}) {

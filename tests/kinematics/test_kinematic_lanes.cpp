@@ -40,7 +40,7 @@ void expectLanesEqualScalar(const RobotModel& m, const std::vector<std::vector<d
   for (int s = 0; s < n; ++s) computeLinkPoses(m, states[s].data(), scalar[s].data());
   std::vector<const double*> q(n);
   for (int s = 0; s < n; ++s) q[s] = states[s].data();
-  const std::vector<std::int64_t> targets = hwy::SupportedAndGeneratedTargets();
+  const std::vector<std::int64_t> targets = KinematicLanes::targets();
   ASSERT_FALSE(targets.empty());
   for (const std::int64_t target : targets) {
     const ForcedTarget forced(target);
@@ -179,6 +179,8 @@ TEST(KinematicLanes, NaNGivesTheScalarNaNPoses) {
 
 TEST(KinematicLanes, ChoosesTheWidestTargetOffered) {
   // Unforced, the lanes are the CPU's best compiled target (the first Highway lists).
-  EXPECT_STREQ(KinematicLanes::targetName(), hwy::TargetName(hwy::SupportedAndGeneratedTargets().front()));
-  std::printf("lanes: %s, %d doubles\n", KinematicLanes::targetName(), KinematicLanes::width());
+  EXPECT_STREQ(KinematicLanes::targetName(), hwy::TargetName(KinematicLanes::targets().front()));
+  std::printf("lanes: %s, %d doubles; targets tested:", KinematicLanes::targetName(), KinematicLanes::width());
+  for (const std::int64_t t : KinematicLanes::targets()) std::printf(" %s", hwy::TargetName(t));
+  std::printf("\n");
 }

@@ -6,6 +6,7 @@
 // thread (or through the convenience overloads, which keep one per thread themselves).
 #include <clearway/detail/per_thread.h>
 #include <clearway/environment/environment.h>
+#include <clearway/kinematics/kinematic_lanes.h>
 #include <clearway/kinematics/robot_model.h>
 #include <clearway/load/robot_loader.h>
 #include <clearway/scene/collision_filter.h>
@@ -14,6 +15,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -53,6 +55,10 @@ struct SceneContext {
   std::vector<Pose> poses;     ///< world pose of every link
   SelfCollisionContext self;
   SceneCounters counters;
+  // Scene::areFree's: the kinematics over lanes of states, and each lane's joint vector and link poses.
+  std::optional<KinematicLanes> lanes;
+  std::vector<double> lane_q;    ///< KinematicLanes::kMaxLanes joint vectors
+  std::vector<Pose> lane_poses;  ///< KinematicLanes::kMaxLanes sets of link poses
 };
 
 /// Everything a scene file says, after parsing and before loading anything (paths are absolute).
@@ -198,6 +204,10 @@ class Scene {
               double t = 0.0) const noexcept;
   /// The same with this thread's own context.
   bool isFree(const std::vector<double>& state, CollisionReport* report = nullptr, double t = 0.0) const;
+  /// isFree of `count` states at once, state s at states + s·dimension(): free[s] is the verdict isFree
+  /// gives it (a batch changes no verdict), at time t. The kinematics of several states run together in
+  /// SIMD lanes (KinematicLanes); then each state's links meet the obstacles and each other.
+  void areFree(const double* states, int count, SceneContext& context, bool* free, double t = 0.0) const noexcept;
 
   /// Signed clearance: the distance from the robot to the nearest declared hazard (environment and/or
   /// self) minus padding when free; when something touches, minus the deepest penetration (EPA between
@@ -215,6 +225,8 @@ class Scene {
   void initEnvironment();  // the part of init() that depends on the environment
   SceneContext& threadContext() const;
   bool withinBounds(const double* state) const noexcept;  // the cheap check of every query (no reason)
+  // isFree's geometry, once the poses of the state's links (and its full joint vector q) are known.
+  bool posedFree(const Pose* poses, const double* q, SceneContext& ctx, CollisionReport& r, double t) const noexcept;
 
   SceneDescription description_;
   SceneOptions options_;
