@@ -11,6 +11,7 @@
 
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <map>
@@ -197,11 +198,23 @@ void bindScene(py::module_& m) {
                bool* out = free.mutable_data();
                py::gil_scoped_release release;
                SceneContext ctx = scene.makeContext();
-               CollisionReport r;
-               for (py::ssize_t i = 0; i < n; ++i) {
-                 out[i] = scene.isFree(q + i * dof, ctx, &r, t[i]);
-                 if (r.kind == CollisionReport::Kind::Invalid) { bad = i; break; }
-                 if (report) reports[i] = r;
+               // Verdicts alone, at one time: the batch path (Scene::areFree, kinematics in SIMD lanes), once
+               // every row is known valid so that the first invalid one is still the one named.
+               const bool one_time = std::all_of(t.begin(), t.end(), [&](double x) { return x == t[0]; });
+               if (!report && one_time) {
+                 for (py::ssize_t i = 0; i < n && bad < 0; ++i)
+                   if (!scene.validState(q + i * dof)) bad = i;
+                 constexpr py::ssize_t kSlice = 1 << 20;  // areFree counts in int
+                 for (py::ssize_t first = 0; bad < 0 && first < n; first += kSlice)
+                   scene.areFree(q + first * dof, static_cast<int>(std::min(kSlice, n - first)), ctx, out + first,
+                                 n > 0 ? t[0] : 0.0);
+               } else {
+                 CollisionReport r;
+                 for (py::ssize_t i = 0; i < n; ++i) {
+                   out[i] = scene.isFree(q + i * dof, ctx, &r, t[i]);
+                   if (r.kind == CollisionReport::Kind::Invalid) { bad = i; break; }
+                   if (report) reports[i] = r;
+                 }
                }
              }
              if (bad >= 0) invalidRow(scene, "Q", bad, Q.data() + bad * dof);

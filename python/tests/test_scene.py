@@ -64,6 +64,15 @@ def test_is_free_and_check_agree(arm6):
     assert [arm6.is_free(q) for q in states] == list(free)
 
 
+def test_batched_verdicts_equal_the_reported_ones(panda_box, arm6):
+    # check() without report takes the batch path (kinematics in SIMD lanes); with report, one state at a time.
+    for scene in (panda_box[1], arm6):
+        states = random_states(scene, 1000, seed=6)
+        free, _ = scene.check(states, report=True)
+        np.testing.assert_array_equal(scene.check(states), free)
+        assert 50 < int(free.sum()) < 950
+
+
 def test_check_takes_views_copies_and_empty_batches(arm6):
     states = random_states(arm6, 200, seed=4)
     expected = arm6.check(states)

@@ -21,6 +21,7 @@
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <memory>
 #include <random>
 #include <thread>
 
@@ -60,6 +61,7 @@ std::shared_ptr<const Scene> spinnerScene(const TempDir& dir) {
 }
 
 std::string bundledScene() { return std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/arm6_wall.yaml"; }
+std::string ourScene(const std::string& name) { return std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/" + name; }
 
 TEST(OmplPlugin, StateSpaces) {
   TempDir dir;
@@ -115,6 +117,38 @@ TEST(OmplPlugin, ValidityCheckerAgreesWithTheScene) {
   EXPECT_GE(c.validity->counters().states.load(), 500u);
   // Without `clearance` in the scene, OMPL is told that there is none to ask for.
   EXPECT_EQ(c.validity->getSpecs().clearanceComputationType, ob::StateValidityCheckerSpecs::NONE);
+}
+
+TEST(OmplPlugin, AreValidGivesIsValidsVerdicts) {
+  // A batch of sampled states (the bundled arm, the rover's SE(2) and the flyer's SE(3)) in one call and in
+  // slices of odd lengths: each verdict is isValid's, and each state is counted once.
+  ompl::RNG::setSeed(13);
+  for (const std::string file : {bundledScene(), ourScene("rover_gap.yaml"), ourScene("flyer_post.yaml")}) {
+    const auto scene = Scene::load(file);
+    auto si = std::make_shared<ob::SpaceInformation>(makeStateSpace(*scene));
+    const CollisionChecking c = setupCollisionChecking(si, scene);
+    auto sampler = si->allocStateSampler();
+    constexpr std::size_t kCount = 301;
+    std::vector<ob::State*> states(kCount);
+    for (ob::State*& st : states) {
+      st = si->allocState();
+      sampler->sampleUniform(st);
+    }
+    std::vector<char> expected(kCount);
+    int valid = 0;
+    for (std::size_t k = 0; k < kCount; ++k) valid += expected[k] = c.validity->isValid(states[k]);
+    const std::uint64_t before = c.validity->counters().states.load();
+    std::unique_ptr<bool[]> got(new bool[kCount]);
+    c.validity->areValid(states.data(), kCount, got.get());
+    EXPECT_EQ(c.validity->counters().states.load(), before + kCount) << file;
+    for (std::size_t k = 0; k < kCount; ++k) EXPECT_EQ(got[k], static_cast<bool>(expected[k])) << file << " state " << k;
+    for (std::size_t first = 0; first < kCount; first += 7)
+      c.validity->areValid(states.data() + first, std::min<std::size_t>(7, kCount - first), got.get() + first);
+    for (std::size_t k = 0; k < kCount; ++k) EXPECT_EQ(got[k], static_cast<bool>(expected[k])) << file << " slices, state " << k;
+    EXPECT_GT(valid, 10) << file;
+    EXPECT_LT(valid, static_cast<int>(kCount) - 10) << file;
+    for (ob::State* st : states) si->freeState(st);
+  }
 }
 
 TEST(OmplPlugin, MovingObstaclesAreRefused) {
@@ -203,7 +237,6 @@ void planAndCertify(const std::function<ob::PlannerPtr(const ob::SpaceInformatio
   EXPECT_LT(c.motion->getValidMotionFraction(), 1.0);
 }
 
-std::string ourScene(const std::string& name) { return std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/" + name; }
 
 TEST(OmplPlugin, PlanarAndFloatingJointsAreSE2AndSE3) {
   ompl::RNG::setSeed(12);  // sampled states: a failure replays with the same ones

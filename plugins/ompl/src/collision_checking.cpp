@@ -25,6 +25,7 @@ struct ValidityScratch {
   std::uint64_t version = 0;
   SceneContext ctx;
   std::vector<double> q;
+  std::vector<double> batch;  // areValid's states, one after another (grows to the largest batch)
 };
 
 struct MotionScratch {
@@ -214,7 +215,7 @@ std::shared_ptr<World> worldOf(std::shared_ptr<const Scene> scene, MotionOptions
 
 ValidityScratch& validityScratch(const detail::ScratchOwner& owner, const WorldSnapshot& w) {
   ValidityScratch& s = perThread<ValidityScratch>(owner, [] { return ValidityScratch{}; });
-  if (s.version != w.version) s = ValidityScratch{w.version, w.scene->makeContext(), std::vector<double>(w.scene->dimension())};
+  if (s.version != w.version) s = ValidityScratch{w.version, w.scene->makeContext(), std::vector<double>(w.scene->dimension()), {}};
   return s;
 }
 
@@ -238,6 +239,22 @@ bool ValidityChecker::isValid(const ob::State* state) const {
   ValidityScratch& s = validityScratch(scratch_owner_, w);
   map_.toVector(state, s.q.data());
   return w.scene->isFree(s.q.data(), s.ctx);
+}
+
+void ValidityChecker::areValid(const ob::State* const* states, std::size_t n, bool* valid) const {
+  const Timer timer(counters_.nanoseconds);
+  counters_.states += n;
+  const WorldSnapshot& w = world_->current();
+  ValidityScratch& s = validityScratch(scratch_owner_, w);
+  const std::size_t dim = static_cast<std::size_t>(w.scene->dimension());
+  // In slices, so that a batch's count fits areFree's int however many states come.
+  constexpr std::size_t kSlice = 1024;
+  if (s.batch.size() < std::min(n, kSlice) * dim) s.batch.resize(std::min(n, kSlice) * dim);
+  for (std::size_t first = 0; first < n; first += kSlice) {
+    const std::size_t count = std::min(kSlice, n - first);
+    for (std::size_t k = 0; k < count; ++k) map_.toVector(states[first + k], s.batch.data() + k * dim);
+    w.scene->areFree(s.batch.data(), static_cast<int>(count), s.ctx, valid + first);
+  }
 }
 
 double ValidityChecker::clearance(const ob::State* state) const {

@@ -65,6 +65,9 @@ class ValidityChecker : public ompl::base::StateValidityChecker {
   /// The checker of a world's current snapshot, whichever it is at each query.
   ValidityChecker(const ompl::base::SpaceInformationPtr& si, std::shared_ptr<World> world);
   bool isValid(const ompl::base::State* state) const override;
+  /// valid[k] = isValid(states[k]) for k < n, the states' kinematics in SIMD lanes (Scene::areFree): for
+  /// planners and tools that check many states at once, such as a roadmap's samples or a path's states.
+  void areValid(const ompl::base::State* const* states, std::size_t n, bool* valid) const;
   double clearance(const ompl::base::State* state) const override;
   const CheckerCounters& counters() const noexcept { return counters_; }
   /// The current snapshot's scene (World::current(): valid until this thread's next query).
