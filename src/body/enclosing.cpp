@@ -23,6 +23,11 @@ EnclosingBalls::EnclosingBalls(const RobotGeometry& geometry) : geometry_(&geome
       }
     links_[i].count = static_cast<int>(local_.size()) - links_[i].first;
   }
+  bound_x_.assign(n, 0.0);
+  bound_y_.assign(n, 0.0);
+  bound_z_.assign(n, 0.0);
+  bound_r_.assign(n, std::numeric_limits<double>::infinity());
+  bound_norm_.assign(n, 0.0);
   centers_.assign(local_.size(), Vec3::Constant(std::numeric_limits<double>::quiet_NaN()));
   norms_.assign(local_.size(), std::numeric_limits<double>::quiet_NaN());
 }
@@ -36,6 +41,11 @@ void EnclosingBalls::place(const Pose* link_poses) noexcept {
     centers_[l.first] = link_poses[i] * local_[l.first];
     norms_[l.first] = centers_[l.first].norm();
     l.parts_placed = l.count == 1;
+    bound_x_[i] = centers_[l.first].x();
+    bound_y_[i] = centers_[l.first].y();
+    bound_z_[i] = centers_[l.first].z();
+    bound_r_[i] = radii_[l.first];
+    bound_norm_[i] = norms_[l.first];
   }
 }
 

@@ -8,13 +8,7 @@
 
 #include "kinematics/sincos.h"
 
-// Fixed-width vectors only: the kernel keeps vectors in arrays, which sizeless ones (SVE, RVV) forbid. And
-// no AVX-512: on Intel's server parts its arithmetic lowers the core's clock for a while after, so the
-// scalar checks that follow each pass ran slower than the lanes saved (measured on a Xeon: a batch of box_panda
-// states 3–9% slower than one at a time with AVX-512 lanes, 4–5% faster with AVX2's).
-#ifndef HWY_DISABLED_TARGETS
-#define HWY_DISABLED_TARGETS (HWY_AVX3 | HWY_AVX3_DL | HWY_SVE | HWY_SVE2 | HWY_SVE_256 | HWY_SVE2_128 | HWY_RVV)
-#endif
+#include "detail/simd_targets.h"  // before Highway's headers
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "kinematics/kinematic_lanes.cpp"
 #include <hwy/foreach_target.h>  // must come before highway.h

@@ -33,6 +33,8 @@ SelfCollision::SelfCollision(std::shared_ptr<const RobotGeometry> geometry, cons
     if (!geometry_->link(a) || !geometry_->link(b)) continue;
     pairs_.push_back({a, b});
     pair_padding_.push_back(pad[a] + pad[b]);
+    pair_a_.push_back(a);
+    pair_b_.push_back(b);
   }
   if (options_.pair_tables) {
     const PairTableOptions table = options_.table_options.within(options_.table_seconds);
@@ -51,6 +53,7 @@ SelfCollisionContext SelfCollision::makeContext() const {
   c.balls = EnclosingBalls(*geometry_);
   c.unsure.reserve(pairs_.size());
   c.table_free.assign(pairs_.size(), 0);
+  c.bounds_apart.assign(pairs_.size(), 0);
   return c;
 }
 
@@ -104,6 +107,11 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
         return hit(k, ctx);
     }
   const bool balls = placeBalls(poses, ctx);
+  // The enclosing layer's first rung for every pair at once (SIMD lanes): most pairs end here.
+  const bool bounds = balls && ctx.bounds_apart.size() == pairs_.size();
+  if (bounds)
+    ctx.balls.boundsApart(pair_a_.data(), pair_b_.data(), pair_padding_.data(), n, options_.tolerances,
+                          ctx.bounds_apart.data());
   // A pair that collided a moment ago probably still does: trying it first ends most colliding queries
   // of a planner exploring near an obstacle after one pair test.
   const auto tableFree = [&](int k) {
@@ -118,6 +126,10 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
   if (two_pass) ctx.unsure.clear();
   for (int k = 0; k < n; ++k) {
     if (k == ctx.last_hit || tableFree(k)) continue;
+    if (bounds && ctx.bounds_apart[k]) {  // as pairScreen would have found it: counted, apart
+      ++ctx.pair_tests;
+      continue;
+    }
     if (!two_pass) {
       if (pairHits(k, poses, ctx, balls)) return hit(k, ctx);
       continue;

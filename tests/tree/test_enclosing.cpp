@@ -3,11 +3,14 @@
 // not (a layer that never fires would pass the first check).
 #include <clearway/body/enclosing.h>
 #include <clearway/kinematics/forward_kinematics.h>
+#include <clearway/kinematics/kinematic_lanes.h>
 #include <clearway/load/robot_loader.h>
 
 #include <gtest/gtest.h>
+#include <hwy/targets.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <memory>
@@ -76,6 +79,75 @@ TEST(EnclosingBalls, ApartOnlyWhereTheMeshesAreApart) {
     balls.place(poses.data());
     for (int a : links)
       if (a != links.back()) EXPECT_FALSE(balls.apart(a, links.back(), 0.0, tol));
+  }
+}
+
+TEST(EnclosingBalls, BoundsApartInLanesIsApartsFirstTest) {
+  // Every pair of every robot at random states, the lanes forced to each target this machine offers (and
+  // batches of every length, so that both the lanes and the one-at-a-time tail run): a pair the lanes call
+  // apart is apart by apart() and by the exact meshes, and the lanes call apart every pair whose bounding
+  // balls apart() alone clears.
+  std::vector<std::string> urdfs{std::string(CLEARWAY_SOURCE_DIR) + "/robots/arm6/arm6.urdf",
+                                 std::string(CLEARWAY_SOURCE_DIR) + "/robots/twin_arm/twin_arm.urdf"};
+  for (const char* rel : {"robots/panda/panda.urdf", "robots/ur5/ur5.urdf"}) {
+    CLEARWAY_REQUIRE_SHARED(rel);
+    urdfs.push_back(test::sharedPath(rel));
+  }
+  const Tolerances tol;
+  for (const std::string& urdf : urdfs) {
+    auto model = std::make_shared<const RobotModel>(loadRobot(urdf));
+    const RobotGeometry geometry(model);
+    EnclosingBalls balls(geometry);
+    std::vector<std::int64_t> a, b;
+    std::vector<double> padding;
+    const std::vector<int>& links = geometry.geometricLinks();
+    for (std::size_t i = 0; i < links.size(); ++i)
+      for (std::size_t j = i + 1; j < links.size(); ++j) {
+        a.push_back(links[i]);
+        b.push_back(links[j]);
+        padding.push_back(0.01 * static_cast<double>((i + j) % 3));
+      }
+    // A link without geometry (the root of our arms has none) is never apart, whatever its pose.
+    for (int l = 0; l < model->linkCount(); ++l)
+      if (!geometry.link(l)) {
+        a.push_back(l);
+        b.push_back(links.front());
+        padding.push_back(0.0);
+      }
+    const int n = static_cast<int>(a.size());
+    std::vector<Pose> poses(model->linkCount());
+    std::mt19937_64 rng(5);
+    int apart = 0;
+    std::vector<std::uint8_t> out(n);
+    for (const std::int64_t target : KinematicLanes::targets()  /* (the lanes' targets: simd_targets.h) */) {
+      hwy::SetSupportedTargetsForTest(target);
+      for (int s = 0; s < 40; ++s) {
+        const std::vector<double> q = randomState(*model, rng);
+        computeLinkPoses(*model, q.data(), poses.data());
+        balls.place(poses.data());
+        const int count = 1 + s % n;  // a prefix of every length up to the pair count
+        balls.boundsApart(a.data(), b.data(), padding.data(), count, tol, out.data());
+        for (int k = 0; k < count; ++k) {
+          const LinkGeometry* ga = geometry.link(static_cast<int>(a[k]));
+          const LinkGeometry* gb = geometry.link(static_cast<int>(b[k]));
+          const bool bounding = ga && gb &&
+                                (poses[a[k]] * ga->sphereCenter() - poses[b[k]] * gb->sphereCenter()).norm() >
+                                    ga->sphereRadius() + gb->sphereRadius() + padding[k] + 1e-9;
+          if (!out[k]) {
+            EXPECT_FALSE(bounding) << urdf << ", " << hwy::TargetName(target) << ": pair " << k
+                                   << " has bounding balls apart by more than the band, and the lanes missed it";
+            continue;
+          }
+          ++apart;
+          ASSERT_TRUE(ga && gb) << urdf << ": a link without geometry called apart";
+          EXPECT_TRUE(balls.apart(static_cast<int>(a[k]), static_cast<int>(b[k]), padding[k], tol));
+          EXPECT_FALSE(meshesIntersect(*ga, poses[a[k]], *gb, poses[b[k]], tol, GeometryMode::Mesh, padding[k]))
+              << urdf << ", " << hwy::TargetName(target) << ": pair " << k << " called apart";
+        }
+      }
+    }
+    hwy::SetSupportedTargetsForTest(0);
+    EXPECT_GT(apart, 0) << urdf;
   }
 }
 

@@ -7,6 +7,7 @@
 #include <clearway/body/robot_geometry.h>
 #include <clearway/tolerances.h>
 
+#include <cstdint>
 #include <vector>
 
 namespace clearway {
@@ -29,6 +30,11 @@ class EnclosingBalls {
   /// narrow phase's band: tol.gjk_absolute of their size). False proves nothing; a non-finite pose, or
   /// a link without geometry, is never apart.
   bool apart(int a, int b, double padding, const Tolerances& tol) noexcept;
+  /// For k < n: out[k] = 1 when links a[k] and b[k], as last placed, have bounding balls more than
+  /// padding[k] apart beyond the band (apart()'s first test, for many pairs at once in SIMD lanes, the target
+  /// chosen at run time as KinematicLanes' is), else 0, which proves nothing.
+  void boundsApart(const std::int64_t* a, const std::int64_t* b, const double* padding, int n, const Tolerances& tol,
+                   std::uint8_t* out) const noexcept;
 
  private:
   struct Link {
@@ -44,6 +50,9 @@ class EnclosingBalls {
   std::vector<Vec3> centers_;  // ball centres, world frame (as last placed)
   std::vector<double> norms_;   // |centre|, which sizes the rounding band
   std::vector<double> radii_;
+  // Per link, its bounding ball as last placed, one array per coordinate for the lanes (a link without
+  // geometry: an infinite radius, never apart).
+  std::vector<double> bound_x_, bound_y_, bound_z_, bound_r_, bound_norm_;
 };
 
 }  // namespace clearway

@@ -1,7 +1,8 @@
 #pragma once
 // Forward kinematics for several joint vectors at once: each double of a link's pose is one SIMD vector
 // whose lanes are the states. The widest vectors the CPU offers, up to AVX2 (SSE4: 2 lanes, AVX2: 4), are
-// chosen at run time, so one binary serves every x86-64 machine (kinematic_lanes.cpp says why not AVX-512).
+// chosen at run time, so one binary serves every x86-64 machine (src/detail/simd_targets.h says why not
+// AVX-512).
 //
 // The lanes repeat computeLinkPose's operations in its order, with no fused multiply-add (the library is
 // built with -ffp-contract=off), so every pose equals the scalar one bit for bit, on every target: a batch

@@ -49,6 +49,7 @@ struct SelfCollisionContext {
   EnclosingBalls balls;          ///< the links' enclosing balls at the current query's poses
   std::vector<int> unsure;       ///< pairs the cheap rungs left to the triangles (scratch of one query)
   std::vector<std::uint8_t> table_free;  ///< per pair: its table called it Free at this query's q (scratch)
+  std::vector<std::uint8_t> bounds_apart;  ///< per pair: its bounding balls apart at this query's poses (scratch)
   int last_hit = -1;
   long long pair_tests = 0;  ///< pairs that reached the narrow phase (bounding spheres not apart), cumulative
 };
@@ -109,6 +110,7 @@ class SelfCollision {
   std::shared_ptr<const RobotGeometry> geometry_;
   std::vector<LinkPair> pairs_;
   std::vector<double> pair_padding_;
+  std::vector<std::int64_t> pair_a_, pair_b_;  // pairs_' links, as the enclosing layer's lanes read them
   std::vector<std::shared_ptr<const PairTable>> tables_;  // per pair when options_.pair_tables
   std::vector<int> with_table_;                          // the pairs that have one
   SelfCollisionOptions options_;
