@@ -6,7 +6,10 @@
 #include <cstddef>
 #include <limits>
 
-#include "detail/simd_targets.h"  // before Highway's headers
+#include "detail/simd_targets.h"
+// Nor AVX2: its gathers made every state slower on a Xeon (box_panda, one state at a time: 3.8 µs with
+// AVX2 lanes here, 3.35 µs with SSE4's, whose gathers are plain loads; the kinematics' AVX2 lanes gain).
+#define HWY_DISABLED_TARGETS (CLEARWAY_LANES_DISABLED | HWY_AVX2)  // (before Highway's headers)
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "body/enclosing_lanes.cpp"
 #include <hwy/foreach_target.h>  // must come before highway.h

@@ -1,10 +1,9 @@
 #pragma once
-// The SIMD targets every lanes kernel is compiled for (kinematics/kinematic_lanes.cpp,
-// body/enclosing_lanes.cpp), included before Highway's headers so that all of them dispatch alike:
+// The SIMD targets the lanes kernels are compiled for (kinematics/kinematic_lanes.cpp,
+// body/enclosing_lanes.cpp), named before Highway's headers as HWY_DISABLED_TARGETS:
 // - fixed-width vectors only: the kernels keep vectors in arrays, which sizeless ones (SVE, RVV) forbid;
 // - no AVX-512: on Intel's server parts its arithmetic lowers the core's clock for a while after, so the
 //   scalar checks that follow each pass ran slower than the lanes saved (measured on a Xeon: a batch of
 //   box_panda states 3–9% slower than one at a time with AVX-512 lanes, 4–5% faster with AVX2's).
-#ifndef HWY_DISABLED_TARGETS
-#define HWY_DISABLED_TARGETS (HWY_AVX3 | HWY_AVX3_DL | HWY_SVE | HWY_SVE2 | HWY_SVE_256 | HWY_SVE2_128 | HWY_RVV)
-#endif
+// A kernel may disable more (enclosing_lanes.cpp: AVX2's gathers).
+#define CLEARWAY_LANES_DISABLED (HWY_AVX3 | HWY_AVX3_DL | HWY_SVE | HWY_SVE2 | HWY_SVE_256 | HWY_SVE2_128 | HWY_RVV)

@@ -8,7 +8,8 @@
 
 #include "kinematics/sincos.h"
 
-#include "detail/simd_targets.h"  // before Highway's headers
+#include "detail/simd_targets.h"
+#define HWY_DISABLED_TARGETS CLEARWAY_LANES_DISABLED  // (before Highway's headers)
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "kinematics/kinematic_lanes.cpp"
 #include <hwy/foreach_target.h>  // must come before highway.h

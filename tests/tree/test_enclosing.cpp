@@ -83,10 +83,10 @@ TEST(EnclosingBalls, ApartOnlyWhereTheMeshesAreApart) {
 }
 
 TEST(EnclosingBalls, BoundsApartInLanesIsApartsFirstTest) {
-  // Every pair of every robot at random states, the lanes forced to each target this machine offers (and
-  // batches of every length, so that both the lanes and the one-at-a-time tail run): a pair the lanes call
-  // apart is apart by apart() and by the exact meshes, and the lanes call apart every pair whose bounding
-  // balls apart() alone clears.
+  // Every pair of every robot at random states, the lanes forced to each target this machine offers (one
+  // this kernel is not compiled for falls back to one it is), in batches of every length, so that both the
+  // lanes and the one-at-a-time tail run: a pair the lanes call apart is apart by apart() and by the exact
+  // meshes, and the lanes call apart every pair whose bounding balls are apart by more than the band.
   std::vector<std::string> urdfs{std::string(CLEARWAY_SOURCE_DIR) + "/robots/arm6/arm6.urdf",
                                  std::string(CLEARWAY_SOURCE_DIR) + "/robots/twin_arm/twin_arm.urdf"};
   for (const char* rel : {"robots/panda/panda.urdf", "robots/ur5/ur5.urdf"}) {
