@@ -16,6 +16,7 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "shared_data.h"
@@ -33,18 +34,30 @@ std::vector<double> randomState(const RobotModel& m, std::mt19937_64& rng) {
   return q;
 }
 
-TEST(EnclosingBalls, ApartOnlyWhereTheMeshesAreApart) {
+// One robot's model, geometry and enclosing balls (which point into it: made in place, never moved).
+struct Arm {
+  explicit Arm(const std::string& urdf)
+      : model(std::make_shared<const RobotModel>(loadRobot(urdf))), geometry(model), balls(geometry) {}
+  std::shared_ptr<const RobotModel> model;
+  RobotGeometry geometry;
+  EnclosingBalls balls;
+};
+
+// Our two arms and the shared Panda and UR5 (paths in ../shared; a test requires them first).
+const char* const kSharedArms[] = {"robots/panda/panda.urdf", "robots/ur5/ur5.urdf"};
+std::vector<std::string> arms() {
   std::vector<std::string> urdfs{std::string(CLEARWAY_SOURCE_DIR) + "/robots/arm6/arm6.urdf",
                                  std::string(CLEARWAY_SOURCE_DIR) + "/robots/twin_arm/twin_arm.urdf"};
-  for (const char* rel : {"robots/panda/panda.urdf", "robots/ur5/ur5.urdf"}) {
-    CLEARWAY_REQUIRE_SHARED(rel);
-    urdfs.push_back(test::sharedPath(rel));
-  }
+  for (const char* rel : kSharedArms) urdfs.push_back(test::sharedPath(rel));
+  return urdfs;
+}
+
+TEST(EnclosingBalls, ApartOnlyWhereTheMeshesAreApart) {
+  for (const char* rel : kSharedArms) CLEARWAY_REQUIRE_SHARED(rel);
   const Tolerances tol;
-  for (const std::string& urdf : urdfs) {
-    auto model = std::make_shared<const RobotModel>(loadRobot(urdf));
-    const RobotGeometry geometry(model);
-    EnclosingBalls balls(geometry);
+  for (const std::string& urdf : arms()) {
+    Arm arm(urdf);
+    const auto& [model, geometry, balls] = std::tie(arm.model, arm.geometry, arm.balls);
     ASSERT_TRUE(balls.madeFor(geometry));
     std::vector<Pose> poses(model->linkCount());
     std::mt19937_64 rng(7);
@@ -87,17 +100,11 @@ TEST(EnclosingBalls, BoundsApartInLanesIsApartsFirstTest) {
   // this kernel is not compiled for falls back to one it is), in batches of every length, so that both the
   // lanes and the one-at-a-time tail run: a pair the lanes call apart is apart by apart() and by the exact
   // meshes, and the lanes call apart every pair whose bounding balls are apart by more than the band.
-  std::vector<std::string> urdfs{std::string(CLEARWAY_SOURCE_DIR) + "/robots/arm6/arm6.urdf",
-                                 std::string(CLEARWAY_SOURCE_DIR) + "/robots/twin_arm/twin_arm.urdf"};
-  for (const char* rel : {"robots/panda/panda.urdf", "robots/ur5/ur5.urdf"}) {
-    CLEARWAY_REQUIRE_SHARED(rel);
-    urdfs.push_back(test::sharedPath(rel));
-  }
+  for (const char* rel : kSharedArms) CLEARWAY_REQUIRE_SHARED(rel);
   const Tolerances tol;
-  for (const std::string& urdf : urdfs) {
-    auto model = std::make_shared<const RobotModel>(loadRobot(urdf));
-    const RobotGeometry geometry(model);
-    EnclosingBalls balls(geometry);
+  for (const std::string& urdf : arms()) {
+    Arm arm(urdf);
+    const auto& [model, geometry, balls] = std::tie(arm.model, arm.geometry, arm.balls);
     std::vector<std::int64_t> a, b;
     std::vector<double> padding;
     const std::vector<int>& links = geometry.geometricLinks();
