@@ -11,6 +11,8 @@
 #include <gtest/gtest.h>
 #include <hwy/targets.h>
 
+#include "forced_target.h"
+
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -22,12 +24,6 @@
 using namespace clearway;
 
 namespace {
-
-// Restores the CPU's own targets when a test ends, however it ends.
-struct ForcedTarget {
-  explicit ForcedTarget(std::int64_t t) { hwy::SetSupportedTargetsForTest(t); }
-  ~ForcedTarget() { hwy::SetSupportedTargetsForTest(0); }
-};
 
 bool sameBits(double a, double b) {
   return std::isnan(a) ? std::isnan(b) : std::memcmp(&a, &b, sizeof a) == 0;
@@ -43,7 +39,7 @@ void expectLanesEqualScalar(const RobotModel& m, const std::vector<std::vector<d
   const std::vector<std::int64_t> targets = KinematicLanes::targets();
   ASSERT_FALSE(targets.empty());
   for (const std::int64_t target : targets) {
-    const ForcedTarget forced(target);
+    const test::ForcedTarget forced(target);
     ASSERT_STREQ(KinematicLanes::targetName(), hwy::TargetName(target));
     const int w = KinematicLanes::width();
     ASSERT_TRUE(w >= 1 && w <= KinematicLanes::kMaxLanes) << w;

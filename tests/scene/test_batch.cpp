@@ -10,6 +10,8 @@
 #include <gtest/gtest.h>
 #include <hwy/targets.h>
 
+#include "forced_target.h"
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -20,12 +22,6 @@
 
 namespace clearway {
 namespace {
-
-// Restores the CPU's own targets when a test ends, however it ends.
-struct ForcedTarget {
-  explicit ForcedTarget(std::int64_t t) { hwy::SetSupportedTargetsForTest(t); }
-  ~ForcedTarget() { hwy::SetSupportedTargetsForTest(0); }
-};
 
 // `count` states uniform in the scene's bounds (unbounded: ±π; floating joints' quaternions normalised);
 // every 50th has a NaN and every 77th an entry out of bounds.
@@ -68,7 +64,7 @@ int expectBatchEqualsOneByOne(const Scene& scene, const std::vector<double>& sta
     colliding += !expected[s];
   }
   for (const std::int64_t target : KinematicLanes::targets()) {
-    const ForcedTarget forced(target);
+    const test::ForcedTarget forced(target);
     const int w = KinematicLanes::width();
     for (const int batch : {1, std::max(1, w - 1), w, w + 1, 2 * w + 1}) {
       std::unique_ptr<bool[]> got(new bool[count]);

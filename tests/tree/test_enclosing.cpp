@@ -9,6 +9,8 @@
 #include <gtest/gtest.h>
 #include <hwy/targets.h>
 
+#include "forced_target.h"
+
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -126,8 +128,8 @@ TEST(EnclosingBalls, BoundsApartInLanesIsApartsFirstTest) {
     std::mt19937_64 rng(5);
     int apart = 0;
     std::vector<std::uint8_t> out(n);
-    for (const std::int64_t target : KinematicLanes::targets()  /* (the lanes' targets: simd_targets.h) */) {
-      hwy::SetSupportedTargetsForTest(target);
+    for (const std::int64_t target : KinematicLanes::targets()) {  // the lanes' targets (simd_targets.h)
+      const test::ForcedTarget forced(target);
       for (int s = 0; s < 40; ++s) {
         const std::vector<double> q = randomState(*model, rng);
         computeLinkPoses(*model, q.data(), poses.data());
@@ -153,7 +155,6 @@ TEST(EnclosingBalls, BoundsApartInLanesIsApartsFirstTest) {
         }
       }
     }
-    hwy::SetSupportedTargetsForTest(0);
     EXPECT_GT(apart, 0) << urdf;
   }
 }
