@@ -446,6 +446,7 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
     ctx.safe_until[k] = 0.0;
   }
 
+  if (!locate_contact && motion_detail::probeCollides(*this, q0, t0, q1, t1, ctx, r)) return r;
   if (options_.mode == MotionMode::Cast) castAhead(q0, q1, t0, n_items, ctx, r);
   // Self items whose tables prove them apart along the whole segment are not swept.
   bool ends_set = false;

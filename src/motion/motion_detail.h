@@ -45,7 +45,19 @@ struct Scratch {
   };
   std::vector<Interval> intervals;  // scratch: what items have yet to cover
   int lead = -1;                    // the item that met the last contact: measured first
+  // The probe (probe.cpp): how often it has found a collision lately (a moving average over the segments
+  // it ran on), and the segments since it last ran.
+  double probe_rate = 1.0;
+  int probe_skipped = 0;
 };
+
+// A verdict-only check's first look (probe.cpp): the states at s = 1/2, 1/4 and 3/4, checked as the
+// validity checker checks states. True, with r filled (a contact at that s, the state's report), when one
+// collides: the segment is then not free whatever the items would measure. Only where it has lately
+// paid for itself (planners' segments often collide; a path's or a benchmark's seldom do).
+bool probeCollides(const MotionChecker& checker, const double* q0, double t0, const double* q1, double t1,
+                   Scratch& ctx, MotionResult& r) noexcept;
+
 
 // A state inside the scene's bounds (their midpoints) with unit quaternions, where the poses are defined.
 inline std::vector<double> referenceState(const Scene& scene) {

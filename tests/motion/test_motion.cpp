@@ -964,12 +964,12 @@ TEST(MotionCertified, BranchingPaddedRobotNeverMissesWhatDenseSamplingFinds) {
   EXPECT_LE(c.first_contact, d.first_contact + 1e-9);
 }
 
-// The slider with a 1 mm wall that starts at x = x0 and moves along +x at 1 m/s (checks: moving).
-std::shared_ptr<const Scene> movingWallScene(const TempDir& dir, double x0) {
+// The slider with a wall (1 mm thick unless given) that starts at x = x0 and moves along +x at 1 m/s (checks: moving).
+std::shared_ptr<const Scene> movingWallScene(const TempDir& dir, double x0, double thickness = 0.001) {
   const std::string urdf = dir.write("slider.urdf", kSliderUrdf);
   return Scene::load(dir.write("moving.yaml", "format: 1\nname: moving\nrobot:\n  urdf: " + urdf +
                                                   "\n  group: [slide, turn]\nenvironment:\n  obstacles:\n"
-                                                  "    - {name: wall, box: {size: [0.001, 2, 2]}, pose: {position: [" +
+                                                  "    - {name: wall, box: {size: [" + std::to_string(thickness) + ", 2, 2]}, pose: {position: [" +
                                                   std::to_string(x0) + ", 0, 0]}, velocity: [1, 0, 0]}\n"
                                                   "checks: [environment, continuous, moving]\nstart: [0, 0]\ngoal: [0, 0]\n"));
 }
@@ -1205,6 +1205,84 @@ TEST(MotionCertified, PairTablesKeepEveryVerdict) {
       EXPECT_LT(free, segments);
       EXPECT_LE(queries_a, queries_b);
     }
+  }
+}
+
+// The probe (motion/probe.cpp) ends a verdict-only check at the first of a few states of the segment that
+// collides. Its verdicts equal the located check's (which never probes), segment by segment, on
+// planner-like segments of which many collide, with moving obstacles too; every segment it settles has a
+// colliding state where it says; and where segments seldom collide it runs only now and then.
+TEST(MotionCertified, ProbeKeepsEveryVerdict) {
+  TempDir dir;
+  struct Case {
+    std::string name;
+    std::shared_ptr<const Scene> scene;
+    bool timed = false;
+  };
+  std::vector<Case> cases;
+  cases.push_back({"arm", Scene::load(dir.write("arm.yaml", test::armScene("",
+                                           "    - {name: wall, box: {size: [0.004, 1.0, 3.0]}, pose: {position: [0.3, 0, 1.5]}}\n"
+                                           "    - {name: shelf, box: {size: [1.0, 1.0, 0.02]}, pose: {position: [0, 0.5, 0.4]}}\n")))});
+  cases.push_back({"moving wall", movingWallScene(dir, -1.0, 0.4), true});
+  const std::string shared = test::sharedPath("scenes");
+  if (!shared.empty() && std::filesystem::exists(shared + "/box_panda"))
+    for (const char* name : {"box_panda/box_panda_0001.yaml", "cage_ur5/cage_ur5_0001.yaml",
+                             "cage_panda/cage_panda_0001.octomap.yaml"})
+      cases.push_back({name, Scene::load(shared + "/" + name)});
+  else
+    std::printf("shared scenes not found: the probe is compared on our own scenes only\n");
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const Scene& scene = *c.scene;
+    const MotionChecker checker(c.scene);
+    MotionContext located = checker.makeContext(), verdict = checker.makeContext();
+    SceneContext sc = scene.makeContext();
+    std::mt19937 rng(23);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    const int n = scene.dimension();
+    std::vector<double> q0(n), q1(n), at(n);
+    int segments = 0, colliding = 0, settled = 0;
+    while (segments < 300) {
+      for (int i = 0; i < n; ++i) {
+        q0[i] = scene.lower(i) + u(rng) * (scene.upper(i) - scene.lower(i));
+        q1[i] = scene.lower(i) + u(rng) * (scene.upper(i) - scene.lower(i));  // (RRTConnect's connect steps are long)
+      }
+      const double t0 = c.timed ? u(rng) : 0.0, t1 = c.timed ? t0 + 2.0 * u(rng) : 0.0;
+      if (!scene.isFree(q0.data(), sc, nullptr, t0) || !scene.isFree(q1.data(), sc, nullptr, t1)) continue;
+      ++segments;
+      const MotionResult a = checker.check(q0.data(), t0, q1.data(), t1, located);
+      const MotionResult v = checker.check(q0.data(), t0, q1.data(), t1, verdict, /*locate_contact=*/false);
+      ASSERT_EQ(v.free, a.free) << "segment " << segments;
+      colliding += !a.free;
+      if (v.free || v.distance_queries > 0) continue;
+      ++settled;  // by the probe: no item was measured
+      EXPECT_TRUE(v.first_contact == 0.5 || v.first_contact == 0.25 || v.first_contact == 0.75) << v.first_contact;
+      checker.interpolate(q0.data(), q1.data(), v.first_contact, at.data());
+      CollisionReport report;
+      EXPECT_FALSE(scene.isFree(at.data(), sc, &report, t0 + v.first_contact * (t1 - t0))) << "segment " << segments;
+      EXPECT_EQ(report.kind, v.report.kind) << "segment " << segments;
+    }
+    std::printf("%s: %d of %d segments collide, %d settled by the probe\n", c.name.c_str(), colliding, segments, settled);
+    EXPECT_GT(colliding, segments / 3);
+    EXPECT_LT(colliding, segments);
+    EXPECT_GT(settled, colliding / 3);
+    // Then segments that never collide (a free state held still): the probe stops running on all of
+    // them, but still runs on every eighth. A free segment it ran on took three states more than the located
+    // check's.
+    int probed = 0, quiet = 0;
+    while (!scene.isFree(q1.data(), sc))
+      for (int i = 0; i < n; ++i) q1[i] = scene.lower(i) + u(rng) * (scene.upper(i) - scene.lower(i));
+    for (int k = 0; k < 400; ++k) {
+      const MotionResult a = checker.check(q1.data(), 0.0, q1.data(), 0.0, located);
+      const MotionResult v = checker.check(q1.data(), 0.0, q1.data(), 0.0, verdict, false);
+      ASSERT_TRUE(a.free && v.free);
+      ASSERT_TRUE(v.steps == a.steps || v.steps == a.steps + 3) << v.steps << " " << a.steps;
+      probed += v.steps > a.steps;
+      quiet += k >= 100 && v.steps == a.steps;
+    }
+    EXPECT_GE(probed, 400 / 8);
+    EXPECT_LE(probed, 40 + 400 / 8);
+    EXPECT_GE(quiet, 300 * 7 / 8 - 1);
   }
 }
 
