@@ -145,11 +145,26 @@ struct MotionChecker::Sweep {
     ctx.contact[k] = mc.options_.contact_distance;
     const Item& it = mc.items_[k];
     if (it.last > it.first) return d;  // a group's members decide, each with its own ends
+    // Only the verdict asked, and the state at s collides: the segment is not free whatever the ends'
+    // clearances (a colliding state is within every contact distance), and the state check costs far less
+    // than measuring the ends near contact, which climbs to their triangles.
+    if (verdict_only && stateCollides(s, report)) return d;
     const double e0 = endClearance(k, 0.0);
     const double e = e0 > 0.0 ? std::min(e0, endClearance(k, 1.0)) : 0.0;
     if (!(e > 0.0) || !(0.5 * e < ctx.contact[k])) return d;
     ctx.contact[k] = 0.5 * e;
     return measure(k, s, need, report);
+  }
+
+  // True when the state at s collides as the validity checker sees it (then `report` says what).
+  bool stateCollides(double s, CollisionReport& report) {
+    mc.interpolate(q0, q1, s, ctx.q.data());
+    at_s = -1.0;  // (the check overwrites the poses the sweep keeps)
+    ++r.steps;
+    CollisionReport found;
+    if (mc.scene_->isFree(ctx.q.data(), ctx.scene, &found, time(s))) return false;
+    report = found;
+    return true;
   }
 
   // A certified lower bound on item k's clearance at s (padding removed) where it is below the contact
