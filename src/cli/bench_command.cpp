@@ -39,7 +39,8 @@ const char* const kBenchHelp =
     "resolution over Clearway and over FCL, against a dense reference), plan (RRTConnect with each\n"
     "checker: one OMPL benchmark log per problem in DIR/plan, the checkers as planners side by side for\n"
     "Planner Arena), or all. Default: narrowphase states motions.\n"
-    "Writes DIR/results.csv; unsharded runs and merges also DIR/summary.csv, DIR/table.txt (printed),\n"
+    "Writes DIR/results.csv; unsharded runs and merges also DIR/summary.csv, DIR/table.txt (printed; it\n"
+    "ends with each problem family's state, motion and planning figures beside issue 20's targets),\n"
     "DIR/plots.gp and its PNG plots (when gnuplot is installed). --shard I/N runs the cases with index I\n"
     "modulo N; `clearway bench merge --out DIR SHARD_DIR...` combines shards 0..N-1.\n"
     "Exit status: 0 when every case ran, 1 when a case failed, 2 on a usage error, missing shared data or\n"
@@ -52,7 +53,7 @@ constexpr int kFields = 14;
 
 struct Row {
   long case_index = 0;
-  std::string suite, engine, mode;
+  std::string suite, subject, engine, mode;
   double tolerance = 0, items = 0, ns = 0, work = 0, positives = 0, misses = 0, false_alarms = 0, error = 0,
          max_error = 0;
   std::string line;  // as written: merges copy it
@@ -110,7 +111,7 @@ Row parseRow(const std::string& line, const std::string& where) {
                                                                        " fields, found " + std::to_string(f.size()));
   Row r;
   r.line = line;
-  r.suite = f[0], r.engine = f[3], r.mode = f[4];
+  r.suite = f[0], r.subject = f[2], r.engine = f[3], r.mode = f[4];
   double* numbers[] = {&r.tolerance, &r.items, &r.ns, &r.work, &r.positives, &r.misses, &r.false_alarms, &r.error,
                        &r.max_error};
   if (!parseLong(f[1], r.case_index) || r.case_index < 0) throw std::runtime_error(where + ": bad case index '" + f[1] + "'");
@@ -253,6 +254,62 @@ std::string table(const std::vector<Summary>& all) {
   return t.str();
 }
 
+// Issue 20's figures per problem family (a problem's name without its number), beside its targets: the
+// exact state check one per call and batched, a certified motion at a 1 mm contact distance, and RRTConnect
+// with the certified validator, each against FCL in the same run (states: OBBRSS; motions and planning:
+// OMPL's 1% sampling over FCL). A family's ratio is FCL's total time over ours on the same items.
+std::string targets(const std::vector<Row>& rows) {
+  struct Family {
+    double one = 0, one_n = 0, batch = 0, batch_n = 0, fcl_state = 0, fcl_state_n = 0, motion = 0, motion_n = 0,
+           fcl_motion = 0, fcl_motion_n = 0, plan = 0, fcl_plan = 0;
+  };
+  std::vector<std::pair<std::string, Family>> families;
+  for (const Row& r : rows) {
+    if (r.suite != "states" && r.suite != "motions" && r.suite != "plan") continue;
+    const std::size_t cut = r.subject.find_last_of('_');
+    const std::string name = cut == std::string::npos ? r.subject : r.subject.substr(0, cut);
+    auto it = std::find_if(families.begin(), families.end(), [&](const auto& f) { return f.first == name; });
+    if (it == families.end()) it = families.insert(families.end(), {name, Family{}});
+    Family& f = it->second;
+    const bool fcl = r.engine.rfind("fcl", 0) == 0;
+    const auto add = [&](double& total, double& items) { total += r.ns * r.items, items += r.items; };
+    if (r.suite == "states" && r.engine == "clearway" && r.mode == "mesh") add(f.one, f.one_n);
+    if (r.suite == "states" && r.engine == "clearway" && r.mode == "mesh-batch") add(f.batch, f.batch_n);
+    if (r.suite == "states" && fcl) add(f.fcl_state, f.fcl_state_n);
+    if (r.suite == "motions" && r.engine == "clearway" && r.mode == "certified" && r.tolerance == 1e-3) add(f.motion, f.motion_n);
+    if (r.suite == "motions" && fcl && r.mode == "sampled" && r.tolerance == 0.01) add(f.fcl_motion, f.fcl_motion_n);
+    // (Planning: the medians of each problem's runs, summed over the family's problems.)
+    if (r.suite == "plan" && r.engine == "clearway" && r.mode == "certified") f.plan += r.ns;
+    if (r.suite == "plan" && fcl && r.mode == "sampled") f.fcl_plan += r.ns;
+  }
+  if (families.empty()) return "";
+  const auto per = [](double total, double n, double unit) { return n > 0 ? fmt("%.0f", total / n / unit) : "-"; };
+  const auto ratio = [](double theirs, double ours) { return theirs > 0 && ours > 0 ? fmt("%.1f", theirs / ours) : "-"; };
+  std::ostringstream t;
+  char line[256];
+  std::snprintf(line, sizeof line, "%-22s %10s %10s %8s %10s %10s %8s\n", "family", "state ns", "batch ns", "FCL/x",
+                "motion us", "OMPL-FCL/x", "plan/x");
+  t << line;
+  for (const auto& [name, f] : families) {
+    std::snprintf(line, sizeof line, "%-22s %10s %10s %8s %10s %10s %8s\n", name.c_str(), per(f.one, f.one_n, 1).c_str(),
+                  per(f.batch, f.batch_n, 1).c_str(),
+                  ratio(f.fcl_state_n > 0 ? f.fcl_state / f.fcl_state_n : 0, f.one_n > 0 ? f.one / f.one_n : 0).c_str(),
+                  per(f.motion, f.motion_n, 1e3).c_str(),
+                  ratio(f.fcl_motion_n > 0 ? f.fcl_motion / f.fcl_motion_n : 0, f.motion_n > 0 ? f.motion / f.motion_n : 0).c_str(),
+                  ratio(f.fcl_plan, f.plan).c_str());
+    t << line;
+  }
+  std::snprintf(line, sizeof line, "%-22s %10s %10s %8s %10s %10s %8s\n", "target (issue 20)", "500", "100", "30", "4", "80",
+                "10");
+  t << line;
+  t << "state ns: the exact check, one state per call; batch ns: 64 per call; FCL/x: FCL OBBRSS's time per state over\n"
+       "the one-per-call check's. motion us: certified at a 1 mm contact distance; OMPL-FCL/x: OMPL's 1% sampling\n"
+       "over FCL against it. plan/x: RRTConnect's median solve time with OMPL's 1% sampling over FCL divided by\n"
+       "the certified validator's. The time targets are the Panda's; the UR5's are the same factors over its\n"
+       "figures when the issue was filed.\n";
+  return t.str();
+}
+
 void writeSummaryCsv(const std::string& file, const std::vector<Summary>& all) {
   std::ofstream out(file);
   out << "suite,engine,mode,tolerance,items,ns_per_item,work_per_item,positives,misses,false_alarms,error,max_error,"
@@ -344,7 +401,7 @@ void finish(const std::string& dir, const Results& res) {
   writeResults(dir + "/results.csv", res);
   const std::vector<Summary> all = summarize(res.rows);
   writeSummaryCsv(dir + "/summary.csv", all);
-  const std::string t = table(all);
+  const std::string t = table(all) + targets(res.rows);
   std::ofstream(dir + "/table.txt") << "# " << res.config << "\n" << t;
   std::cout << t;
   writePlots(dir, all);

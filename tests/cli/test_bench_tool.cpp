@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -246,6 +247,55 @@ TEST(BenchTool, PlanningWritesOneOmplExperimentPerProblem) {
     }
   }
   EXPECT_EQ(plan_rows, 3);
+  fs::remove_all(dir);
+}
+
+// The table ends with issue 20's figures per problem family beside the targets, each computed from the
+// run's own rows: the exact state check one per call and batched, its ratio to FCL, the certified motion
+// (1 mm) and its ratio to OMPL's 1% sampling over FCL, and the planning ratio.
+TEST(BenchTool, TableShowsEachFamilyAgainstTheTargets) {
+  CLEARWAY_REQUIRE_SHARED("scenes");
+  const std::string dir = tempDir("targets");
+  const ToolRun r = runTool("bench states motions plan --subjects box_panda --count 10 --plan-runs 2 --plan-time=20" +
+                            sharedArg() + " --out '" + dir + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::map<std::string, double> ns;  // suite/engine/mode/tolerance -> ns per item (one problem)
+  std::ifstream in(dir + "/results.csv");
+  for (std::string line; std::getline(in, line);) {
+    const std::vector<std::string> f = fields(line);
+    if (f.size() == 14 && f[0] != "suite") ns[f[0] + "/" + f[3] + "/" + f[4] + "/" + f[5]] = std::stod(f[7]);
+  }
+  const auto fixed = [](const char* format, double x) {
+    char b[32];
+    std::snprintf(b, sizeof b, format, x);
+    return std::string(b);
+  };
+  std::vector<std::string> expected = {
+      "box_panda",
+      fixed("%.0f", ns.at("states/clearway/mesh/0")),
+      fixed("%.0f", ns.at("states/clearway/mesh-batch/0")),
+      fixed("%.1f", ns.at("states/fcl/obbrss/0") / ns.at("states/clearway/mesh/0")),
+      fixed("%.0f", ns.at("motions/clearway/certified/0.001") / 1e3),
+      fixed("%.1f", ns.at("motions/fcl/sampled/0.01") / ns.at("motions/clearway/certified/0.001")),
+      fixed("%.1f", ns.at("plan/fcl/sampled/0.01") / ns.at("plan/clearway/certified/0.001"))};
+  std::ifstream table(dir + "/table.txt");
+  bool header = false, family = false, target = false;
+  for (std::string line; std::getline(table, line);) {
+    std::istringstream words(line);
+    std::vector<std::string> w;
+    for (std::string x; words >> x;) w.push_back(x);
+    if (line.rfind("family ", 0) == 0) header = true;
+    if (header && !w.empty() && w[0] == "box_panda") {
+      family = true;
+      EXPECT_EQ(w, expected) << line;
+    }
+    if (header && line.rfind("target (issue 20)", 0) == 0) {
+      target = true;
+      EXPECT_EQ(w, (std::vector<std::string>{"target", "(issue", "20)", "500", "100", "30", "4", "80", "10"}));
+    }
+  }
+  EXPECT_TRUE(header && family && target) << "table.txt lacks the targets block";
+  EXPECT_MENTIONS(r.out, "target (issue 20)");
   fs::remove_all(dir);
 }
 
