@@ -158,13 +158,9 @@ struct MotionChecker::Sweep {
 
   // True when the state at s collides as the validity checker sees it (then `report` says what).
   bool stateCollides(double s, CollisionReport& report) {
-    mc.interpolate(q0, q1, s, ctx.q.data());
     at_s = -1.0;  // (the check overwrites the poses the sweep keeps)
     ++r.steps;
-    CollisionReport found;
-    if (mc.scene_->isFree(ctx.q.data(), ctx.scene, &found, time(s))) return false;
-    report = found;
-    return true;
+    return motion_detail::stateCollides(mc, q0, q1, s, time(s), ctx, report);
   }
 
   // A certified lower bound on item k's clearance at s (padding removed) where it is below the contact

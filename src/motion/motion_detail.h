@@ -58,6 +58,10 @@ struct Scratch {
 bool probeCollides(const MotionChecker& checker, const double* q0, double t0, const double* q1, double t1,
                    Scratch& ctx, MotionResult& r) noexcept;
 
+// True when the state at s of q0 → q1 (at time t) collides as the validity checker sees it; `report` then
+// says what. It overwrites ctx.q and ctx.scene's poses (probe.cpp).
+bool stateCollides(const MotionChecker& checker, const double* q0, const double* q1, double s, double t, Scratch& ctx,
+                   CollisionReport& report) noexcept;
 
 // A state inside the scene's bounds (their midpoints) with unit quaternions, where the poses are defined.
 inline std::vector<double> referenceState(const Scene& scene) {

@@ -21,12 +21,10 @@ bool probeCollides(const MotionChecker& checker, const double* q0, double t0, co
                    Scratch& ctx, MotionResult& r) noexcept {
   if (ctx.probe_rate < kWorthwhile && ++ctx.probe_skipped < kRecheck) return false;
   ctx.probe_skipped = 0;
-  const Scene& scene = checker.scene();
   bool found = false;
   for (const double s : kAt) {
-    checker.interpolate(q0, q1, s, ctx.q.data());
     ++r.steps;
-    if (!scene.isFree(ctx.q.data(), ctx.scene, &r.report, t0 + s * (t1 - t0))) {
+    if (stateCollides(checker, q0, q1, s, t0 + s * (t1 - t0), ctx, r.report)) {
       r.free = false;
       r.first_contact = s;  // (verdict only: a contact, not necessarily the first)
       r.last_valid = 0.0;
@@ -36,6 +34,15 @@ bool probeCollides(const MotionChecker& checker, const double* q0, double t0, co
   }
   ctx.probe_rate += kAverage * ((found ? 1.0 : 0.0) - ctx.probe_rate);
   return found;
+}
+
+bool stateCollides(const MotionChecker& checker, const double* q0, const double* q1, double s, double t, Scratch& ctx,
+                   CollisionReport& report) noexcept {
+  checker.interpolate(q0, q1, s, ctx.q.data());
+  CollisionReport found;
+  if (checker.scene().isFree(ctx.q.data(), ctx.scene, &found, t)) return false;
+  report = found;
+  return true;
 }
 
 }  // namespace clearway::motion_detail
