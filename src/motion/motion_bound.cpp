@@ -24,6 +24,13 @@ struct MotionBound::Tables {
   double link(int link, const double* dq) const noexcept;
   double pair(int a, int b, const double* dq) const noexcept;
   double linkStep(int link, const double* dq, const Pose* poses, double d, double extra) const noexcept;
+  // The bound from the velocity field now (below linkStep): f(h) = h·speed + h²·accel/2.
+  struct TwistBound {
+    double speed = 0.0, accel = 0.0;
+    double solve(double d) const noexcept;  // the largest h with f(h) ≤ d
+  };
+  // Adds to f the joints of link's chain from index `from` on; false when one that moves does not turn.
+  bool addTwist(int link, std::size_t from, const double* dq, const Pose* poses, TwistBound& f) const noexcept;
   double pairStep(int a, int b, const double* dq, const Pose* poses, double d) const noexcept;
   bool translates(int a, int b, const double* dq) const noexcept;
   bool translates(int link, const double* dq) const noexcept;
@@ -46,6 +53,7 @@ struct MotionBound::Tables {
   // three and a floating joint seven (see the constructor); chains list elements.
   enum class Kind : char { Revolute, Prismatic, Spin };
   std::vector<double> joint_mult_;                // per joint: |multiplier| of a mimic, kSpin for a spin, else 1
+  std::vector<double> joint_sign_;                // per joint: the sign of a mimic's multiplier, else 1
   std::vector<char> kind_;                        // per joint: a Kind
   std::vector<int> joint_of_;                     // per joint: the robot's joint
   bool isSlide(int j) const noexcept { return kind_[j] == static_cast<char>(Kind::Prismatic); }
@@ -103,6 +111,7 @@ MotionBound::Tables::Tables(const Scene& scene, const std::vector<Body>& bodies)
       joint_var_.push_back(v);
       kind_.push_back(static_cast<char>(kind));
       joint_mult_.push_back(kind == Kind::Spin ? kSpin : joint.isMimic() ? std::abs(joint.mimic.multiplier) : 1.0);
+      joint_sign_.push_back(joint.isMimic() && joint.mimic.multiplier < 0.0 ? -1.0 : 1.0);
       step_.push_back(step);
       axis_.push_back(joint.axis.normalized());
       child_.push_back(joint.child_link);
@@ -307,7 +316,58 @@ double MotionBound::Tables::linkStep(int link, const double* dq, const Pose* pos
   DynamicBound f;
   addDynamic(link, 0, dq, poses, f);
   f.a += extra, f.fixed += extra;  // (linear in h)
-  return f.solve(d);
+  TwistBound t;
+  t.speed = extra;
+  return addTwist(link, 0, dq, poses, t) ? std::max(f.solve(d), t.solve(d)) : f.solve(d);
+}
+
+// The same bound from the link's velocity field now, where the joints' speeds add as vectors, not as
+// lengths. A revolute chain turns the link's points at w_k (the signed Δq_k) about axis k (unit u_k through
+// o_k): dx/ds = Σ_k w_k·t_k with t_k = u_k × (x − o_k), a twist Ω × x + V, so on the link's ball (centre c,
+// radius ρ) the speed now is at most v0 = |Ω × c + V| + |Ω|·ρ. Along the segment t_k turns with the frame
+// of joint k (at most Σ_{j≤k} |w_j| radians per unit s) and changes inside it only as the joints below k
+// move x, by at most Σ_{j>k} |w_j|·R_j; with |t_k| ≤ R_k (the static reach of the link from axis k),
+// |d²x/ds²| ≤ A = Σ_k |w_k|·((Σ_{j≤k} |w_j|)·R_k + Σ_{j>k} |w_j|·R_j) anywhere. So no point moves farther than
+// h·v0 + h²·A/2 for a step of h either way. Only for chains whose moving joints all turn (else 0, which
+// proves nothing).
+bool MotionBound::Tables::addTwist(int link, std::size_t from, const double* dq, const Pose* poses, TwistBound& f) const noexcept {
+  const std::vector<int>& chain = chain_[link];
+  const std::vector<double>& reach = joint_reach_[link];
+  const Vec3 c = poses[frame_[link]] * sphere_center_[link];
+  Vec3 omega = Vec3::Zero(), velocity = Vec3::Zero();  // Ω, and the field at c
+  double below = 0.0;  // Σ |w_j|·R_j over the joints below k (all of them, at first)
+  for (std::size_t k = from; k < chain.size(); ++k) {
+    const int j = chain[k], v = joint_var_[j];
+    if (v < 0 || dq[v] == 0.0) continue;
+    if (kind_[j] != static_cast<char>(Kind::Revolute)) return false;
+    const double w = joint_sign_[j] * joint_mult_[j] * dq[v];
+    const Pose& frame = poses[child_[j]];
+    const Vec3 u = frame.R * axis_[j];
+    omega += w * u;
+    velocity += w * u.cross(c - frame.t);
+    below += std::abs(w) * reach[k];
+  }
+  double turn = 0.0;  // Σ_{j≤k} |w_j|
+  for (std::size_t k = from; k < chain.size(); ++k) {
+    const int j = chain[k], v = joint_var_[j];
+    if (v < 0 || dq[v] == 0.0) continue;
+    const double w = joint_mult_[j] * std::abs(dq[v]);
+    turn += w;
+    below -= w * reach[k];
+    f.accel += w * (turn * reach[k] + std::max(below, 0.0));
+  }
+  f.speed += velocity.norm() + omega.norm() * sphere_radius_[link];
+  return true;
+}
+
+double MotionBound::Tables::TwistBound::solve(double d) const noexcept {
+  if (!(d > 0.0)) return 0.0;
+  // Rounding: the terms are sums of a few products of metres and radians; a relative margin far above it.
+  constexpr double kMargin = 1.0 + 1e-9;
+  const double v0 = speed * kMargin, a = accel * kMargin;
+  const double root = v0 + std::sqrt(v0 * v0 + 2.0 * a * d);
+  const double h = root > 0.0 ? 2.0 * d / root : INFINITY;
+  return std::isnan(h) ? 0.0 : h;
 }
 
 double MotionBound::Tables::pairStep(int a, int b, const double* dq, const Pose* poses, double d) const noexcept {
@@ -317,6 +377,8 @@ double MotionBound::Tables::pairStep(int a, int b, const double* dq, const Pose*
   DynamicBound f;
   addDynamic(a, fork, dq, poses, f);
   addDynamic(b, fork, dq, poses, f);
+  TwistBound t;
+  if (addTwist(a, fork, dq, poses, t) && addTwist(b, fork, dq, poses, t)) return std::max(f.solve(d), t.solve(d));
   return f.solve(d);
 }
 
@@ -388,6 +450,12 @@ double MotionBound::linkStep(int link, const double* dq, const Pose* poses, doub
 }
 double MotionBound::pairStep(int a, int b, const double* dq, const Pose* poses, double d) const noexcept {
   return t_->pairStep(a, b, dq, poses, d);
+}
+bool MotionBound::linkTwist(int link, const double* dq, const Pose* poses, double& speed, double& accel) const noexcept {
+  Tables::TwistBound f;
+  if (!t_->addTwist(link, 0, dq, poses, f)) return false;
+  speed = f.speed, accel = f.accel;
+  return true;
 }
 bool MotionBound::translates(int a, int b, const double* dq) const noexcept { return t_->translates(a, b, dq); }
 bool MotionBound::translates(int link, const double* dq) const noexcept { return t_->translates(link, dq); }

@@ -911,6 +911,103 @@ TEST(MotionBound, HoldsForLinksOnTwoBranchesOfAFork) {
   for (int round = 0; round < 3; ++round) expectBoundsHold(scene, rng);
 }
 
+// linkTwist's terms, checked by finite differences along random segments: the speed bounds every hull
+// vertex's speed where it was computed, the acceleration bounds every vertex's acceleration anywhere, and a
+// step of h moves no vertex h·speed + h²·accel/2 or farther. Steps of up to 0.4 and of up to 2 radians per
+// joint (a planner's long segments). Returns the largest ratios seen (speed, acceleration).
+std::pair<double, double> expectTwistHolds(const Scene& scene, std::mt19937& rng, int trials) {
+  const MotionBound bound(scene);
+  const int n = scene.dimension();
+  const std::string name = scene.name();
+  std::vector<double> q0(n), q1(n), dq(n), q(n);
+  SceneContext ct = scene.makeContext(), cp = scene.makeContext(), cm = scene.makeContext(), ch = scene.makeContext();
+  const auto at = [&](double s, SceneContext& c) {
+    for (int i = 0; i < n; ++i) q[i] = q0[i] + s * dq[i];
+    scene.computePoses(q.data(), c);
+  };
+  double worst_speed = 0.0, worst_accel = 0.0;
+  int tighter = 0, links = 0;
+  for (int trial = 0; trial < trials; ++trial) {
+    randomStep(scene, rng, q0, q1, dq);
+    if (trial % 2) // long: up to 2 radians per joint, within the bounds
+      for (int i = 0; i < n; ++i) {
+        q1[i] = std::clamp(q0[i] + 5.0 * dq[i], scene.lower(i), scene.upper(i));
+        dq[i] = q1[i] - q0[i];
+      }
+    const double s = std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+    at(s, ct);
+    for (const int link : scene.environmentLinks()) {
+      double speed = 0.0, accel = 0.0;
+      EXPECT_TRUE(bound.linkTwist(link, dq.data(), ct.poses.data(), speed, accel)) << name << ": every joint turns";
+      ++links;
+      tighter += speed < bound.link(link, dq.data());
+      const std::vector<Vec3>& vertices = scene.geometry().link(link)->hull().vertices();
+      for (std::size_t k = 0; k < vertices.size(); k += 1 + vertices.size() / 24) {
+        const Vec3 x = ct.poses[link] * vertices[k];
+        constexpr double kV = 1e-6, kA = 1e-3;  // difference steps: truncation and rounding both far below the bounds
+        at(s + kV, cp), at(s - kV, cm);
+        const double v = (cp.poses[link] * vertices[k] - cm.poses[link] * vertices[k]).norm() / (2 * kV);
+        EXPECT_LE(v, speed * (1 + 1e-6) + 1e-7) << name << ": " << scene.robot().link(link).name;
+        at(s + kA, cp), at(s - kA, cm);
+        const double a = (cp.poses[link] * vertices[k] - 2.0 * x + cm.poses[link] * vertices[k]).norm() / (kA * kA);
+        EXPECT_LE(a, accel * (1 + 1e-3) + 1e-6) << name << ": " << scene.robot().link(link).name;
+        worst_speed = std::max(worst_speed, v / speed);
+        worst_accel = std::max(worst_accel, a / accel);
+        for (const double h : {0.05, 0.3, 1.0}) {
+          const double step = h * std::max(s, 1.0 - s);  // either way, as far as the segment goes
+          at(s + (s < 0.5 ? step : -step), ch);
+          EXPECT_LE((ch.poses[link] * vertices[k] - x).norm(), step * speed + 0.5 * step * step * accel + 1e-9) << name;
+        }
+      }
+    }
+  }
+  EXPECT_GT(tighter, links / 2) << name << ": the field's speed should usually beat the static bound";
+  return {worst_speed, worst_accel};
+}
+
+// A three-link arm whose last joint follows the second at −1.5 times its angle (a mimic turning the other
+// way): the field adds the joints' turns with their signs.
+const char* kMimicArmUrdf = R"(<?xml version="1.0"?>
+<robot name="mimic_arm">
+  <link name="base"/>
+  <link name="upper"><collision><origin xyz="0.2 0 0"/><geometry><box size="0.4 0.05 0.05"/></geometry></collision></link>
+  <link name="fore"><collision><origin xyz="0.15 0 0"/><geometry><box size="0.3 0.05 0.05"/></geometry></collision></link>
+  <link name="hand"><collision><origin xyz="0.1 0 0.02"/><geometry><box size="0.2 0.08 0.04"/></geometry></collision></link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="upper"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" velocity="1" effort="1"/></joint>
+  <joint name="j2" type="revolute"><parent link="upper"/><child link="fore"/><origin xyz="0.4 0 0"/><axis xyz="0 1 0"/>
+    <limit lower="-2" upper="2" velocity="1" effort="1"/></joint>
+  <joint name="j3" type="revolute"><parent link="fore"/><child link="hand"/><origin xyz="0.3 0 0" rpy="0.3 0 0"/><axis xyz="0 1 0"/>
+    <limit lower="-3" upper="3" velocity="1" effort="1"/><mimic joint="j2" multiplier="-1.5" offset="0.1"/></joint>
+</robot>
+)";
+
+void expectTwistHoldsOn(const std::vector<std::shared_ptr<const Scene>>& scenes, unsigned seed) {
+  std::mt19937 rng(seed);
+  for (const auto& scene : scenes) {
+    const auto [speed, accel] = expectTwistHolds(*scene, rng, 40);
+    std::printf("%s: at most %.3f of the speed bound and %.3f of the acceleration bound reached\n", scene->name().c_str(),
+                speed, accel);
+  }
+}
+
+TEST(MotionBound, VelocityFieldHoldsOnOurRobots) {
+  TempDir dir;
+  const std::string urdf = dir.write("mimic_arm.urdf", kMimicArmUrdf);
+  const auto mimic = Scene::load(dir.write("mimic.yaml", "format: 1\nname: mimic\nrobot:\n  urdf: " + urdf +
+                                                            "\n  group: [j1, j2]\nchecks: [environment]\nstart: [0, 0]\ngoal: [1, 1]\n"));
+  expectTwistHoldsOn({mimic, twinArmScene(), Scene::load(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/arm6_wall.yaml")}, 17);
+}
+
+TEST(MotionBound, VelocityFieldHoldsOnTheSharedRobots) {
+  CLEARWAY_REQUIRE_SHARED("robots/panda/panda.urdf");
+  CLEARWAY_SHARED_OR_SKIP(root, "scenes");
+  std::vector<std::shared_ptr<const Scene>> scenes;
+  for (const char* name : {"box_panda/box_panda_0001.yaml", "box_ur5/box_ur5_0001.yaml"})
+    scenes.push_back(std::make_shared<const Scene>(parseSceneFile(root + "/" + name)));
+  expectTwistHoldsOn(scenes, 19);
+}
+
 TEST(MotionCertified, BranchingPaddedRobotNeverMissesWhatDenseSamplingFinds) {
   // The two arms over a table, by a thin post and under a thin bar, with 1 cm of padding: random steps
   // between free states, checked by the certified loop and by dense sampling (2 mm in the joint vector).

@@ -12,7 +12,9 @@
 // turn it by at most π/√2 times their change. Two links of one robot move relative to each other only through the joints on
 // the path between them, and may be watched from any link on that path: the joints on one side of it
 // move A, the others B; the pair's bound is that of the cheapest such link. If a pair is d apart at s,
-// it cannot touch within s ± d / B_pair. Each item (a pair, or a link against the environment) covers
+// it cannot touch within s ± d / B_pair; tighter where measured from the poses at s, as the larger of the
+// per-joint reaches from the axes there and the link's velocity field there (the joints' turns added as
+// vectors, with a bound on how fast the field changes). Each item (a pair, or a link against the environment) covers
 // the segment on its own with such balls: measured at the middle of what is left, it leaves up to two
 // shorter intervals, left first, so a free segment costs one measurement per ball twice as wide as
 // one-sided advancement's. A measurement within contact_distance switches the item to advancement from
@@ -61,6 +63,11 @@ class MotionBound {
   /// The same for the distance between links a and b (poses of both and their ancestors needed), watched
   /// from their common ancestor; where pair() watches from a better link, d / pair(a, b, dq) may be larger.
   double pairStep(int a, int b, const double* dq, const Pose* poses, double d) const noexcept;
+  /// The terms of the second bound linkStep() takes the larger of, from the link's velocity field now: for
+  /// the step ±h·dq no point of the link moves h·speed + h²·accel/2 or farther, speed bounding its points'
+  /// speed at `poses` and accel their acceleration anywhere (per unit step). False, with no terms, when a
+  /// joint of the chain that dq moves does not turn (a slide, a planar or floating joint).
+  bool linkTwist(int link, const double* dq, const Pose* poses, double& speed, double& accel) const noexcept;
   /// True when the step dq moves links a and b relative to each other by a pure translation (every
   /// joint it moves on the path between them is prismatic), which is then linear in the step.
   bool translates(int a, int b, const double* dq) const noexcept;
