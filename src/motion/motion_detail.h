@@ -51,7 +51,7 @@ struct Scratch {
   int probe_skipped = 0;
 };
 
-// A verdict-only check's first look (probe.cpp): the states at s = 1/2, 1/4 and 3/4, checked as the
+// A verdict-only check's first look (probe.cpp): the states at s = 1, 1/2, 1/4 and 3/4, checked as the
 // validity checker checks states. True, with r filled (a contact at that s, the state's report), when one
 // collides: the segment is then not free whatever the items would measure. Only where it has lately
 // paid for itself (planners' segments often collide; a path's or a benchmark's seldom do).

@@ -6,10 +6,13 @@
 namespace clearway::motion_detail {
 
 namespace {
-// The parameters, coarse to fine.
-constexpr double kAt[] = {0.5, 0.25, 0.75};
+// The parameters: the end first, then coarse to fine. RRTConnect checks the state it extends to only on its
+// goal tree, so on its start tree the end often collides itself (on the shared problems, putting the end
+// before 0.5, 0.25 and 0.75 took 1 to 16% off the motion checks of the same runs; dropping 0.25 then
+// was no better within the noise, and worse for segments whose ends are both free).
+constexpr double kAt[] = {1.0, 0.5, 0.25, 0.75};
 // The probe runs while it finds a collision on at least this share of the segments it looks at: below it,
-// the three state checks cost free segments more than they save colliding ones (measured on the shared
+// the state checks cost free segments more than they save colliding ones (measured on the shared
 // problems: a probe costs about a tenth of a colliding segment's sweep). It also runs on every eighth
 // segment it would skip, so that the share it sees follows the caller's segments.
 constexpr double kWorthwhile = 0.125;
