@@ -301,6 +301,7 @@ struct MotionChecker::Sweep {
     const Pose* poses = ctx.scene.poses.data();  // (at the parameter d was measured at)
     // The static bound first: where it reaches as far as asked, the reaches from the axes now are not needed.
     double h = d / ctx.bound[k];  // (∞ when the item does not move)
+    if (std::isnan(h)) h = d == INFINITY ? INFINITY : 0.0;  // (∞ / ∞: nothing near, and an unbounded motion)
     if (!(h < want)) return h;
     if (it.b < 0) return std::max(h, mc.bound_.linkStep(it.a, dq, poses, d, ctx.obstacle_motion));
     h = std::max(h, mc.bound_.pairStep(it.a, it.b, dq, poses, d));

@@ -46,6 +46,17 @@ struct MotionBound::Tables {
   std::vector<double> link_coef_;                 // links × dim
   std::vector<std::vector<int>> chain_;           // per link: the joints from the root, in order
   std::vector<std::vector<double>> prefix_;       // per link: running sum of step_ along its chain
+  // Σ step_ over chain_[link][i + 1 .. j] (i = −1: from the start): a difference of the running sums where
+  // they are finite; summed where an unbounded slide (a planar or floating joint without bounds) makes
+  // them ∞, which a difference would turn into NaN.
+  double offsets(int link, std::ptrdiff_t i, std::ptrdiff_t j) const noexcept {
+    if (j <= i) return 0.0;
+    const std::vector<double>& p = prefix_[link];
+    if (std::isfinite(p[j])) return p[j] - (i >= 0 ? p[i] : 0.0);
+    double sum = 0.0;
+    for (std::ptrdiff_t m = i + 1; m <= j; ++m) sum += step_[chain_[link][m]];
+    return sum;
+  }
   std::vector<std::vector<double>> joint_reach_;  // per link: per joint of its chain, its reach to the link
   std::vector<double> radius_;                    // per link: farthest hull vertex from the link's origin
   std::vector<int> joint_var_;                    // per joint: the state entry that drives it, -1 if none
@@ -210,7 +221,7 @@ MotionBound::Tables::Tables(const Scene& scene, const std::vector<Body>& bodies)
     // lengths do not change under rotation); the link's own joint knows it exactly.
     joint_reach_[i].assign(n, 0.0);
     for (std::size_t k = 0; k < n; ++k) {
-      joint_reach_[i][k] = radius_[i] + (prefix_[i][n - 1] - prefix_[i][k]);
+      joint_reach_[i][k] = radius_[i] + offsets(i, static_cast<std::ptrdiff_t>(k), static_cast<std::ptrdiff_t>(n) - 1);
       joint_reach_[i][k] = std::min(joint_reach_[i][k], exactReach(i, chain_[i][k]));
     }
     for (std::size_t k = 0; k < n; ++k) {
@@ -335,39 +346,38 @@ bool MotionBound::Tables::addTwist(int link, std::size_t from, const double* dq,
   const std::vector<double>& reach = joint_reach_[link];
   const Vec3 c = poses[frame_[link]] * sphere_center_[link];
   Vec3 omega = Vec3::Zero(), velocity = Vec3::Zero();  // Ω, and the field at c
-  double below = 0.0;  // Σ |w_j|·R_j over the joints below k (all of them, at first)
+  // A = Σ_k |w_k|·R_k·(2·Σ_{j<k} |w_j| + |w_k|), the sum above regrouped: sums of terms ≥ 0 only, so an
+  // unbounded reach makes it ∞, never NaN.
+  double above = 0.0, accel = 0.0, size = 0.0;
   for (std::size_t k = from; k < chain.size(); ++k) {
     const int j = chain[k], v = joint_var_[j];
     if (v < 0 || dq[v] == 0.0) continue;
     if (kind_[j] != static_cast<char>(Kind::Revolute)) return false;
     const double w = joint_sign_[j] * joint_mult_[j] * dq[v];
+    if (w == 0.0) continue;  // (a mimic of multiplier 0)
     const Pose& frame = poses[child_[j]];
     const Vec3 u = frame.R * axis_[j];
     omega += w * u;
     velocity += w * u.cross(c - frame.t);
-    below += std::abs(w) * reach[k];
+    accel += std::abs(w) * reach[k] * (2.0 * above + std::abs(w));
+    above += std::abs(w);
+    size += std::abs(w) * (reach[k] + sphere_radius_[link]);
   }
-  double turn = 0.0;  // Σ_{j≤k} |w_j|
-  for (std::size_t k = from; k < chain.size(); ++k) {
-    const int j = chain[k], v = joint_var_[j];
-    if (v < 0 || dq[v] == 0.0) continue;
-    const double w = joint_mult_[j] * std::abs(dq[v]);
-    turn += w;
-    below -= w * reach[k];
-    f.accel += w * (turn * reach[k] + std::max(below, 0.0));
-  }
-  f.speed += velocity.norm() + omega.norm() * sphere_radius_[link];
+  f.accel += accel;
+  // Rounding: the field's terms can cancel, so their sum's error is absolute, a few ulps of Σ |w_k|·(R_k + ρ)
+  // at most; 1e-12 of it is far above.
+  f.speed += velocity.norm() + omega.norm() * sphere_radius_[link] + 1e-12 * size;
   return true;
 }
 
 double MotionBound::Tables::TwistBound::solve(double d) const noexcept {
   if (!(d > 0.0)) return 0.0;
-  // Rounding: the terms are sums of a few products of metres and radians; a relative margin far above it.
+  // Rounding of the sums of products of metres and radians, and of the root below: relative, and far above it.
   constexpr double kMargin = 1.0 + 1e-9;
   const double v0 = speed * kMargin, a = accel * kMargin;
   const double root = v0 + std::sqrt(v0 * v0 + 2.0 * a * d);
-  const double h = root > 0.0 ? 2.0 * d / root : INFINITY;
-  return std::isnan(h) ? 0.0 : h;
+  if (!(root > 0.0)) return root == 0.0 ? INFINITY : 0.0;  // nothing moves; NaN proves nothing
+  return 2.0 * d / root;
 }
 
 double MotionBound::Tables::pairStep(int a, int b, const double* dq, const Pose* poses, double d) const noexcept {
@@ -392,9 +402,9 @@ double MotionBound::Tables::pair(int a, int b, const double* dq) const noexcept 
   const std::size_t na = ca.size(), nb = cb.size();
   std::size_t fork = 0;
   while (fork < na && fork < nb && ca[fork] == cb[fork]) ++fork;
-  const double above = fork ? prefix_[a][fork - 1] : 0.0;  // equal for b: the shared joints
-  const double side_a = na > fork ? prefix_[a][na - 1] - above : 0.0;
-  const double side_b = nb > fork ? prefix_[b][nb - 1] - above : 0.0;
+  const std::ptrdiff_t shared = static_cast<std::ptrdiff_t>(fork) - 1;  // the last joint both chains share
+  const double side_a = offsets(a, shared, static_cast<std::ptrdiff_t>(na) - 1);
+  const double side_b = offsets(b, shared, static_cast<std::ptrdiff_t>(nb) - 1);
   // Path order: a's joints upwards, then b's downwards. cost_a[k]: the joint moving a; cost_b[k]: moving b.
   constexpr std::size_t kMaxPath = 128;
   double cost_a[kMaxPath], cost_b[kMaxPath];
@@ -420,11 +430,11 @@ double MotionBound::Tables::pair(int a, int b, const double* dq) const noexcept 
   }
   for (std::size_t k = na; k-- > fork;) {
     // From this joint up to the fork, then down to b.
-    const double reach_b = radius_[b] + (prefix_[a][k] - above) + side_b;
+    const double reach_b = radius_[b] + offsets(a, shared, static_cast<std::ptrdiff_t>(k)) + side_b;
     add(ca[k], joint_reach_[a][k], std::min(reach_b, exactReach(b, ca[k])));
   }
   for (std::size_t k = fork; k < nb; ++k) {
-    const double reach_a = radius_[a] + (prefix_[b][k] - above) + side_a;
+    const double reach_a = radius_[a] + offsets(b, shared, static_cast<std::ptrdiff_t>(k)) + side_a;
     add(cb[k], std::min(reach_a, exactReach(a, cb[k])), joint_reach_[b][k]);
   }
   // Split after i joints: Σ_{k<i} cost_a + Σ_{k≥i} cost_b, smallest over i, by a suffix sweep.

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <random>
 #include <thread>
@@ -805,6 +806,49 @@ TEST(MotionCertified, PlanarAndFloatingNeverMissWhatDenseSamplingFinds) {
   EXPECT_GE(r.first_contact, (0.69 - 0.15 + 1 - certified.options().contact_distance) / 3 - 1e-9);
 }
 
+// A planar or floating joint without bounds (robot.bounds is optional): its slides may take the robot anywhere,
+// so the links' distances from the axes above them have no bound, while those from the joints below do.
+// The rover and the flyer with their bounds struck out still get real answers (a motion bound that
+// subtracted one unbounded sum from another was NaN, and the check called every such segment colliding at
+// its start), and never miss what dense sampling finds.
+TEST(MotionCertified, UnboundedPlanarAndFloatingJointsStillAnswer) {
+  TempDir dir;
+  for (const char* robot : {"rover", "flyer"}) {
+    const std::string file = std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/" + (robot == std::string("rover") ? "rover_gap.yaml" : "flyer_post.yaml");
+    std::ifstream in(file);
+    std::string text, line;
+    while (std::getline(in, line)) {
+      if (line.find("bounds:") != std::string::npos) continue;
+      const std::string relative = std::string("../") + robot + "/";
+      if (const std::size_t at = line.find(relative); at != std::string::npos)
+        line.replace(at, relative.size(), std::string(CLEARWAY_SOURCE_DIR) + "/robots/" + robot + "/");
+      text += line + "\n";
+    }
+    const auto bounded = Scene::load(file);
+    const auto open = Scene::load(dir.write(std::string(robot) + "_open.yaml", text));
+    ASSERT_FALSE(std::isfinite(open->lower(0)) && std::isfinite(open->upper(0))) << robot << ": the bounds were not struck out";
+    const MotionChecker b(bounded), u(open), fine(open, sampled(2e-3));
+    MotionContext bc = b.makeContext(), uc = u.makeContext(), fc = fine.makeContext();
+    std::mt19937 rng(23);
+    int free_bounded = 0, free_open = 0, collide = 0;
+    for (int trial = 0; trial < 150; ++trial) {
+      const std::vector<double> q0 = randomState(*bounded, rng), q1 = randomState(*bounded, rng);
+      if (!open->isFree(q0) || !open->isFree(q1)) continue;
+      const MotionResult c = u.check(q0.data(), q1.data(), uc);
+      const MotionResult d = fine.check(q0.data(), q1.data(), fc);
+      if (!d.free) EXPECT_FALSE(c.free) << robot << " trial " << trial << ": certified missed a collision";
+      EXPECT_FALSE(c.capped) << robot << " trial " << trial;
+      free_open += c.free;
+      collide += !d.free;
+      free_bounded += b.check(q0.data(), q1.data(), bc).free;
+    }
+    std::printf("%s without bounds: %d segments free (%d with them), %d colliding\n", robot, free_open, free_bounded, collide);
+    EXPECT_GT(free_open, 15) << robot;
+    EXPECT_GE(free_open, free_bounded * 9 / 10) << robot;
+    EXPECT_GT(collide, 15) << robot;
+  }
+}
+
 // A random state within the scene's bounds (and ±3), and a step of up to 0.4 in each entry that stays in them.
 void randomStep(const Scene& scene, std::mt19937& rng, std::vector<double>& q0, std::vector<double>& q1,
                 std::vector<double>& dq) {
@@ -1338,14 +1382,16 @@ TEST(MotionCertified, ProbeKeepsEveryVerdict) {
     std::uniform_real_distribution<double> u(0.0, 1.0);
     const int n = scene.dimension();
     std::vector<double> q0(n), q1(n), at(n);
-    int segments = 0, colliding = 0, settled = 0;
+    int segments = 0, colliding = 0, settled = 0, at_end = 0;
     while (segments < 300) {
       for (int i = 0; i < n; ++i) {
         q0[i] = scene.lower(i) + u(rng) * (scene.upper(i) - scene.lower(i));
         q1[i] = scene.lower(i) + u(rng) * (scene.upper(i) - scene.lower(i));  // (RRTConnect's connect steps are long)
       }
       const double t0 = c.timed ? u(rng) : 0.0, t1 = c.timed ? t0 + 2.0 * u(rng) : 0.0;
-      if (!scene.isFree(q0.data(), sc, nullptr, t0) || !scene.isFree(q1.data(), sc, nullptr, t1)) continue;
+      // Every third segment is an extension of RRTConnect's start tree, whose end nothing has checked.
+      const bool extension = segments % 3 == 2;
+      if (!scene.isFree(q0.data(), sc, nullptr, t0) || (!extension && !scene.isFree(q1.data(), sc, nullptr, t1))) continue;
       ++segments;
       const MotionResult a = checker.check(q0.data(), t0, q1.data(), t1, located);
       const MotionResult v = checker.check(q0.data(), t0, q1.data(), t1, verdict, /*locate_contact=*/false);
@@ -1355,15 +1401,31 @@ TEST(MotionCertified, ProbeKeepsEveryVerdict) {
       ++settled;  // by the probe: no item was measured
       EXPECT_TRUE(v.first_contact == 1.0 || v.first_contact == 0.5 || v.first_contact == 0.25 || v.first_contact == 0.75)
           << v.first_contact;
+      at_end += v.first_contact == 1.0;
       checker.interpolate(q0.data(), q1.data(), v.first_contact, at.data());
       CollisionReport report;
       EXPECT_FALSE(scene.isFree(at.data(), sc, &report, t0 + v.first_contact * (t1 - t0))) << "segment " << segments;
       EXPECT_EQ(report.kind, v.report.kind) << "segment " << segments;
     }
-    std::printf("%s: %d of %d segments collide, %d settled by the probe\n", c.name.c_str(), colliding, segments, settled);
+    std::printf("%s: %d of %d segments collide, %d settled by the probe (%d at the end)\n", c.name.c_str(), colliding,
+                segments, settled, at_end);
     EXPECT_GT(colliding, segments / 3);
     EXPECT_LT(colliding, segments);
     EXPECT_GT(settled, colliding / 3);
+    EXPECT_GT(at_end, segments / 30) << "the start tree's extensions should often end in a collision";
+    // An end out of bounds: not free either way; where the probe settles it, the report says Invalid.
+    for (int k = 0; k < 10; ++k) {
+      do {
+        for (int i = 0; i < n; ++i) q0[i] = scene.lower(i) + u(rng) * (scene.upper(i) - scene.lower(i));
+      } while (!scene.isFree(q0.data(), sc));
+      q1 = q0;
+      q1[k % n] = scene.upper(k % n) + 0.1;
+      const MotionResult a = checker.check(q0.data(), q1.data(), located);
+      const MotionResult v = checker.check(q0.data(), q1.data(), verdict, false);
+      EXPECT_FALSE(a.free || v.free) << "out of bounds " << k;
+      if (v.distance_queries == 0 && v.first_contact == 1.0)
+        EXPECT_EQ(v.report.kind, CollisionReport::Kind::Invalid) << "out of bounds " << k;
+    }
     // Then segments that never collide (a free state held still): the probe stops running on all of
     // them, but still runs on every eighth. A free segment it ran on took four states more than the located
     // check's.
