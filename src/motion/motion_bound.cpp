@@ -226,7 +226,7 @@ MotionBound::Tables::Tables(const Scene& scene, const std::vector<Body>& bodies)
     }
     for (std::size_t k = 0; k < n; ++k) {
       const int j = chain_[i][k];
-      if (joint_var_[j] < 0) continue;
+      if (joint_var_[j] < 0 || joint_mult_[j] == 0.0) continue;  // (a mimic of multiplier 0 never moves)
       const double w = isSlide(j) ? 1.0 : joint_reach_[i][k];
       link_coef_[static_cast<std::size_t>(i) * dim_ + joint_var_[j]] += joint_mult_[j] * w;
     }
@@ -302,7 +302,7 @@ void MotionBound::Tables::addDynamic(int link, std::size_t from, const double* d
   double after = 0.0;  // Σ w·R over the joints below k: γ_k
   for (std::size_t k = chain.size(); k-- > from;) {
     const int j = chain[k], v = joint_var_[j];
-    if (v < 0 || dq[v] == 0.0) continue;
+    if (v < 0 || dq[v] == 0.0 || joint_mult_[j] == 0.0) continue;  // (0·∞ would be NaN)
     const double w = joint_mult_[j] * std::abs(dq[v]);
     const double reach = isSlide(j) ? 1.0 : joint_reach_[link][k];
     if (kind_[j] != static_cast<char>(Kind::Revolute) || f.n == DynamicBound::kMax) {  // slides, spins: static
@@ -411,7 +411,7 @@ double MotionBound::Tables::pair(int a, int b, const double* dq) const noexcept 
   std::size_t n = 0;
   const auto add = [&](int j, double reach_a, double reach_b) {
     const int v = joint_var_[j];
-    if (v < 0 || dq[v] == 0.0) return;
+    if (v < 0 || dq[v] == 0.0 || joint_mult_[j] == 0.0) return;  // (0·∞ would be NaN)
     const double w = joint_mult_[j] * std::abs(dq[v]);
     cost_a[n] = (isSlide(j) ? 1.0 : reach_a) * w;
     cost_b[n] = (isSlide(j) ? 1.0 : reach_b) * w;
@@ -423,7 +423,8 @@ double MotionBound::Tables::pair(int a, int b, const double* dq) const noexcept 
       const int l = side ? b : a;
       for (std::size_t k = fork; k < chain_[l].size(); ++k) {
         const int j = chain_[l][k], v = joint_var_[j];
-        if (v >= 0 && dq[v] != 0.0) bound += joint_mult_[j] * std::abs(dq[v]) * (isSlide(j) ? 1.0 : joint_reach_[l][k]);
+        if (v >= 0 && dq[v] != 0.0 && joint_mult_[j] != 0.0)
+          bound += joint_mult_[j] * std::abs(dq[v]) * (isSlide(j) ? 1.0 : joint_reach_[l][k]);
       }
     }
     return bound;

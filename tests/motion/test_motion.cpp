@@ -849,6 +849,51 @@ TEST(MotionCertified, UnboundedPlanarAndFloatingJointsStillAnswer) {
   }
 }
 
+// A turret whose mimic joint (multiplier 0: it never moves) carries an unbounded planar cart: the reaches
+// above the cart are infinite, and 0·∞ must not make a bound NaN (a NaN step once read as "covered").
+TEST(MotionBound, NeverNaNWithAnUnboundedSlideBelowAStillMimic) {
+  TempDir dir;
+  const std::string urdf = dir.write("turret.urdf", R"(<?xml version="1.0"?>
+<robot name="turret">
+  <link name="base"/>
+  <link name="turret"><collision><geometry><cylinder radius="0.1" length="0.1"/></geometry></collision></link>
+  <link name="mount"/>
+  <link name="cart"><collision><origin xyz="0.3 0 0"/><geometry><box size="0.4 0.2 0.1"/></geometry></collision></link>
+  <joint name="spin" type="revolute"><parent link="base"/><child link="turret"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" velocity="1" effort="1"/></joint>
+  <joint name="still" type="revolute"><parent link="turret"/><child link="mount"/><origin xyz="0 0 0.2"/><axis xyz="0 1 0"/>
+    <limit lower="-3" upper="3" velocity="1" effort="1"/><mimic joint="spin" multiplier="0" offset="0.2"/></joint>
+  <joint name="drive" type="planar"><parent link="mount"/><child link="cart"/><axis xyz="0 0 1"/></joint>
+</robot>
+)");
+  const auto scene = Scene::load(dir.write("turret.yaml", "format: 1\nname: turret\nrobot:\n  urdf: " + urdf +
+      "\n  group: [spin, drive]\nenvironment:\n  obstacles:\n    - {name: post, cylinder: {radius: 0.02, length: 2}, "
+      "pose: {position: [0.4, 0, 0]}}\nchecks: [environment, continuous]\nstart: [0, 0, 0, 0]\ngoal: [1, 0, 0, 0]\n"));
+  ASSERT_FALSE(std::isfinite(scene->upper(1)));
+  const MotionBound bound(*scene);
+  const int cart = scene->robot().linkIndex("cart"), turret = scene->robot().linkIndex("turret");
+  SceneContext ctx = scene->makeContext();
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    const std::vector<double> q = {2.5 * u(rng), 0.5 * u(rng), 0.5 * u(rng), 3.0 * u(rng)};
+    std::vector<double> dq = {u(rng), trial % 2 ? 0.0 : u(rng), trial % 3 ? 0.0 : u(rng), trial % 5 ? 0.0 : u(rng)};
+    scene->computePoses(q.data(), ctx);
+    for (const double b : {bound.link(cart, dq.data()), bound.pair(turret, cart, dq.data()),
+                           bound.linkStep(cart, dq.data(), ctx.poses.data(), 0.05),
+                           bound.pairStep(turret, cart, dq.data(), ctx.poses.data(), 0.05)})
+      EXPECT_FALSE(std::isnan(b)) << "trial " << trial;
+  }
+  // The cart swung through the post by the turret (the cart's slides still), and past it: as dense sampling.
+  const MotionChecker checker(scene), fine(scene, sampled(1e-3));
+  MotionContext mc = checker.makeContext(), fc = fine.makeContext();
+  const double q0[4] = {-1.0, 0, 0, 0}, q1[4] = {1.0, 0, 0, 0}, q2[4] = {-1.0, 2.0, 0, 0}, q3[4] = {1.0, 2.0, 0, 0};
+  ASSERT_FALSE(fine.check(q0, q1, fc).free);
+  EXPECT_FALSE(checker.check(q0, q1, mc).free);
+  ASSERT_TRUE(fine.check(q2, q3, fc).free);
+  EXPECT_TRUE(checker.check(q2, q3, mc).free);
+}
+
 // A random state within the scene's bounds (and ±3), and a step of up to 0.4 in each entry that stays in them.
 void randomStep(const Scene& scene, std::mt19937& rng, std::vector<double>& q0, std::vector<double>& q1,
                 std::vector<double>& dq) {
