@@ -27,10 +27,9 @@ struct MotionBound::Tables {
   // The bound from the velocity field now (below linkStep): f(h) = h·speed + h²·accel/2.
   struct TwistBound {
     double speed = 0.0, accel = 0.0;
+    bool valid = true;  // false when a joint that moves does not turn
     double solve(double d) const noexcept;  // the largest h with f(h) ≤ d
   };
-  // Adds to f the joints of link's chain from index `from` on; false when one that moves does not turn.
-  bool addTwist(int link, std::size_t from, const double* dq, const Pose* poses, TwistBound& f) const noexcept;
   double pairStep(int a, int b, const double* dq, const Pose* poses, double d) const noexcept;
   bool translates(int a, int b, const double* dq) const noexcept;
   bool translates(int link, const double* dq) const noexcept;
@@ -38,8 +37,9 @@ struct MotionBound::Tables {
   using Body = MotionBound::Body;
 
   struct DynamicBound;
-  // Adds to f the joints of link's chain from index `from` on.
-  void addDynamic(int link, std::size_t from, const double* dq, const Pose* poses, DynamicBound& f) const noexcept;
+  // Adds to f and t the joints of link's chain from index `from` on, in one walk of the chain.
+  void addBounds(int link, std::size_t from, const double* dq, const Pose* poses, DynamicBound& f,
+                 TwistBound& t) const noexcept;
 
   int dim_ = 0, links_ = 0;
   std::vector<int> frame_;                        // per link: the link whose pose places it (a body's anchor)
@@ -296,78 +296,63 @@ struct MotionBound::Tables::DynamicBound {
   }
 };
 
-void MotionBound::Tables::addDynamic(int link, std::size_t from, const double* dq, const Pose* poses, DynamicBound& f) const noexcept {
-  const std::vector<int>& chain = chain_[link];
-  const Vec3 center = poses[frame_[link]] * sphere_center_[link];
-  double after = 0.0;  // Σ w·R over the joints below k: γ_k
-  for (std::size_t k = chain.size(); k-- > from;) {
-    const int j = chain[k], v = joint_var_[j];
-    if (v < 0 || dq[v] == 0.0 || joint_mult_[j] == 0.0) continue;  // (0·∞ would be NaN)
-    const double w = joint_mult_[j] * std::abs(dq[v]);
-    const double reach = isSlide(j) ? 1.0 : joint_reach_[link][k];
-    if (kind_[j] != static_cast<char>(Kind::Revolute) || f.n == DynamicBound::kMax) {  // slides, spins: static
-      f.a += w * reach;
-    } else {
-      const Pose& frame = poses[child_[j]];
-      const Vec3 u = frame.R * axis_[j], r = center - frame.t;
-      const double now = std::min(reach, (r - r.dot(u) * u).norm() + sphere_radius_[link]);
-      f.a += w * now;
-      if (now < reach && after > 0.0) {
-        f.c += w * after;
-        f.cap[f.n] = (reach - now) / after, f.gain[f.n] = w * after, f.excess[f.n] = w * (reach - now);
-        ++f.n;
-      }
-    }
-    after += w * reach;
-  }
-  f.fixed += after;
-}
-
-double MotionBound::Tables::linkStep(int link, const double* dq, const Pose* poses, double d, double extra) const noexcept {
-  DynamicBound f;
-  addDynamic(link, 0, dq, poses, f);
-  f.a += extra, f.fixed += extra;  // (linear in h)
-  TwistBound t;
-  t.speed = extra;
-  return addTwist(link, 0, dq, poses, t) ? std::max(f.solve(d), t.solve(d)) : f.solve(d);
-}
-
-// The same bound from the link's velocity field now, where the joints' speeds add as vectors, not as
-// lengths. A revolute chain turns the link's points at w_k (the signed Δq_k) about axis k (unit u_k through
+// The twist bound (TwistBound): the motion from the link's velocity field now, where the joints' speeds add
+// as vectors, not as lengths. A revolute chain turns the link's points at w_k (the signed Δq_k) about axis k (unit u_k through
 // o_k): dx/ds = Σ_k w_k·t_k with t_k = u_k × (x − o_k), a twist Ω × x + V, so on the link's ball (centre c,
 // radius ρ) the speed now is at most v0 = |Ω × c + V| + |Ω|·ρ. Along the segment t_k turns with the frame
 // of joint k (at most Σ_{j≤k} |w_j| radians per unit s) and changes inside it only as the joints below k
 // move x, by at most Σ_{j>k} |w_j|·R_j; with |t_k| ≤ R_k (the static reach of the link from axis k),
 // |d²x/ds²| ≤ A = Σ_k |w_k|·((Σ_{j≤k} |w_j|)·R_k + Σ_{j>k} |w_j|·R_j) anywhere. So no point moves farther than
-// h·v0 + h²·A/2 for a step of h either way. Only for chains whose moving joints all turn (else 0, which
-// proves nothing).
-bool MotionBound::Tables::addTwist(int link, std::size_t from, const double* dq, const Pose* poses, TwistBound& f) const noexcept {
+// h·v0 + h²·A/2 for a step of h either way. Only for chains whose moving joints all turn (else not valid).
+void MotionBound::Tables::addBounds(int link, std::size_t from, const double* dq, const Pose* poses, DynamicBound& f,
+                                    TwistBound& t) const noexcept {
   const std::vector<int>& chain = chain_[link];
-  const std::vector<double>& reach = joint_reach_[link];
-  const Vec3 c = poses[frame_[link]] * sphere_center_[link];
-  Vec3 omega = Vec3::Zero(), velocity = Vec3::Zero();  // Ω, and the field at c
-  // A = Σ_k |w_k|·R_k·(2·Σ_{j<k} |w_j| + |w_k|), the sum above regrouped: sums of terms ≥ 0 only, so an
-  // unbounded reach makes it ∞, never NaN.
-  double above = 0.0, accel = 0.0, size = 0.0;
-  for (std::size_t k = from; k < chain.size(); ++k) {
+  const Vec3 center = poses[frame_[link]] * sphere_center_[link];
+  const double rho = sphere_radius_[link];
+  double after = 0.0;  // Σ w·R over the joints below k: γ_k
+  // The twist: Ω, the field at the centre, A and the rounding's scale. A = Σ_k |w_k|·R_k·(|w_k| + 2·Σ_{j<k} |w_j|)
+  // is summed here as Σ_k |w_k|·(|w_k|·R_k + 2·γ_k): terms ≥ 0 only, so an unbounded reach makes it ∞, never NaN.
+  Vec3 omega = Vec3::Zero(), velocity = Vec3::Zero();
+  double accel = 0.0, size = 0.0;
+  for (std::size_t k = chain.size(); k-- > from;) {
     const int j = chain[k], v = joint_var_[j];
-    if (v < 0 || dq[v] == 0.0) continue;
-    if (kind_[j] != static_cast<char>(Kind::Revolute)) return false;
-    const double w = joint_sign_[j] * joint_mult_[j] * dq[v];
-    if (w == 0.0) continue;  // (a mimic of multiplier 0)
-    const Pose& frame = poses[child_[j]];
-    const Vec3 u = frame.R * axis_[j];
-    omega += w * u;
-    velocity += w * u.cross(c - frame.t);
-    accel += std::abs(w) * reach[k] * (2.0 * above + std::abs(w));
-    above += std::abs(w);
-    size += std::abs(w) * (reach[k] + sphere_radius_[link]);
+    if (v < 0 || dq[v] == 0.0 || joint_mult_[j] == 0.0) continue;  // (0·∞ would be NaN)
+    const double w = joint_mult_[j] * std::abs(dq[v]);
+    const double reach = isSlide(j) ? 1.0 : joint_reach_[link][k];
+    if (kind_[j] != static_cast<char>(Kind::Revolute)) {  // slides, spins: static, and no twist
+      f.a += w * reach;
+      t.valid = false;
+    } else {
+      const Pose& frame = poses[child_[j]];
+      const Vec3 u = frame.R * axis_[j], r = center - frame.t;
+      const double now = std::min(reach, (r - r.dot(u) * u).norm() + rho);
+      f.a += w * (f.n == DynamicBound::kMax ? reach : now);
+      if (f.n < DynamicBound::kMax && now < reach && after > 0.0) {
+        f.c += w * after;
+        f.cap[f.n] = (reach - now) / after, f.gain[f.n] = w * after, f.excess[f.n] = w * (reach - now);
+        ++f.n;
+      }
+      const double signed_w = joint_sign_[j] * w * (dq[v] < 0.0 ? -1.0 : 1.0);
+      omega += signed_w * u;
+      velocity += signed_w * u.cross(r);
+      accel += w * (w * reach + 2.0 * after);
+      size += w * (reach + rho);
+    }
+    after += w * reach;
   }
-  f.accel += accel;
+  f.fixed += after;
+  t.accel += accel;
   // Rounding: the field's terms can cancel, so their sum's error is absolute, a few ulps of Σ |w_k|·(R_k + ρ)
   // at most; 1e-12 of it is far above.
-  f.speed += velocity.norm() + omega.norm() * sphere_radius_[link] + 1e-12 * size;
-  return true;
+  t.speed += velocity.norm() + omega.norm() * rho + 1e-12 * size;
+}
+
+double MotionBound::Tables::linkStep(int link, const double* dq, const Pose* poses, double d, double extra) const noexcept {
+  DynamicBound f;
+  TwistBound t;
+  addBounds(link, 0, dq, poses, f, t);
+  f.a += extra, f.fixed += extra, t.speed += extra;  // (linear in h)
+  return t.valid ? std::max(f.solve(d), t.solve(d)) : f.solve(d);
 }
 
 double MotionBound::Tables::TwistBound::solve(double d) const noexcept {
@@ -385,11 +370,10 @@ double MotionBound::Tables::pairStep(int a, int b, const double* dq, const Pose*
   std::size_t fork = 0;
   while (fork < chain_[a].size() && fork < chain_[b].size() && chain_[a][fork] == chain_[b][fork]) ++fork;
   DynamicBound f;
-  addDynamic(a, fork, dq, poses, f);
-  addDynamic(b, fork, dq, poses, f);
   TwistBound t;
-  if (addTwist(a, fork, dq, poses, t) && addTwist(b, fork, dq, poses, t)) return std::max(f.solve(d), t.solve(d));
-  return f.solve(d);
+  addBounds(a, fork, dq, poses, f, t);
+  addBounds(b, fork, dq, poses, f, t);
+  return t.valid ? std::max(f.solve(d), t.solve(d)) : f.solve(d);
 }
 
 double MotionBound::Tables::pair(int a, int b, const double* dq) const noexcept {
@@ -463,9 +447,11 @@ double MotionBound::pairStep(int a, int b, const double* dq, const Pose* poses, 
   return t_->pairStep(a, b, dq, poses, d);
 }
 bool MotionBound::linkTwist(int link, const double* dq, const Pose* poses, double& speed, double& accel) const noexcept {
-  Tables::TwistBound f;
-  if (!t_->addTwist(link, 0, dq, poses, f)) return false;
-  speed = f.speed, accel = f.accel;
+  Tables::DynamicBound f;
+  Tables::TwistBound t;
+  t_->addBounds(link, 0, dq, poses, f, t);
+  if (!t.valid) return false;
+  speed = t.speed, accel = t.accel;
   return true;
 }
 bool MotionBound::translates(int a, int b, const double* dq) const noexcept { return t_->translates(a, b, dq); }
