@@ -385,7 +385,9 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
   const double reach = link.sphereRadius() * (1.0 + 1e-12) + 8.0 * std::numeric_limits<double>::epsilon() *
                                                              (link.sphereCenter().norm() + pose.t.norm());
   const Aabb link_box = Aabb::fromCenterHalf(centre, Vec3::Constant(reach));
-  const double slack = padding + bandOf(scale_ + maxAbs(link_box) + padding, tol);
+  // (|centre| + reach is the box's largest coordinate, within an ulp: it only sizes the band.)
+  const double extent = std::max({std::abs(centre.x()), std::abs(centre.y()), std::abs(centre.z())}) + reach;
+  const double slack = padding + bandOf(scale_ + extent + padding, tol);
   const Aabb query = link_box.inflated(slack);
   // Most links of a state overlap no item's box at all: the trees alone say so, before the culls and hull
   // tests below are set up (which cost more than the walk). Moving obstacles take the full path.
@@ -414,7 +416,7 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
     double c[3], h[3];
     detail::OrientedBoxTest::centerHalf(*item.voxel, c, h);
     if (!obb) {
-      obb.emplace(pose, slack, scale_ + maxAbs(link_box));
+      obb.emplace(pose, slack, scale_ + extent);
       placed_link = obb->place(link.bounds());
     }
     if (obb->separated<false>(c, h, placed_link)) return false;
@@ -460,7 +462,7 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
   // GJK; then the link's primitives against the voxels near them.
   found = -1;
   // A core of the link meeting an occupied voxel settles it without the triangle search.
-  const double core_margin = 1e-9 * (1.0 + scale_ + maxAbs(link_box));
+  const double core_margin = 1e-9 * (1.0 + scale_ + extent);
   for (const LinkGeometry::Ball& core : link.cores()) {
     const Vec3 c = pose * core.center;
     const double r = core.radius - core_margin;

@@ -424,16 +424,25 @@ bool Scene::posedFree(const Pose* poses, const double* q, SceneContext& ctx, Col
   const Effects& fx = description_.effects;
   if (fx.environment && !environment_->empty()) {
     const double time = fx.moving ? t : 0.0;
-    for (int i : env_links_) {
+    const auto hits = [&](int k) {
+      const int i = env_links_[k];
       EnvironmentHit hit;
-      if (environment_->linkIntersects(*geometry_->link(i), poses[i], options_.tolerances, options_.mode,
-                                       link_padding_[i], time, &hit, &ctx.counters.environment)) {
-        r.kind = CollisionReport::Kind::Environment;
-        r.link = i;
-        r.hit = hit;
+      if (!environment_->linkIntersects(*geometry_->link(i), poses[i], options_.tolerances, options_.mode,
+                                        link_padding_[i], time, &hit, &ctx.counters.environment))
         return false;
-      }
-    }
+      r.kind = CollisionReport::Kind::Environment;
+      r.link = i;
+      r.hit = hit;
+      ctx.env_last_hit = k;
+      return true;
+    };
+    // The link that met an obstacle last goes first: a planner's next state is near its last, and the links
+    // before it in order would each be tested for nothing. Each link is still tested once at most.
+    const int n = static_cast<int>(env_links_.size());
+    const int lead = ctx.env_last_hit >= 0 && ctx.env_last_hit < n ? ctx.env_last_hit : -1;
+    if (lead >= 0 && hits(lead)) return false;
+    for (int k = 0; k < n; ++k)
+      if (k != lead && hits(k)) return false;
   }
   if (fx.self) {
     const long long before = ctx.self.pair_tests;

@@ -54,6 +54,8 @@ struct SceneContext {
   std::vector<double> q;       ///< the full joint vector (group values, held values, defaults)
   std::vector<Pose> poses;     ///< world pose of every link
   SelfCollisionContext self;
+  /// The environment link (an index into Scene::environmentLinks()) that last met an obstacle, −1: none.
+  int env_last_hit = -1;
   SceneCounters counters;
   // Scene::areFree's: the kinematics over lanes of states, and each lane's joint vector and link poses.
   std::optional<KinematicLanes> lanes;
@@ -199,7 +201,8 @@ class Scene {
   bool validState(const double* state, std::string* why = nullptr) const;
 
   /// True when the state is valid and free of every declared collision effect at time t (t is used
-  /// only when the scene declares `moving`). `report` (optional) says what collided first.
+  /// only when the scene declares `moving`). `report` (optional) says what collided (the first collision found; the link
+  /// that last met an obstacle in this context is tried first).
   bool isFree(const double* state, SceneContext& context, CollisionReport* report = nullptr,
               double t = 0.0) const noexcept;
   /// The same with this thread's own context.
