@@ -451,14 +451,13 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
     r.report.kind = CollisionReport::Kind::Invalid;
     return r;
   }
-  // Members wait until their group comes within contact.
+  if (!locate_contact && motion_detail::probeCollides(*this, q0, t0, q1, t1, ctx, r)) return r;
+  // (After the probe: a segment it settles needs no bounds.) Members wait until their group comes within contact.
   for (int k = 0; k < n_items; ++k) {
     if (items_[k].group >= 0) continue;
     ctx.bound[k] = itemBound(items_[k], ctx.dq.data(), ctx.obstacle_motion);  // (0 when nothing moves: measured once)
     ctx.safe_until[k] = 0.0;
   }
-
-  if (!locate_contact && motion_detail::probeCollides(*this, q0, t0, q1, t1, ctx, r)) return r;
   if (options_.mode == MotionMode::Cast) castAhead(q0, q1, t0, n_items, ctx, r);
   // Self items whose tables prove them apart along the whole segment are not swept.
   bool ends_set = false;
