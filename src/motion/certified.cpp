@@ -280,13 +280,10 @@ struct MotionChecker::Sweep {
 
   // Self item k's parts' motion bounds against the other link, for this segment: a's parts, then b's.
   const double* splitBounds(int k) {
-    const Item& it = mc.items_[k];
     double* bound = ctx.split_bound.data() + ctx.split_slot[k];
     if (ctx.split_stamp[k] != ctx.segment) {
-      const std::vector<int>& begin = mc.bodies_.parts_begin;
-      const int na = static_cast<int>(it.ga->parts().size()), nb = static_cast<int>(it.gb->parts().size());
-      for (int i = 0; i < na; ++i) bound[i] = mc.bound_.pair(begin[it.a] + i, it.b, ctx.dq.data());
-      for (int j = 0; j < nb; ++j) bound[na + j] = mc.bound_.pair(it.a, begin[it.b] + j, ctx.dq.data());
+      const std::vector<MotionBound::PairPath>& paths = mc.split_paths_[k];
+      for (std::size_t i = 0; i < paths.size(); ++i) bound[i] = mc.bound_.pair(paths[i], ctx.dq.data());
       ctx.split_stamp[k] = ctx.segment;
     }
     return bound;
@@ -350,7 +347,7 @@ struct MotionChecker::Sweep {
       if (d <= contactOf(k)) {
         if (it.last > it.first) {  // a group within contact: its members take over here, exactly
           for (int member = it.first; member < it.last && !stop(); ++member) {
-            ctx.bound[member] = mc.itemBound(mc.items_[member], ctx.dq.data(), ctx.obstacle_motion);
+            ctx.bound[member] = mc.itemBound(member, ctx.dq.data(), ctx.obstacle_motion);
             cover(member, iv.a, hi, iv.witness);
           }
           continue;
@@ -403,8 +400,8 @@ struct MotionChecker::Sweep {
   }
 };
 
-double MotionChecker::itemBound(const Item& it, const double* dq, double obstacle_motion) const noexcept {
-  return it.b >= 0 ? bound_.pair(it.a, it.b, dq) : bound_.link(it.a, dq) + obstacle_motion;
+double MotionChecker::itemBound(int k, const double* dq, double obstacle_motion) const noexcept {
+  return items_[k].b >= 0 ? bound_.pair(paths_[k], dq) : bound_.link(items_[k].a, dq) + obstacle_motion;
 }
 
 MotionResult MotionChecker::certified(const double* q0, double t0, const double* q1, double t1, motion_detail::Scratch& ctx,
@@ -455,7 +452,7 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
   // (After the probe: a segment it settles needs no bounds.) Members wait until their group comes within contact.
   for (int k = 0; k < n_items; ++k) {
     if (items_[k].group >= 0) continue;
-    ctx.bound[k] = itemBound(items_[k], ctx.dq.data(), ctx.obstacle_motion);  // (0 when nothing moves: measured once)
+    ctx.bound[k] = itemBound(k, ctx.dq.data(), ctx.obstacle_motion);  // (0 when nothing moves: measured once)
     ctx.safe_until[k] = 0.0;
   }
   if (options_.mode == MotionMode::Cast) castAhead(q0, q1, t0, n_items, ctx, r);

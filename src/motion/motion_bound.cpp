@@ -23,6 +23,15 @@ struct MotionBound::Tables {
   Tables(const Scene& scene, const std::vector<MotionBound::Body>& bodies);
   double link(int link, const double* dq) const noexcept;
   double pair(int a, int b, const double* dq) const noexcept;
+  // Paths of at most this many joints take pair()'s cheapest watching link; longer ones are watched from the fork.
+  static constexpr std::size_t kMaxPath = 128;
+  // Visits the joints on the path between a and b that could move them, in path order (a's side upwards,
+  // then b's downwards), as visit(joint, reach to a, reach to b). False, visiting none, for a path longer than
+  // kMaxPath.
+  template <class F>
+  bool forPath(int a, int b, F&& visit) const noexcept;
+  // The cheapest split of the path's joints' costs: Σ_{k<i} cost_a[k] + Σ_{k≥i} cost_b[k], least over i.
+  static double cheapestSplit(const double* cost_a, const double* cost_b, std::size_t n) noexcept;
   double linkStep(int link, const double* dq, const Pose* poses, double d, double extra) const noexcept;
   // The bound from the velocity field now (below linkStep): f(h) = h·speed + h²·accel/2.
   struct TwistBound {
@@ -376,53 +385,38 @@ double MotionBound::Tables::pairStep(int a, int b, const double* dq, const Pose*
   return t.valid ? std::max(f.solve(d), t.solve(d)) : f.solve(d);
 }
 
-double MotionBound::Tables::pair(int a, int b, const double* dq) const noexcept {
+template <class F>
+bool MotionBound::Tables::forPath(int a, int b, F&& visit) const noexcept {
   // Joints shared by both chains move the pair rigidly. The others lie on the path a → fork → b, and
   // the pair may be watched from any link X on that path: the joints between a and X move a, the rest
   // move b. Each joint costs |Δq| times its reach to the link it moves (for a link above the joint, the
-  // offsets up to the fork and down to that link); the bound is the cheapest X, found in one sweep.
+  // offsets up to the fork and down to that link); pair() takes the cheapest X, found in one sweep.
   const std::vector<int>& ca = chain_[a];
   const std::vector<int>& cb = chain_[b];
   const std::size_t na = ca.size(), nb = cb.size();
   std::size_t fork = 0;
   while (fork < na && fork < nb && ca[fork] == cb[fork]) ++fork;
+  if (na - fork + nb - fork > kMaxPath) return false;
   const std::ptrdiff_t shared = static_cast<std::ptrdiff_t>(fork) - 1;  // the last joint both chains share
   const double side_a = offsets(a, shared, static_cast<std::ptrdiff_t>(na) - 1);
   const double side_b = offsets(b, shared, static_cast<std::ptrdiff_t>(nb) - 1);
-  // Path order: a's joints upwards, then b's downwards. cost_a[k]: the joint moving a; cost_b[k]: moving b.
-  constexpr std::size_t kMaxPath = 128;
-  double cost_a[kMaxPath], cost_b[kMaxPath];
-  std::size_t n = 0;
-  const auto add = [&](int j, double reach_a, double reach_b) {
-    const int v = joint_var_[j];
-    if (v < 0 || dq[v] == 0.0 || joint_mult_[j] == 0.0) return;  // (0·∞ would be NaN)
-    const double w = joint_mult_[j] * std::abs(dq[v]);
-    cost_a[n] = (isSlide(j) ? 1.0 : reach_a) * w;
-    cost_b[n] = (isSlide(j) ? 1.0 : reach_b) * w;
-    ++n;
-  };
-  if (na - fork + nb - fork > kMaxPath) {  // beyond any real robot: watched from the fork
-    double bound = 0.0;
-    for (int side = 0; side < 2; ++side) {
-      const int l = side ? b : a;
-      for (std::size_t k = fork; k < chain_[l].size(); ++k) {
-        const int j = chain_[l][k], v = joint_var_[j];
-        if (v >= 0 && dq[v] != 0.0 && joint_mult_[j] != 0.0)
-          bound += joint_mult_[j] * std::abs(dq[v]) * (isSlide(j) ? 1.0 : joint_reach_[l][k]);
-      }
-    }
-    return bound;
-  }
+  const auto moving = [&](int j) { return joint_var_[j] >= 0 && joint_mult_[j] != 0.0; };  // (0·∞ would be NaN)
   for (std::size_t k = na; k-- > fork;) {
+    if (!moving(ca[k])) continue;
     // From this joint up to the fork, then down to b.
     const double reach_b = radius_[b] + offsets(a, shared, static_cast<std::ptrdiff_t>(k)) + side_b;
-    add(ca[k], joint_reach_[a][k], std::min(reach_b, exactReach(b, ca[k])));
+    visit(ca[k], joint_reach_[a][k], std::min(reach_b, exactReach(b, ca[k])));
   }
   for (std::size_t k = fork; k < nb; ++k) {
+    if (!moving(cb[k])) continue;
     const double reach_a = radius_[a] + offsets(b, shared, static_cast<std::ptrdiff_t>(k)) + side_a;
-    add(cb[k], std::min(reach_a, exactReach(a, cb[k])), joint_reach_[b][k]);
+    visit(cb[k], std::min(reach_a, exactReach(a, cb[k])), joint_reach_[b][k]);
   }
-  // Split after i joints: Σ_{k<i} cost_a + Σ_{k≥i} cost_b, smallest over i, by a suffix sweep.
+  return true;
+}
+
+double MotionBound::Tables::cheapestSplit(const double* cost_a, const double* cost_b, std::size_t n) noexcept {
+  // By a suffix sweep.
   double suffix_b = 0.0;
   double best = INFINITY;
   double prefix_a[kMaxPath + 1];
@@ -435,11 +429,61 @@ double MotionBound::Tables::pair(int a, int b, const double* dq) const noexcept 
   return best;
 }
 
+double MotionBound::Tables::pair(int a, int b, const double* dq) const noexcept {
+  double cost_a[kMaxPath], cost_b[kMaxPath];
+  std::size_t n = 0;
+  const bool within = forPath(a, b, [&](int j, double reach_a, double reach_b) {
+    const int v = joint_var_[j];
+    if (dq[v] == 0.0) return;
+    const double w = joint_mult_[j] * std::abs(dq[v]);
+    cost_a[n] = (isSlide(j) ? 1.0 : reach_a) * w;
+    cost_b[n] = (isSlide(j) ? 1.0 : reach_b) * w;
+    ++n;
+  });
+  if (within) return cheapestSplit(cost_a, cost_b, n);
+  // Beyond any real robot: watched from the fork.
+  std::size_t fork = 0;
+  while (fork < chain_[a].size() && fork < chain_[b].size() && chain_[a][fork] == chain_[b][fork]) ++fork;
+  double bound = 0.0;
+  for (int side = 0; side < 2; ++side) {
+    const int l = side ? b : a;
+    for (std::size_t k = fork; k < chain_[l].size(); ++k) {
+      const int j = chain_[l][k], v = joint_var_[j];
+      if (v >= 0 && dq[v] != 0.0 && joint_mult_[j] != 0.0)
+        bound += joint_mult_[j] * std::abs(dq[v]) * (isSlide(j) ? 1.0 : joint_reach_[l][k]);
+    }
+  }
+  return bound;
+}
+
 
 MotionBound::MotionBound(const Scene& scene, const std::vector<Body>& bodies)
     : t_(std::make_shared<const Tables>(scene, bodies)) {}
 double MotionBound::link(int link, const double* dq) const noexcept { return t_->link(link, dq); }
 double MotionBound::pair(int a, int b, const double* dq) const noexcept { return t_->pair(a, b, dq); }
+MotionBound::PairPath MotionBound::path(int a, int b) const {
+  PairPath p;
+  p.a_ = a, p.b_ = b;
+  const Tables& t = *t_;
+  p.long_ = !t.forPath(a, b, [&](int j, double reach_a, double reach_b) {
+    const bool slide = t.isSlide(j);
+    p.joints_.push_back({t.joint_var_[j], t.joint_mult_[j], slide ? 1.0 : reach_a, slide ? 1.0 : reach_b});
+  });
+  return p;
+}
+double MotionBound::pair(const PairPath& path, const double* dq) const noexcept {
+  if (path.long_) return t_->pair(path.a_, path.b_, dq);
+  double cost_a[Tables::kMaxPath], cost_b[Tables::kMaxPath];
+  std::size_t n = 0;
+  for (const PairPath::Joint& j : path.joints_) {  // (as Tables::pair: the same products, the same sums)
+    if (dq[j.var] == 0.0) continue;
+    const double w = j.mult * std::abs(dq[j.var]);
+    cost_a[n] = j.to_a * w;
+    cost_b[n] = j.to_b * w;
+    ++n;
+  }
+  return Tables::cheapestSplit(cost_a, cost_b, n);
+}
 double MotionBound::linkStep(int link, const double* dq, const Pose* poses, double d, double extra) const noexcept {
   return t_->linkStep(link, dq, poses, d, extra);
 }

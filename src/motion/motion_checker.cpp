@@ -80,6 +80,16 @@ MotionChecker::MotionChecker(std::shared_ptr<const Scene> scene, MotionOptions o
   }
   buildItems();
   buildItemTables();
+  const std::vector<int>& begin = bodies_.parts_begin;
+  for (int k = 0; k < env_begin_; ++k) {
+    const Item& it = items_[k];
+    paths_.push_back(bound_.path(it.a, it.b));
+    std::vector<MotionBound::PairPath> split;
+    const int na = static_cast<int>(it.ga->parts().size()), nb = static_cast<int>(it.gb->parts().size());
+    for (int i = 0; i < na; ++i) split.push_back(bound_.path(begin[it.a] + i, it.b));
+    for (int j = 0; j < nb; ++j) split.push_back(bound_.path(it.a, begin[it.b] + j));
+    split_paths_.push_back(std::move(split));
+  }
 }
 
 void MotionChecker::buildItemTables() {

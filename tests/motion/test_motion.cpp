@@ -1241,6 +1241,42 @@ TEST(MotionCertified, MovingObstaclesNeverMissWhatDenseSamplingFinds) {
   EXPECT_LE(extras, segments / 20) << "said colliding far more often than dense sampling finds (contact_distance is 1 mm)";
 }
 
+// pair(path(a, b), dq), the certified check's form (its paths set up once), is pair(a, b, dq) to the bit: on
+// our robots (a forked twin arm, a planar rover and a floating flyer, with their unbounded slides) and the
+// shared ones, for every pair of links and of the links' convex parts, over random steps that leave some
+// joints still.
+TEST(MotionBound, PathsGiveThePairBoundExactly) {
+  std::mt19937 rng(31);
+  long compared = 0;
+  const auto check = [&](const std::string& file) {
+    const auto scene = Scene::load(file);
+    std::vector<MotionBound::Body> parts;
+    for (const int l : scene->geometry().geometricLinks())
+      for (const LinkGeometry::Part& part : scene->geometry().link(l)->parts())
+        parts.push_back({l, &part.hull, part.center, part.radius});
+    const MotionBound bound(*scene, parts);
+    const int links = scene->robot().linkCount() + static_cast<int>(parts.size()), n = scene->dimension();
+    std::vector<double> q0(n), q1(n), dq(n);
+    for (int trial = 0; trial < 20; ++trial) {
+      randomStep(*scene, rng, q0, q1, dq);
+      for (int i = 0; i < n; ++i)
+        if (trial % 3 == 0 && rng() % 3 == 0) dq[i] = 0.0;
+      for (int a = 0; a < links; a += 1 + (trial + a) % 3)
+        for (int b = 0; b < links; ++b) {
+          const MotionBound::PairPath path = bound.path(a, b);
+          EXPECT_EQ(bound.pair(path, dq.data()), bound.pair(a, b, dq.data())) << file << ": " << a << " / " << b;
+          ++compared;
+        }
+    }
+  };
+  for (const char* f : {"arm6_wall", "twin_arm_table", "rover_gap", "flyer_post"})
+    check(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/" + f + ".yaml");
+  EXPECT_GT(compared, 5000);
+  CLEARWAY_REQUIRE_SHARED("robots/panda/panda.urdf");
+  CLEARWAY_SHARED_OR_SKIP(root, "scenes");
+  for (const char* f : {"box_panda/box_panda_0001.yaml", "box_ur5/box_ur5_0001.yaml"}) check(root + "/" + f);
+}
+
 // A link's convex parts as links of the bound of their own (as the certified check splits a pair whose
 // hulls are near): no distance between a part's hull vertices and the other link's changes by more than
 // pair(part, other) says; and a part next to the axes that turn it gets a bound well below its link's

@@ -53,6 +53,21 @@ class MotionBound {
   double link(int link, const double* dq) const noexcept;
   /// Upper bound on how much the distance between links a and b can change for the step dq.
   double pair(int a, int b, const double* dq) const noexcept;
+  /// The joints between two links and their reaches to either, set up once by path(a, b) for pair(path, dq).
+  class PairPath {
+    friend class MotionBound;
+    struct Joint {
+      int var;        // the state entry that drives it
+      double mult;    // |multiplier| (a mimic's), else 1
+      double to_a, to_b;  // its reach to a and to b (1 for a slide)
+    };
+    std::vector<Joint> joints_;  // in path order: a's side upwards, then b's downwards
+    int a_ = -1, b_ = -1;
+    bool long_ = false;  // longer than any real robot's: pair(a, b, dq) answers
+  };
+  PairPath path(int a, int b) const;
+  /// pair(a, b, dq) for path(a, b), the same number, without walking the chains for every step.
+  double pair(const PairPath& path, const double* dq) const noexcept;
   /// The largest h (possibly above 1, or ∞) such that, for the step ±h·dq from the state whose link poses
   /// are `poses` (the link's and its ancestors' at least), no point of the link moves d or farther: the
   /// reaches measured from where the joint axes are now (a point's distance from joint k's axis changes
@@ -219,8 +234,8 @@ class MotionChecker {
   };
   // Fills items_: groups where two bodies' every link pair (or a body's every link) is checked.
   void buildItems();
-  // The item's motion bound for the step dq.
-  double itemBound(const Item& item, const double* dq, double obstacle_motion) const noexcept;
+  // Item k's motion bound for the step dq.
+  double itemBound(int k, const double* dq, double obstacle_motion) const noexcept;
   struct Sweep;  // certified.cpp
 
   void validateOptions() const;
@@ -229,6 +244,10 @@ class MotionChecker {
   Bodies bodies_;
   MotionBound bound_;
   std::vector<Item> items_;  // self groups and their members, other self pairs; then the same for the environment
+  // Per self item: the path between its links, and those from each of a's parts to b and from a to each of
+  // b's parts (a's first), for the bound's pair().
+  std::vector<MotionBound::PairPath> paths_;
+  std::vector<std::vector<MotionBound::PairPath>> split_paths_;
   int env_begin_ = 0;        // the first environment item
   CollisionReport rigid_collision_;  // a self pair within one rigid body that collides (then every state does)
   double obstacle_speed_ = 0.0;   // the fastest obstacle's speed (m/s)
