@@ -24,6 +24,7 @@
 #include <exception>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,7 @@ namespace {
 namespace ob = ompl::base;
 namespace og = ompl::geometric;
 using clearway::Scene;
+using clearway::SceneDescription;
 using clearway::StateMap;
 using Clock = std::chrono::steady_clock;
 
@@ -108,9 +110,14 @@ struct Sampled {
 
 void replay(const std::string& file, int seeds) {
   const auto scene = Scene::load(file);
+  const SceneDescription& d = scene->description();
+  const std::size_t dimension = static_cast<std::size_t>(scene->dimension());
+  if (d.start.size() != dimension || d.goal.size() != dimension)
+    throw std::invalid_argument(file + ": the scene needs a start and a goal of " + std::to_string(dimension) + " values");
   const StateMap map(*scene);
   std::vector<Segment> segments;
   double solve_us = 0.0, motion_us = 0.0, state_us = 0.0;
+  int solved = 0;
   for (int seed = 1; seed <= seeds; ++seed) {
     ompl::RNG::setSeed(seed);
     og::SimpleSetup setup(clearway::makeStateSpace(*scene));
@@ -120,46 +127,51 @@ void replay(const std::string& file, int seeds) {
     si->setStateValidityChecker(counter);
     si->setMotionValidator(std::make_shared<Recorder>(si, cc.motion, map, segments, motion_us));
     ob::ScopedState<> start(setup.getStateSpace()), goal(setup.getStateSpace());
-    map.fromVector(scene->description().start.data(), start.get());
-    map.fromVector(scene->description().goal.data(), goal.get());
+    map.fromVector(d.start.data(), start.get());
+    map.fromVector(d.goal.data(), goal.get());
     setup.setStartAndGoalStates(start, goal);
     setup.setPlanner(std::make_shared<og::RRTConnect>(si));
     setup.setup();
     const Clock::time_point t = Clock::now();
-    setup.solve(ob::timedPlannerTerminationCondition(30.0));
+    // (A condition without a checking thread: SimpleSetup::solve(seconds) starts one, about a millisecond.)
+    solved += setup.solve(ob::timedPlannerTerminationCondition(30.0)) == ob::PlannerStatus::EXACT_SOLUTION;
     solve_us += microseconds(t);
     state_us += counter->us;
   }
-  // The replay: [free][kind] with kind 0 certified, 1 sampled over Clearway, 2 sampled over FCL.
+  // The replay: [free][kind] with kind 0 certified, 1 sampled over Clearway, 2 sampled over FCL. One checker
+  // over all the segments at a time: interleaved per segment, each would evict the others' data.
   const clearway::MotionChecker certified(scene);
   clearway::MotionContext context = certified.makeContext();
   Sampled ours(*scene, [&](const ob::SpaceInformationPtr& si) { return std::make_shared<clearway::ValidityChecker>(si, scene); });
   Sampled fcl(*scene, [&](const ob::SpaceInformationPtr& si) { return std::make_shared<clearway::bench::FclValidity>(si, scene); });
   double us[2][3] = {}, queries[2] = {}, states[2] = {};
   long count[2] = {};
-  ob::ScopedState<> a(ours.setup.getStateSpace()), b(ours.setup.getStateSpace());
-  for (const Segment& s : segments) {
-    Clock::time_point t = Clock::now();
-    const clearway::MotionResult r = certified.check(s.from.data(), s.to.data(), context, false);
-    const double certified_us = microseconds(t);
-    const int f = r.free ? 1 : 0;
+  std::vector<int> is_free(segments.size());
+  for (std::size_t i = 0; i < segments.size(); ++i) {
+    const Clock::time_point t = Clock::now();
+    const clearway::MotionResult r = certified.check(segments[i].from.data(), segments[i].to.data(), context, false);
+    const double spent = microseconds(t);
+    const int f = is_free[i] = r.free ? 1 : 0;
     ++count[f];
-    us[f][0] += certified_us;
+    us[f][0] += spent;
     queries[f] += r.distance_queries;
-    map.fromVector(s.from.data(), a.get());
-    map.fromVector(s.to.data(), b.get());
-    const long before = ours.counter->calls;
-    t = Clock::now();
-    ours.motion->checkMotion(a.get(), b.get());
-    us[f][1] += microseconds(t);
-    states[f] += static_cast<double>(ours.counter->calls - before);
-    t = Clock::now();
-    fcl.motion->checkMotion(a.get(), b.get());
-    us[f][2] += microseconds(t);
   }
-  std::printf("%s: %d runs, solve %.0f us per run: motion checks %.0f%%, state checks %.0f%%, the rest %.0f%%\n",
-              scene->name().c_str(), seeds, solve_us / seeds, 100.0 * motion_us / solve_us, 100.0 * state_us / solve_us,
-              100.0 * (solve_us - motion_us - state_us) / solve_us);
+  ob::ScopedState<> a(ours.setup.getStateSpace()), b(ours.setup.getStateSpace());
+  for (int kind = 1; kind <= 2; ++kind) {
+    Sampled& sampled = kind == 1 ? ours : fcl;
+    for (std::size_t i = 0; i < segments.size(); ++i) {
+      map.fromVector(segments[i].from.data(), a.get());
+      map.fromVector(segments[i].to.data(), b.get());
+      const long before = sampled.counter->calls;
+      const Clock::time_point t = Clock::now();
+      sampled.motion->checkMotion(a.get(), b.get());
+      us[is_free[i]][kind] += microseconds(t);
+      if (kind == 1) states[is_free[i]] += static_cast<double>(sampled.counter->calls - before);
+    }
+  }
+  std::printf("%s: %d runs (%d solved), solve %.0f us per run: motion checks %.0f%%, state checks %.0f%%, the rest %.0f%%\n",
+              scene->name().c_str(), seeds, solved, solve_us / seeds, 100.0 * motion_us / solve_us,
+              100.0 * state_us / solve_us, 100.0 * (solve_us - motion_us - state_us) / solve_us);
   for (int f = 1; f >= 0; --f) {
     const double n = static_cast<double>(std::max(1L, count[f]));
     std::printf("  %-9s %6ld motions: certified %6.1f us (%.1f queries) | 1%% sampled: %.1f states, over Clearway %6.1f us, "
@@ -167,13 +179,14 @@ void replay(const std::string& file, int seeds) {
                 f ? "free" : "colliding", count[f], us[f][0] / n, queries[f] / n, states[f] / n, us[f][1] / n,
                 us[f][2] / n, us[f][2] / std::max(1e-9, us[f][0]));
   }
-  const double certified_all = us[0][0] + us[1][0], fcl_all = us[0][2] + us[1][2];
-  // Planning over FCL, estimated: its motions as replayed, its state checks as ours scaled by the sampled
-  // replays' ratio, and the same rest.
-  std::printf("  all motions: FCL/certified %.2f; planning, estimated with the rest of the solve: %.2f\n",
-              fcl_all / std::max(1e-9, certified_all),
-              (fcl_all + state_us * fcl_all / std::max(1e-9, us[0][1] + us[1][1]) + (solve_us - motion_us - state_us)) /
-                  std::max(1e-9, solve_us));
+  // Planning over FCL, estimated from this solve: its motion checks at the replays' ratio to the certified
+  // ones, its state checks at the sampled replays' ratio (FCL's state check to ours), the same rest. (The
+  // Recorder's copies count as the rest: well under 1%.)
+  const double certified_all = us[0][0] + us[1][0], fcl_all = us[0][2] + us[1][2], ours_all = us[0][1] + us[1][1];
+  const double motion_ratio = fcl_all / std::max(1e-9, certified_all), state_ratio = fcl_all / std::max(1e-9, ours_all);
+  const double rest = solve_us - motion_us - state_us;
+  std::printf("  all motions: FCL/certified %.2f; planning, estimated: %.2f\n", motion_ratio,
+              (motion_ratio * motion_us + state_ratio * state_us + rest) / std::max(1e-9, solve_us));
 }
 
 }  // namespace
@@ -184,8 +197,13 @@ int main(int argc, char** argv) {
     return 2;
   }
   ompl::msg::setLogLevel(ompl::msg::LOG_NONE);
+  const int seeds = std::atoi(argv[1]);
+  if (seeds < 1) {
+    std::fprintf(stderr, "%s: SEEDS must be a whole number of at least 1, not '%s'\n", argv[0], argv[1]);
+    return 2;
+  }
   try {
-    for (int i = 2; i < argc; ++i) replay(argv[i], std::atoi(argv[1]));
+    for (int i = 2; i < argc; ++i) replay(argv[i], seeds);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_plan_replay: %s\n", e.what());
     return 1;

@@ -385,7 +385,7 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
   const double reach = link.sphereRadius() * (1.0 + 1e-12) + 8.0 * std::numeric_limits<double>::epsilon() *
                                                              (link.sphereCenter().norm() + pose.t.norm());
   const Aabb link_box = Aabb::fromCenterHalf(centre, Vec3::Constant(reach));
-  // (|centre| + reach is the box's largest coordinate, within an ulp: it only sizes the band.)
+  // (max |centre_i| + reach is the box's largest coordinate: rounding to nearest is monotone and symmetric.)
   const double extent = std::max({std::abs(centre.x()), std::abs(centre.y()), std::abs(centre.z())}) + reach;
   const double slack = padding + bandOf(scale_ + extent + padding, tol);
   const Aabb query = link_box.inflated(slack);

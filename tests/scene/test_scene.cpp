@@ -538,6 +538,7 @@ void expectLeadKeepsVerdicts(const Scene& scene, const std::string& what, std::m
       for (int i = 0; i < scene.dimension(); ++i)
         q[i] = std::clamp(q[i] + std::normal_distribution<double>(0.0, 0.15)(rng), scene.lower(i), scene.upper(i));
       CollisionReport a, b;
+      if (step == 7) kept.env_last_hit = walk % 2 ? 1000 : -5;  // (a context of another scene's: out of range)
       const bool led = scene.isFree(q.data(), kept, &a);
       ASSERT_EQ(led, fresh(b)) << what << " walk " << walk << " step " << step;
       if (led || a.kind != CollisionReport::Kind::Environment) continue;

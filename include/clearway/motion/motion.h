@@ -53,18 +53,20 @@ class MotionBound {
   double link(int link, const double* dq) const noexcept;
   /// Upper bound on how much the distance between links a and b can change for the step dq.
   double pair(int a, int b, const double* dq) const noexcept;
-  /// The joints between two links and their reaches to either, set up once by path(a, b) for pair(path, dq).
+  /// The joints between two links and their reaches to either, set up once by path(a, b) for pair(path, dq)
+  /// (a default-made one is no path: pair() gives it 0).
   class PairPath {
     friend class MotionBound;
     struct Joint {
       int var;        // the state entry that drives it
-      double mult;    // |multiplier| (a mimic's), else 1
+      double mult;    // |multiplier| of a mimic, kSpin for a spin, else 1
       double to_a, to_b;  // its reach to a and to b (1 for a slide)
     };
     std::vector<Joint> joints_;  // in path order: a's side upwards, then b's downwards
     int a_ = -1, b_ = -1;
     bool long_ = false;  // longer than any real robot's: pair(a, b, dq) answers
   };
+  /// The path between links a and b (bodies too), for pair(path, dq).
   PairPath path(int a, int b) const;
   /// pair(a, b, dq) for path(a, b), the same number, without walking the chains for every step.
   double pair(const PairPath& path, const double* dq) const noexcept;
