@@ -176,7 +176,9 @@ int runPlan(const PlanSettings& s) {
             << (scene->environment().map() ? ", an OctoMap" : "") << "; checks: " << scene->effects().toString()
             << "\n";
   const auto t0 = std::chrono::steady_clock::now();
-  const ob::PlannerStatus status = setup.solve(time_limit);
+  // A condition that reads the clock where the planner asks: SimpleSetup::solve(seconds) starts a thread to
+  // watch the limit for runs of a second or more, which costs milliseconds, more than many a solve.
+  const ob::PlannerStatus status = setup.solve(ob::timedPlannerTerminationCondition(time_limit));
   const double solve_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (status != ob::PlannerStatus::EXACT_SOLUTION) {
     std::cerr << "clearway plan: " << planner_name << " found no path in " << time_limit << " s (" << status.asString()
