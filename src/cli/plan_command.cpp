@@ -33,6 +33,7 @@
 #include <chrono>
 #include <cstdio>
 #include <functional>
+#include <iomanip>
 #include <iostream>
 #include <map>
 
@@ -182,7 +183,7 @@ int runPlan(const PlanSettings& s) {
   const double solve_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (status != ob::PlannerStatus::EXACT_SOLUTION) {
     std::cerr << "clearway plan: " << planner_name << " found no path in " << time_limit << " s (" << status.asString()
-              << ")\n";
+              << "; planned for " << std::fixed << std::setprecision(3) << solve_s << " s)\n";
     return kExitNo;
   }
   const auto states_before = checking.validity->counters().states.load();
