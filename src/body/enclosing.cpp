@@ -28,6 +28,7 @@ EnclosingBalls::EnclosingBalls(const RobotGeometry& geometry) : geometry_(&geome
   bound_z_.assign(n, 0.0);
   bound_r_.assign(n, std::numeric_limits<double>::infinity());
   bound_norm_.assign(n, 0.0);
+  for (const Vec3& c : local_) local_norms_.push_back(c.norm());
   centers_.assign(local_.size(), Vec3::Constant(std::numeric_limits<double>::quiet_NaN()));
   norms_.assign(local_.size(), std::numeric_limits<double>::quiet_NaN());
 }

@@ -357,10 +357,6 @@ Aabb placedBox(const Shape& shape, const Pose& pose) noexcept {
   return std::visit([&](const auto& s) { return placedBox(s, pose); }, shape);
 }
 
-double narrowBand(double scale, const Tolerances& tol) noexcept {
-  return std::max(tol.gjk_absolute, 64.0 * std::numeric_limits<double>::epsilon()) * scale;
-}
-
 namespace {
 double partsBound(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
                   const Tolerances& tol, double enough, double relative, SimplexCache* caches) noexcept;

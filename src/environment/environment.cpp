@@ -18,8 +18,10 @@
 #include <clearway/shape/support.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <utility>
@@ -57,6 +59,13 @@ double maxAbs(const Aabb& b) noexcept {
 
 // The culls' band: four times the narrow phase's, for the roundings of placing boxes in the world.
 double bandOf(double scale, const Tolerances& tol) noexcept { return 4.0 * narrowBand(scale, tol); }
+
+// The radius of the link's bounding ball placed by `pose` (centre pose · sphereCenter()), grown by the
+// rounding of that product (R·c + t rounds by a few ulps of |c| + |t|).
+double ballReach(const LinkGeometry& link, const Pose& pose) noexcept {
+  return link.sphereRadius() * (1.0 + 1e-12) +
+         8.0 * std::numeric_limits<double>::epsilon() * (link.sphereCenter().norm() + pose.t.norm());
+}
 
 bool obstacleIntersects(const Obstacle& o, const Pose& pose_o, const LinkGeometry& link, const Pose& pose,
                         const Tolerances& tol, GeometryMode mode, double padding) noexcept {
@@ -162,8 +171,49 @@ Environment Environment::withMap(std::shared_ptr<const OccupancyMap> map) const 
   return e;
 }
 
-void Environment::rescale() noexcept {
+struct Environment::Clearance {
+  std::atomic<const ClearanceGrid*> ready{nullptr};  // published once `grid` is whole
+  std::atomic<int> asked{0};
+  std::once_flag once;
+  std::unique_ptr<const ClearanceGrid> grid;
+};
+
+void Environment::rescale() {
   scale_ = std::max(maxAbs(static_.bounds()), voxel_tree_ ? maxAbs(voxel_tree_->bounds()) : 0.0);
+  clearance_ = std::make_shared<Clearance>();
+}
+
+const ClearanceGrid* Environment::clearanceGrid() const noexcept {
+  return clearance_ ? clearance_->ready.load(std::memory_order_acquire) : nullptr;
+}
+
+const ClearanceGrid* Environment::clearanceFor(bool asked) const noexcept {
+  if (!clearance_) return nullptr;
+  if (const ClearanceGrid* g = clearance_->ready.load(std::memory_order_acquire)) return g;
+  // One query, the one that reaches the count, builds it; the others go on without it meanwhile.
+  if (asked && clearance_->asked.fetch_add(1, std::memory_order_relaxed) == kClearanceAfter) prepareClearanceGrid();
+  return nullptr;
+}
+
+void Environment::prepareClearanceGrid() const noexcept {
+  if (!clearance_) return;
+  Clearance& c = *clearance_;
+  try {
+    std::call_once(c.once, [&] {
+      std::vector<Aabb> boxes;
+      static_.forEach([&](const Static&, const Aabb& box) { boxes.push_back(box); });
+      if (map_) boxes.insert(boxes.end(), map_->occupied.begin(), map_->occupied.end());
+      c.grid = std::make_unique<const ClearanceGrid>(boxes);
+      c.ready.store(c.grid.get(), std::memory_order_release);
+    });
+  } catch (...) {  // (out of memory: the queries go on through the trees)
+  }
+}
+
+Environment Environment::withoutClearanceGrid() const {
+  Environment e = *this;
+  e.clearance_.reset();
+  return e;
 }
 
 std::vector<std::shared_ptr<const Obstacle>> Environment::obstacles() const {
@@ -382,16 +432,16 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
   // The box of the link's bounding ball: a dozen operations where placing its box costs ten times more,
   // and as tight for most links (R·c + t rounds by a few ulps of |c| + |t|).
   const Vec3 centre = pose * link.sphereCenter();
-  const double reach = link.sphereRadius() * (1.0 + 1e-12) + 8.0 * std::numeric_limits<double>::epsilon() *
-                                                             (link.sphereCenter().norm() + pose.t.norm());
+  const double reach = ballReach(link, pose);
   const Aabb link_box = Aabb::fromCenterHalf(centre, Vec3::Constant(reach));
   // (max |centre_i| + reach is the box's largest coordinate: rounding to nearest is monotone and symmetric.)
   const double extent = std::max({std::abs(centre.x()), std::abs(centre.y()), std::abs(centre.z())}) + reach;
-  const double slack = padding + bandOf(scale_ + extent + padding, tol);
+  const double slack = linkSlack(padding, extent, tol);
   const Aabb query = link_box.inflated(slack);
   // Most links of a state overlap no item's box at all: the trees alone say so, before the culls and hull
   // tests below are set up (which cost more than the walk). Moving obstacles take the full path.
   if (moving_.empty()) {
+    clearanceFor(true);  // (counts the query; Scene::isFree asks clearsBall() before it calls here)
     const auto any = [](const auto&...) { return true; };
     if (!static_.query(query, any) && !(voxel_tree_ && voxel_tree_->query(query, any))) return false;
   }
@@ -566,6 +616,12 @@ double Environment::hullLowerBound(const LinkGeometry& link, const Pose& pose, c
                                    SimplexCache* warm, bool by_parts) const noexcept {
   if (!pose.isFinite() || !std::isfinite(t) || !(enough >= 0.0) || !(relative >= 0.0) || !std::isfinite(relative))
     return 0.0;
+  // The link's ball beyond `enough` of every static item: all that is asked (a conservative advancement
+  // far from obstacles asks nothing more).
+  if (moving_.empty())
+    if (const ClearanceGrid* grid = clearanceFor(true);
+        grid && grid->lowerBound(pose * link.sphereCenter()) - ballReach(link, pose) >= enough)
+      return enough;
   double lower = enough;  // the least bound so far: items certainly beyond it cannot lower it
   const auto measure = [&](const auto& shape, const Pose& pose_o, SimplexCache* cache) {
     SimplexCache cold;

@@ -1,5 +1,7 @@
 #include <clearway/scene/scene.h>
 
+#include <clearway/body/enclosing.h>
+
 #include <clearway/detail/per_thread.h>
 
 #include <clearway/kinematics/attached_body.h>
@@ -422,10 +424,36 @@ bool Scene::isFree(const double* state, SceneContext& ctx, CollisionReport* repo
 bool Scene::posedFree(const Pose* poses, const double* q, SceneContext& ctx, CollisionReport& r,
                       double t) const noexcept {
   const Effects& fx = description_.effects;
+  bool balls_placed = false;
   if (fx.environment && !environment_->empty()) {
     const double time = fx.moving ? t : 0.0;
+    // Once the environment has its clearance grid, the enclosing balls (placed here for the self check
+    // too) clear most links with a look-up each: the bounding ball, else every part's ball (whose union
+    // holds the link, but not the inside of a closed mesh, which only the bounding ball holds).
+    const Environment& env = *environment_;
+    EnclosingBalls& balls = ctx.self.balls;
+    const ClearanceGrid* grid = env.hasMovingObstacles() ? nullptr : env.clearanceGrid();
+    if (grid && !(balls_placed = self_.placeBalls(poses, ctx.self))) grid = nullptr;
+    const auto cleared = [&](int i) {
+      const int n = balls.ballCount(i);
+      if (n == 0) return false;
+      const EnclosingBalls::Placed bound = balls.placed(i, 0);
+      const double slack = env.linkSlack(link_padding_[i], bound.center.cwiseAbs().maxCoeff() + bound.radius,
+                                         options_.tolerances);
+      if (grid->lowerBound(bound.center) > bound.radius + slack) return true;
+      if (n == 1 || geometry_->link(i)->solidCount() > 0) return false;
+      for (int k = 1; k < n; ++k) {
+        const EnclosingBalls::Placed part = balls.placed(i, k);
+        if (!(grid->lowerBound(part.center) > part.radius + slack)) return false;
+      }
+      return true;
+    };
     const auto hits = [&](int k) {
       const int i = env_links_[k];
+      if (grid && cleared(i)) {
+        ++ctx.counters.environment.grid_clears;
+        return false;
+      }
       EnvironmentHit hit;
       if (!environment_->linkIntersects(*geometry_->link(i), poses[i], options_.tolerances, options_.mode,
                                         link_padding_[i], time, &hit, &ctx.counters.environment))
@@ -446,7 +474,7 @@ bool Scene::posedFree(const Pose* poses, const double* q, SceneContext& ctx, Col
   }
   if (fx.self) {
     const long long before = ctx.self.pair_tests;
-    const LinkPair* hit = self_.firstCollision(poses, ctx.self, q);
+    const LinkPair* hit = self_.firstCollision(poses, ctx.self, q, balls_placed);
     ctx.counters.self_pair_tests += ctx.self.pair_tests - before;
     if (hit) {
       r.kind = CollisionReport::Kind::Self;

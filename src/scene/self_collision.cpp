@@ -87,7 +87,8 @@ bool SelfCollision::pairExactly(int k, const Pose* poses) const noexcept {
                                 options_.tolerances, pair_padding_[k]);
 }
 
-const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionContext& ctx, const double* q) const noexcept {
+const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionContext& ctx, const double* q,
+                                              bool balls_placed) const noexcept {
   const int n = static_cast<int>(pairs_.size());
   // The tables first: a pair they prove colliding ends the query before any geometry is placed.
   // A witness (two triangles that touched at the centre of the pair's unsure cell) proves a collision
@@ -106,7 +107,7 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
                                       options_.tolerances, pair_padding_[k]))
         return hit(k, ctx);
     }
-  const bool balls = placeBalls(poses, ctx);
+  const bool balls = balls_placed || placeBalls(poses, ctx);
   // The enclosing layer's first rung for every pair at once (SIMD lanes): most pairs end here.
   const bool bounds = balls && ctx.bounds_apart.size() == pairs_.size();
   if (bounds)

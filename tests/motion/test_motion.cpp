@@ -1718,5 +1718,48 @@ TEST(MotionCertified, VerdictDependsOnlyOnTheSegment) {
   EXPECT_LT(verdict_queries, located_queries) << "the verdict alone should stop sooner on colliding segments";
 }
 
+// Certified motions with the environment's clearance grid (which settles a link's measurement when its
+// ball is beyond what the step needs) and without: the same verdicts on random segments of our arm and of
+// every shared family, primitive and OctoMap forms.
+TEST(MotionCertified, TheClearanceGridChangesNoVerdict) {
+  std::vector<std::string> scenes = {std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/arm6_wall.yaml"};
+  const std::string root = test::sharedPath("scenes");
+  if (!root.empty())
+    for (const auto& family : std::filesystem::directory_iterator(root)) {
+      if (!family.is_directory()) continue;
+      const std::string stem = family.path().string() + "/" + family.path().filename().string() + "_0001";
+      for (const std::string form : {".yaml", ".octomap.yaml"})
+        if (std::filesystem::exists(stem + form)) scenes.push_back(stem + form);
+    }
+  std::mt19937 rng(31);
+  int colliding = 0, total = 0;
+  for (const std::string& path : scenes) {
+    const auto with = Scene::load(path);
+    const auto without = with->withEnvironment(std::make_shared<Environment>(with->environment().withoutClearanceGrid()));
+    with->environment().prepareClearanceGrid();
+    const MotionChecker a(with), b(without);
+    MotionContext ca = a.makeContext(), cb = b.makeContext();
+    SceneContext sc = with->makeContext();
+    const int d = with->dimension();
+    std::vector<double> q0(d), q1(d);
+    for (int k = 0; k < 40;) {
+      for (int i = 0; i < d; ++i) {
+        const double lo = std::max(with->lower(i), -M_PI), hi = std::min(with->upper(i), M_PI);
+        q0[i] = std::uniform_real_distribution<double>(lo, hi)(rng);
+        q1[i] = std::clamp(q0[i] + std::uniform_real_distribution<double>(-0.6, 0.6)(rng), lo, hi);
+      }
+      if (!with->isFree(q0.data(), sc) || !with->isFree(q1.data(), sc)) continue;
+      ++k;
+      const bool fa = a.check(q0.data(), q1.data(), ca, false).free, fb = b.check(q0.data(), q1.data(), cb, false).free;
+      ASSERT_EQ(fa, fb) << path << " segment " << k;
+      colliding += !fa;
+      ++total;
+    }
+  }
+  EXPECT_GT(colliding, 0) << "no segment collided: the test shows nothing near obstacles";
+  std::printf("%d of %d segments collide, with and without the grid\n", colliding, total);
+  CLEARWAY_REQUIRE_SHARED("scenes");  // (our arm is checked either way)
+}
+
 }  // namespace
 }  // namespace clearway

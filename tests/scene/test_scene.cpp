@@ -572,5 +572,55 @@ TEST(Scene, TheLinkThatHitLastGoesFirstAndNoVerdictChanges) {
   std::printf("the lead changed the reported link on %d colliding states\n", changed);
 }
 
+// The same states with the environment's clearance grid and without: every verdict, and what each report
+// names, equal; one at a time and batched. Half the states are random, half walk near obstacles.
+void expectGridKeepsVerdicts(const std::shared_ptr<const Scene>& with, const std::string& what, std::mt19937& rng,
+                             long long& clears) {
+  const auto without = with->withEnvironment(std::make_shared<Environment>(with->environment().withoutClearanceGrid()));
+  with->environment().prepareClearanceGrid();
+  ASSERT_NE(with->environment().clearanceGrid(), nullptr) << what;
+  SceneContext a = with->makeContext(), b = without->makeContext(), batched = with->makeContext();
+  const int d = with->dimension();
+  std::vector<double> q(d), states;
+  std::vector<char> verdicts;
+  for (int k = 0; k < 600; ++k) {
+    const bool jump = k % 2 == 0 || k % 20 == 1;
+    for (int i = 0; i < d; ++i) {
+      const double lo = std::max(with->lower(i), -M_PI), hi = std::min(with->upper(i), M_PI);
+      q[i] = jump ? std::uniform_real_distribution<double>(lo, hi)(rng)
+                  : std::clamp(q[i] + std::normal_distribution<double>(0.0, 0.1)(rng), with->lower(i), with->upper(i));
+    }
+    CollisionReport ra, rb;
+    const bool fa = with->isFree(q.data(), a, &ra), fb = without->isFree(q.data(), b, &rb);
+    ASSERT_EQ(fa, fb) << what << " state " << k;
+    EXPECT_EQ(ra.kind, rb.kind) << what << " state " << k;
+    EXPECT_EQ(ra.link, rb.link) << what << " state " << k;
+    EXPECT_EQ(ra.other_link, rb.other_link) << what << " state " << k;
+    states.insert(states.end(), q.begin(), q.end());
+    verdicts.push_back(fa);
+  }
+  std::unique_ptr<bool[]> free(new bool[verdicts.size()]);
+  with->areFree(states.data(), static_cast<int>(verdicts.size()), batched, free.get());
+  for (std::size_t k = 0; k < verdicts.size(); ++k) ASSERT_EQ(free[k], verdicts[k] != 0) << what << " batched state " << k;
+  EXPECT_EQ(b.counters.environment.grid_clears, 0) << what;
+  EXPECT_GT(a.counters.environment.grid_clears, 0) << what << ": the grid cleared no link";
+  clears += a.counters.environment.grid_clears;
+}
+
+TEST(Scene, TheClearanceGridChangesNoVerdict) {
+  std::mt19937 rng(29);
+  long long clears = 0;
+  expectGridKeepsVerdicts(Scene::load(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/arm6_wall.yaml"), "arm6_wall",
+                          rng, clears);
+  CLEARWAY_SHARED_SCENES_OR_SKIP();
+  for (const auto& family : std::filesystem::directory_iterator(sharedScenes())) {
+    if (!family.is_directory()) continue;
+    const std::string stem = family.path().string() + "/" + family.path().filename().string() + "_0001";
+    for (const std::string form : {".yaml", ".octomap.yaml"})
+      if (std::filesystem::exists(stem + form)) expectGridKeepsVerdicts(Scene::load(stem + form), stem + form, rng, clears);
+  }
+  std::printf("the grid cleared %lld links\n", clears);
+}
+
 }  // namespace
 }  // namespace clearway

@@ -8,6 +8,7 @@
 #include <clearway/tolerances.h>
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace clearway {
@@ -36,6 +37,27 @@ class EnclosingBalls {
   void boundsApart(const std::int64_t* a, const std::int64_t* b, const double* padding, int n, const Tolerances& tol,
                    std::uint8_t* out) const noexcept;
 
+  /// A ball as placed, world frame.
+  struct Placed {
+    Vec3 center;
+    double radius;  ///< grown by the rounding of the placement: it holds what the link-frame ball held
+  };
+  /// How many balls link i has: 0 without geometry, else its bounding ball and, when it has several
+  /// parts, one per part.
+  int ballCount(int i) const noexcept { return links_[i].count; }
+  /// Link i's ball k as last placed: k = 0 its bounding ball; 1 ≤ k < ballCount(i) its parts' (placed at
+  /// the first such call since place()). The parts' balls together hold the link's surfaces and
+  /// primitives, not the inside of its closed meshes.
+  Placed placed(int i, int k) noexcept {
+    Link& l = links_[i];
+    if (k > 0 && !l.parts_placed) placeParts(i);
+    const int at = l.first + k;
+    // R·c + t rounds by a few ulps of |c| + |t| per coordinate, and |t| ≤ |R·c + t| + |c|: 16 ulps of
+    // 2|c| + |R·c + t| is more than that.
+    const double rounding = 16.0 * std::numeric_limits<double>::epsilon() * (2.0 * local_norms_[at] + norms_[at]);
+    return {centers_[at], radii_[at] * (1.0 + 1e-12) + rounding};
+  }
+
  private:
   struct Link {
     int first = 0;  // its balls in centers_/radii_: [first] the bounding ball, then the parts' balls
@@ -49,6 +71,7 @@ class EnclosingBalls {
   std::vector<Vec3> local_;    // ball centres, link frame
   std::vector<Vec3> centers_;  // ball centres, world frame (as last placed)
   std::vector<double> norms_;   // |centre|, which sizes the rounding band
+  std::vector<double> local_norms_;  // |centre| in the link frame
   std::vector<double> radii_;
   // Per link, its bounding ball as last placed, one array per coordinate for the lanes (a link without
   // geometry: an infinite radius, never apart).

@@ -148,7 +148,9 @@ Aabb placedBox(const Shape& shape, const Pose& pose) noexcept;
 /// The narrow phase's band for a query whose coordinates and sizes are at most `scale` metres: GJK calls
 /// bodies this near touching (tol.gjk_absolute of their size, never below 64 ulps), so a cull by boxes or
 /// axes must keep at least this much.
-double narrowBand(double scale, const Tolerances& tol) noexcept;
+inline double narrowBand(double scale, const Tolerances& tol) noexcept {
+  return std::max(tol.gjk_absolute, 64.0 * std::numeric_limits<double>::epsilon()) * scale;
+}
 
 /// True when a piece of one link lies inside a closed mesh of the other (b placed in a's frame by b_in_a).
 /// Meaningful once their surfaces are known not to meet: then it decides whether the solids overlap.

@@ -77,9 +77,13 @@ class SelfCollision {
   /// The pair that collided in the previous query of this context is tried first (frame coherence).
   /// Never "free" by accident: a non-finite pose collides. q (optional): the configuration the poses were
   /// computed from (every variable of the robot, held ones at their held values), which lets the pair
-  /// tables answer; the verdict is the same with or without it.
-  const LinkPair* firstCollision(const Pose* link_poses, SelfCollisionContext& context,
-                                 const double* q = nullptr) const noexcept;
+  /// tables answer; the verdict is the same with or without it. balls_placed: placeBalls() was last
+  /// called with these very poses (and its answer was true), so they are not placed again.
+  const LinkPair* firstCollision(const Pose* link_poses, SelfCollisionContext& context, const double* q = nullptr,
+                                 bool balls_placed = false) const noexcept;
+  /// Places the context's enclosing balls (body/enclosing.h) at these poses when it has them (a context
+  /// made by makeContext); false otherwise.
+  bool placeBalls(const Pose* link_poses, SelfCollisionContext& context) const noexcept;
   /// Every colliding pair at these poses, appended to `out` in pair order.
   void allCollisions(const Pose* link_poses, SelfCollisionContext& context, std::vector<LinkPair>& out) const;
   /// True when pair index k collides at these poses.
@@ -104,8 +108,6 @@ class SelfCollision {
   }
   // Records pair k as the last hit and returns it.
   const LinkPair* hit(int k, SelfCollisionContext& context) const noexcept;
-  // Places the context's balls when it has them (a context made by makeContext); false otherwise.
-  bool placeBalls(const Pose* link_poses, SelfCollisionContext& context) const noexcept;
 
   std::shared_ptr<const RobotGeometry> geometry_;
   std::vector<LinkPair> pairs_;
