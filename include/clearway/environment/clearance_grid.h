@@ -34,7 +34,8 @@ class ClearanceGrid {
 
   /// A lower bound on the distance from p to every box given: +∞ when there are none; 0 or less proves
   /// nothing (and a non-finite p gives 0).
-  double lowerBound(const Vec3& p) const noexcept {
+  /// (Inlined into the per-link loops that call it: a call costs as much as the look-up.)
+  [[gnu::always_inline]] double lowerBound(const Vec3& p) const noexcept {
     const double slack = slack_ + 1e-9 * p.cwiseAbs().maxCoeff();
     int i[3];
     for (int k = 0; k < 3; ++k) {
