@@ -17,7 +17,7 @@ namespace {
 
 double boxesDistance(const std::vector<Aabb>& boxes, const Vec3& p) {
   double d = std::numeric_limits<double>::infinity();
-  for (const Aabb& b : boxes) d = std::min(d, (b.min - p).cwiseMax(p - b.max).cwiseMax(0.0).norm());
+  for (const Aabb& b : boxes) d = std::min(d, (b.min - p).cwiseMax(p - b.max).cwiseMax(0.0).stableNorm());
   return d;
 }
 
@@ -90,6 +90,17 @@ TEST(ClearanceGrid, EdgeCases) {
   EXPECT_GT(one.lowerBound(Vec3(1, 2, 4.5)), 0.5);  // 1 m above the top face
   EXPECT_LE(one.lowerBound(Vec3(1, 2, 4.5)), 1.0);
   EXPECT_GT(one.lowerBound(Vec3(1, 2, 100)), 96.0);  // outside the grid: the distance to the boxes' box
+  // Boxes near the doubles' end: still never above the distance.
+  const double big = std::numeric_limits<double>::max() / 2;
+  const std::vector<Aabb> far = {Aabb::fromCenterHalf(Vec3(big, 0, 0), Vec3(1, 1, 1)),
+                                 Aabb::fromCenterHalf(Vec3(-big, 0, 0), Vec3(1, 1, 1)),
+                                 Aabb::fromCenterHalf(Vec3(1e200, 1e200, 0), Vec3(1, 1, 1))};
+  const ClearanceGrid huge(far);
+  for (const Vec3& p : {Vec3(0, 0, 0), Vec3(big, 0, 5), Vec3(-big, 3, 0), Vec3(0, big, big), Vec3(1e200, 1e200, 10)}) {
+    const double bound = huge.lowerBound(p);
+    EXPECT_FALSE(std::isnan(bound));
+    EXPECT_LE(bound, boxesDistance(far, p)) << p.transpose();
+  }
   EXPECT_THROW(ClearanceGrid({Aabb()}), std::invalid_argument);
   EXPECT_THROW(ClearanceGrid({Aabb::fromMinMax(Vec3(0, 0, 0), Vec3(nan, 1, 1))}), std::invalid_argument);
   EXPECT_THROW(ClearanceGrid({Aabb::fromMinMax(Vec3(0, 0, 0), Vec3(inf, 1, 1))}), std::invalid_argument);
