@@ -24,6 +24,7 @@
 #include <mutex>
 #include <optional>
 #include <stdexcept>
+#include <type_traits>
 #include <utility>
 
 namespace clearway {
@@ -623,7 +624,20 @@ double Environment::hullLowerBound(const LinkGeometry& link, const Pose& pose, c
         grid && grid->lowerBound(pose * link.sphereCenter()) - ballReach(link, pose) >= enough)
       return enough;
   double lower = enough;  // the least bound so far: items certainly beyond it cannot lower it
+  const Vec3 centre = pose * link.sphereCenter();
+  const double reach = ballReach(link, pose);
   const auto measure = [&](const auto& shape, const Pose& pose_o, SimplexCache* cache) {
+    using S = std::decay_t<decltype(shape)>;
+    if constexpr (std::is_same_v<S, Box>) {
+      // The link's ball (which holds its hull and its parts) against the box, in the box's frame: a box
+      // it shows beyond the bound so far cannot lower it, for a dozen operations where GJK costs hundreds.
+      // (The margin is far above the few roundings of the distance.)
+      const Vec3 c = pose_o.R.transpose() * (centre - pose_o.t);
+      const Vec3 gap = (c.cwiseAbs() - shape.half).cwiseMax(0.0);
+      const double margin =
+          1e-9 * (1.0 + c.cwiseAbs().maxCoeff() + pose_o.t.cwiseAbs().maxCoeff() + centre.cwiseAbs().maxCoeff());
+      if (gap.norm() - reach - margin >= lower) return false;
+    }
     SimplexCache cold;
     if (by_parts) {  // (cold starts: callers ask only when the hull has come within contact)
       for (const LinkGeometry::Part& part : link.parts()) {
