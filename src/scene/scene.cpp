@@ -427,13 +427,12 @@ bool Scene::posedFree(const Pose* poses, const double* q, SceneContext& ctx, Col
   bool balls_placed = false;
   if (fx.environment && !environment_->empty()) {
     const double time = fx.moving ? t : 0.0;
-    // Once the environment has its clearance grid, the enclosing balls (placed here for the self check
-    // too) clear most links with a look-up each: the bounding ball, else every part's ball (whose union
-    // holds the link, but not the inside of a closed mesh, which only the bounding ball holds).
+    // Once the environment has its clearance grid, the enclosing balls (placed after the lead link for
+    // the self check too) clear most links with a look-up each: the bounding ball, else every part's ball
+    // (whose union holds the link, but not the inside of a closed mesh, which only the bounding ball holds).
     const Environment& env = *environment_;
     EnclosingBalls& balls = ctx.self.balls;
-    const ClearanceGrid* grid = env.hasMovingObstacles() ? nullptr : env.clearanceGrid();
-    if (grid && !(balls_placed = self_.placeBalls(poses, ctx.self))) grid = nullptr;
+    const ClearanceGrid* grid = nullptr;
     const auto cleared = [&](int i) {
       const int n = balls.ballCount(i);
       if (n == 0) return false;
@@ -468,7 +467,9 @@ bool Scene::posedFree(const Pose* poses, const double* q, SceneContext& ctx, Col
     // before it in order would each be tested for nothing. Each link is still tested once at most.
     const int n = static_cast<int>(env_links_.size());
     const int lead = ctx.env_last_hit >= 0 && ctx.env_last_hit < n ? ctx.env_last_hit : -1;
-    if (lead >= 0 && hits(lead)) return false;
+    if (lead >= 0 && hits(lead)) return false;  // (before the balls are placed: it probably still collides)
+    grid = env.hasMovingObstacles() ? nullptr : env.clearanceGrid();
+    if (grid && !(balls_placed = self_.placeBalls(poses, ctx.self))) grid = nullptr;
     for (int k = 0; k < n; ++k)
       if (k != lead && hits(k)) return false;
   }
