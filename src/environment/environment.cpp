@@ -442,7 +442,7 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
   // Most links of a state overlap no item's box at all: the trees alone say so, before the culls and hull
   // tests below are set up (which cost more than the walk). Moving obstacles take the full path.
   if (moving_.empty()) {
-    clearanceFor(true);  // (counts the query; Scene::isFree asks clearsBall() before it calls here)
+    clearanceFor(true);  // (counts the query toward the grid; Scene::isFree reads the grid before it calls here)
     const auto any = [](const auto&...) { return true; };
     if (!static_.query(query, any) && !(voxel_tree_ && voxel_tree_->query(query, any))) return false;
   }
@@ -617,20 +617,19 @@ double Environment::hullLowerBound(const LinkGeometry& link, const Pose& pose, c
                                    SimplexCache* warm, bool by_parts) const noexcept {
   if (!pose.isFinite() || !std::isfinite(t) || !(enough >= 0.0) || !(relative >= 0.0) || !std::isfinite(relative))
     return 0.0;
-  // The link's ball beyond `enough` of every static item: all that is asked (a conservative advancement
-  // far from obstacles asks nothing more).
-  if (moving_.empty())
-    if (const ClearanceGrid* grid = clearanceFor(true);
-        grid && grid->lowerBound(pose * link.sphereCenter()) - ballReach(link, pose) >= enough)
-      return enough;
-  double lower = enough;  // the least bound so far: items certainly beyond it cannot lower it
+  // The link's bounding ball (which holds its hull and its parts) beyond `enough` of every static item:
+  // all that is asked (a conservative advancement far from obstacles asks nothing more).
   const Vec3 centre = pose * link.sphereCenter();
   const double reach = ballReach(link, pose);
+  if (moving_.empty())
+    if (const ClearanceGrid* grid = clearanceFor(true); grid && grid->lowerBound(centre) - reach >= enough)
+      return enough;
+  double lower = enough;  // the least bound so far: items certainly beyond it cannot lower it
   const auto measure = [&](const auto& shape, const Pose& pose_o, SimplexCache* cache) {
     using S = std::decay_t<decltype(shape)>;
     if constexpr (std::is_same_v<S, Box>) {
-      // The link's ball (which holds its hull and its parts) against the box, in the box's frame: a box
-      // it shows beyond the bound so far cannot lower it, for a dozen operations where GJK costs hundreds.
+      // The link's ball against the box, in the box's frame: a box it shows beyond the bound so far cannot
+      // lower it, for a dozen operations where GJK costs hundreds.
       // (The margin is far above the few roundings of the distance.)
       const Vec3 c = pose_o.R.transpose() * (centre - pose_o.t);
       const Vec3 gap = (c.cwiseAbs() - shape.half).cwiseMax(0.0);

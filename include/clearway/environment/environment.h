@@ -100,9 +100,10 @@ class Environment {
   }
   bool hasMovingObstacles() const noexcept { return !moving_.empty(); }
   /// The static obstacles' and voxels' clearance grid (clearance_grid.h), once built, else null. While no
-  /// obstacle moves, queries read it before the trees: a link's bounding ball it clears is free of all of
-  /// them. A version builds its own once kClearanceAfter link queries have been asked of it (copies that
-  /// keep the static items share it), so a world edited between every few queries never pays for one.
+  /// obstacle moves, Scene::isFree and hullLowerBound read it before the trees: a link inside balls it
+  /// clears is free of all of them. A version builds its own once kClearanceAfter link queries have been
+  /// asked of it (copies that keep the static items share it), so a world edited between every few
+  /// queries never pays for one.
   const ClearanceGrid* clearanceGrid() const noexcept;
   /// The slack linkIntersects grows a link's box by: `padding`, and the narrow phase's band for a link
   /// whose coordinates lie within `extent` of the origin. While no obstacle moves, a link inside a ball
