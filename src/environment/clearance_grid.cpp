@@ -100,9 +100,13 @@ ClearanceGrid::ClearanceGrid(const std::vector<Aabb>& boxes, int max_cells) {
   // then rounded down to a float.
   const double half_diagonal = h * (std::sqrt(3.0) / 2.0) * (1.0 + 1e-12);
   float of[kCap + 1];  // the stored bound for each D
+  constexpr double kFloatMax = std::numeric_limits<float>::max();
   for (int d = 0; d <= kCap; ++d) {
     const double v = h * std::sqrt(static_cast<double>(d)) * (1.0 - 1e-12) - half_diagonal;
-    float f = static_cast<float>(v);
+    // (Beyond the floats' range, the nearest float below: the largest one, or −∞.)
+    float f = v >= kFloatMax ? std::numeric_limits<float>::max()
+              : v <= -kFloatMax ? -std::numeric_limits<float>::infinity()
+                                : static_cast<float>(v);
     if (static_cast<double>(f) > v) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
     of[d] = f;
   }

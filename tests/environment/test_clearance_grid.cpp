@@ -96,6 +96,16 @@ TEST(ClearanceGrid, EdgeCases) {
                                  Aabb::fromCenterHalf(Vec3(-big, 0, 0), Vec3(1, 1, 1)),
                                  Aabb::fromCenterHalf(Vec3(1e200, 1e200, 0), Vec3(1, 1, 1))};
   const ClearanceGrid huge(far);
+  // Cells beyond the floats' range (1e40 m apart): bounds rounded down to the largest float.
+  const std::vector<Aabb> vast = {Aabb::fromCenterHalf(Vec3(1e40, 0, 0), Vec3(1, 1, 1)),
+                                  Aabb::fromCenterHalf(Vec3(-1e40, 0, 0), Vec3(1, 1, 1))};
+  const ClearanceGrid wide(vast);
+  for (const Vec3& p : {Vec3(0, 0, 0), Vec3(1e40, 0, 5), Vec3(0, 3e39, 0), Vec3(-1e40, 0, 1e30)}) {
+    const double bound = wide.lowerBound(p);
+    EXPECT_FALSE(std::isnan(bound));
+    EXPECT_LE(bound, boxesDistance(vast, p)) << p.transpose();
+  }
+  EXPECT_GT(wide.lowerBound(Vec3(0, 0, 0)), 1e38);
   for (const Vec3& p : {Vec3(0, 0, 0), Vec3(big, 0, 5), Vec3(-big, 3, 0), Vec3(0, big, big), Vec3(1e200, 1e200, 10)}) {
     const double bound = huge.lowerBound(p);
     EXPECT_FALSE(std::isnan(bound));
