@@ -42,6 +42,7 @@ ClearanceGrid::ClearanceGrid(const std::vector<Aabb>& boxes, int max_cells) {
   const double e_max = e.maxCoeff();
   const double scale = std::max(bounds_.min.cwiseAbs().maxCoeff(), bounds_.max.cwiseAbs().maxCoeff());
   // Boxes near the doubles' end (extents that overflow): no cells, every point reads the boxes' box.
+  slack_ = 1e-9 * (1.0 + scale);
   if (!(scale < 1e300) || !std::isfinite(e_max)) return;
   // The finest cells within the budget. Exits: h starts at no less than e_max / 1024 and grows by a
   // quarter per step, so within 32 steps h ≥ e_max, where at most 6³ cells remain (≤ 1000 ≤ max_cells).
@@ -116,6 +117,7 @@ ClearanceGrid::ClearanceGrid(const std::vector<Aabb>& boxes, int max_cells) {
 
 double ClearanceGrid::outside(const Vec3& p, double slack) const noexcept {
   if (bounds_.isEmpty()) return std::numeric_limits<double>::infinity();
+  if (p.hasNaN()) return 0.0;  // (max() below would pass over a NaN)
   const Vec3 gap = (bounds_.min - p).cwiseMax(p - bounds_.max).cwiseMax(0.0);
   // (The largest gap where the squares could overflow: no more than the distance either.)
   const double largest = gap.maxCoeff();

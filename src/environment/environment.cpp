@@ -118,6 +118,13 @@ DistanceResult swapped(DistanceResult r) noexcept {
 
 }  // namespace
 
+struct Environment::Clearance {
+  std::atomic<const ClearanceGrid*> ready{nullptr};  // published once `grid` is whole
+  std::atomic<int> asked{0};
+  std::once_flag once;
+  std::unique_ptr<const ClearanceGrid> grid;
+};
+
 Environment::Environment(std::vector<Obstacle> obstacles, std::shared_ptr<const OccupancyMap> map) {
   std::vector<std::pair<Aabb, Static>> items;
   std::vector<std::string> item_names;
@@ -158,6 +165,7 @@ Environment::Environment(std::vector<Obstacle> obstacles, std::shared_ptr<const 
     }
     names_ = names_.assigned(item_names[i], named);
   }
+  clearance_ = std::make_shared<Clearance>();
   *this = withMap(std::move(map));
 }
 
@@ -172,16 +180,9 @@ Environment Environment::withMap(std::shared_ptr<const OccupancyMap> map) const 
   return e;
 }
 
-struct Environment::Clearance {
-  std::atomic<const ClearanceGrid*> ready{nullptr};  // published once `grid` is whole
-  std::atomic<int> asked{0};
-  std::once_flag once;
-  std::unique_ptr<const ClearanceGrid> grid;
-};
-
 void Environment::rescale() {
   scale_ = std::max(maxAbs(static_.bounds()), voxel_tree_ ? maxAbs(voxel_tree_->bounds()) : 0.0);
-  clearance_ = std::make_shared<Clearance>();
+  if (clearance_) clearance_ = std::make_shared<Clearance>();  // (none stays none: withoutClearanceGrid)
 }
 
 const ClearanceGrid* Environment::clearanceGrid() const noexcept {
@@ -617,25 +618,24 @@ double Environment::hullLowerBound(const LinkGeometry& link, const Pose& pose, c
                                    SimplexCache* warm, bool by_parts) const noexcept {
   if (!pose.isFinite() || !std::isfinite(t) || !(enough >= 0.0) || !(relative >= 0.0) || !std::isfinite(relative))
     return 0.0;
-  // The link's bounding ball (which holds its hull and its parts) beyond `enough` of every static item:
-  // all that is asked (a conservative advancement far from obstacles asks nothing more).
+  // (No clearance grid here: it exists only once enough queries were asked, and a bound it settled could
+  // differ from the GJKs' within their relative error, so a segment's verdict would depend on history.)
   const Vec3 centre = pose * link.sphereCenter();
   const double reach = ballReach(link, pose);
-  if (moving_.empty())
-    if (const ClearanceGrid* grid = clearanceFor(true); grid && grid->lowerBound(centre) - reach >= enough)
-      return enough;
   double lower = enough;  // the least bound so far: items certainly beyond it cannot lower it
   const auto measure = [&](const auto& shape, const Pose& pose_o, SimplexCache* cache) {
     using S = std::decay_t<decltype(shape)>;
     if constexpr (std::is_same_v<S, Box>) {
-      // The link's ball against the box, in the box's frame: a box it shows beyond the bound so far cannot
-      // lower it, for a dozen operations where GJK costs hundreds.
+      // The link's bounding ball (which holds its hull and its parts) against the box, in the box's frame:
+      // a box it shows beyond the bound so far cannot lower it, for a dozen operations where GJK costs
+      // hundreds.
       // (The margin is far above the few roundings of the distance.)
       const Vec3 c = pose_o.R.transpose() * (centre - pose_o.t);
       const Vec3 gap = (c.cwiseAbs() - shape.half).cwiseMax(0.0);
       const double margin =
           1e-9 * (1.0 + c.cwiseAbs().maxCoeff() + pose_o.t.cwiseAbs().maxCoeff() + centre.cwiseAbs().maxCoeff());
-      if (gap.norm() - reach - margin >= lower) return false;
+      // (Only below 1e150: a norm that overflowed would skip a box nearer than an infinite bound.)
+      if (lower < 1e150 && gap.norm() - reach - margin >= lower) return false;
     }
     SimplexCache cold;
     if (by_parts) {  // (cold starts: callers ask only when the hull has come within contact)

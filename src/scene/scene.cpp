@@ -429,7 +429,7 @@ bool Scene::posedFree(const Pose* poses, const double* q, SceneContext& ctx, Col
     const double time = fx.moving ? t : 0.0;
     // Once the environment has its clearance grid, the enclosing balls (placed after the lead link for
     // the self check too) clear most links with a look-up each: the bounding ball, else every part's ball
-    // (whose union holds the link, but not the inside of a closed mesh, which only the bounding ball holds).
+    // (whose union holds the link's surfaces, but neither the inside of a closed mesh nor the hull).
     const Environment& env = *environment_;
     EnclosingBalls& balls = ctx.self.balls;
     const ClearanceGrid* grid = nullptr;
@@ -440,7 +440,8 @@ bool Scene::posedFree(const Pose* poses, const double* q, SceneContext& ctx, Col
       const double slack = env.linkSlack(link_padding_[i], bound.center.cwiseAbs().maxCoeff() + bound.radius,
                                          options_.tolerances);
       if (grid->lowerBound(bound.center) > bound.radius + slack) return true;
-      if (n == 1 || geometry_->link(i)->solidCount() > 0) return false;
+      // (Not in Hull mode, where linkIntersects tests the hull, which the parts' balls need not hold.)
+      if (n == 1 || options_.mode != GeometryMode::Mesh || geometry_->link(i)->solidCount() > 0) return false;
       for (int k = 1; k < n; ++k) {
         const EnclosingBalls::Placed part = balls.placed(i, k);
         if (!(grid->lowerBound(part.center) > part.radius + slack)) return false;

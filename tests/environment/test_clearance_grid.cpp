@@ -86,6 +86,8 @@ TEST(ClearanceGrid, EdgeCases) {
   EXPECT_EQ(one.lowerBound(Vec3(nan, 0, 0)), 0.0);
   EXPECT_EQ(one.lowerBound(Vec3(0, inf, 0)), 0.0);
   EXPECT_EQ(one.lowerBound(Vec3(0, 0, -inf)), 0.0);
+  EXPECT_EQ(one.lowerBound(Vec3(1e200, 0, nan)), 0.0);  // (a max over the gaps would pass over the NaN)
+  EXPECT_EQ(one.lowerBound(Vec3(nan, 1e200, 0)), 0.0);
   EXPECT_LE(one.lowerBound(Vec3(1, 2, 3)), 0.0);
   EXPECT_GT(one.lowerBound(Vec3(1, 2, 4.5)), 0.5);  // 1 m above the top face
   EXPECT_LE(one.lowerBound(Vec3(1, 2, 4.5)), 1.0);
@@ -155,12 +157,15 @@ TEST(ClearanceGrid, EachVersionBuildsItsOwnOnceAskedEnough) {
   Obstacle mover = box("m", Vec3(0, 1, 0), Vec3(0.1, 0.1, 0.1));
   mover.velocity = Vec3(0.1, 0, 0);
   EXPECT_EQ(env.withObstacle(mover).clearanceGrid(), grid);
-  // Never, when asked not to: not even when asked to build one.
+  // Never, when asked not to: not even when asked to build one, nor after an edit.
   const Environment without = env.withoutClearanceGrid();
   EXPECT_EQ(without.clearanceGrid(), nullptr);
   ask(without, Environment::kClearanceAfter + 10);
   without.prepareClearanceGrid();
   EXPECT_EQ(without.clearanceGrid(), nullptr);
+  const Environment without_edited = without.withObstacle(box("d", Vec3(0, 0, -0.5), Vec3(0.1, 0.1, 0.1)));
+  without_edited.prepareClearanceGrid();
+  EXPECT_EQ(without_edited.clearanceGrid(), nullptr) << "an edit brought the grid back";
 }
 
 TEST(ClearanceGrid, CoversVoxelsAndPointVoxels) {

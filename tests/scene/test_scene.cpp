@@ -607,17 +607,62 @@ void expectGridKeepsVerdicts(const std::shared_ptr<const Scene>& with, const std
   clears += a.counters.environment.grid_clears;
 }
 
+// A link of two open plates, 1 m apart, around a small box: the meshes are clear of it, the hull (Hull
+// mode's geometry) holds it, and so the parts' balls, which hold each plate, must not clear the link there.
+TEST(Scene, TheClearanceGridKeepsHullModeVerdicts) {
+  const test::TempDir dir;
+  const auto facet = [](const std::string& a, const std::string& b, const std::string& c) {
+    return "facet normal 0 0 0\nouter loop\nvertex " + a + "\nvertex " + b + "\nvertex " + c + "\nendloop\nendfacet\n";
+  };
+  std::string stl = "solid plates\n";
+  for (const std::string z : {"-0.5", "0.5"})
+    stl += facet("-0.1 -0.1 " + z, "0.1 -0.1 " + z, "0.1 0.1 " + z) + facet("-0.1 -0.1 " + z, "0.1 0.1 " + z, "-0.1 0.1 " + z);
+  dir.write("plates.stl", stl + "endsolid plates\n");
+  dir.write("plates.urdf", R"(<robot name="plates">
+  <link name="base"/>
+  <link name="plates"><collision><geometry><mesh filename="plates.stl"/></geometry></collision></link>
+  <joint name="slide" type="prismatic"><parent link="base"/><child link="plates"/><axis xyz="1 0 0"/>
+    <limit lower="-2" upper="2" effort="1" velocity="1"/></joint>
+</robot>)");
+  const std::string path = dir.write("plates.yaml", "format: 1\nname: plates\nrobot:\n  urdf: " + dir.path("plates.urdf") +
+                                                        "\n  group: [slide]\nenvironment:\n  obstacles:\n"
+                                                        "    - {name: block, box: {size: [0.1, 0.1, 0.1]}}\n"
+                                                        "checks: [environment]\n");
+  for (const GeometryMode mode : {GeometryMode::Mesh, GeometryMode::Hull}) {
+    SceneOptions options;
+    options.mode = mode;
+    const auto scene = Scene::load(path, options);
+    ASSERT_GT(scene->geometry().link(1)->parts().size(), 1u) << "the test needs a link of several parts";
+    ASSERT_EQ(scene->geometry().link(1)->solidCount(), 0);
+    scene->environment().prepareClearanceGrid();
+    ASSERT_NE(scene->environment().clearanceGrid(), nullptr);
+    SceneContext ctx = scene->makeContext();
+    const std::vector<double> q = {0.0};
+    EXPECT_EQ(scene->isFree(q.data(), ctx), mode == GeometryMode::Mesh) << (mode == GeometryMode::Mesh ? "mesh" : "hull");
+    if (mode == GeometryMode::Mesh)  // (the parts' balls cleared it: the path the hull must not take)
+      EXPECT_EQ(ctx.counters.environment.grid_clears, 1);
+  }
+}
+
 TEST(Scene, TheClearanceGridChangesNoVerdict) {
   std::mt19937 rng(29);
   long long clears = 0;
   expectGridKeepsVerdicts(Scene::load(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/arm6_wall.yaml"), "arm6_wall",
                           rng, clears);
+  // In Hull mode too, where a link's hull (which its parts' balls need not hold) decides.
+  SceneOptions hull;
+  hull.mode = GeometryMode::Hull;
+  expectGridKeepsVerdicts(Scene::load(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/arm6_wall.yaml", hull),
+                          "arm6_wall (hull)", rng, clears);
   CLEARWAY_SHARED_SCENES_OR_SKIP();
   for (const auto& family : std::filesystem::directory_iterator(sharedScenes())) {
     if (!family.is_directory()) continue;
     const std::string stem = family.path().string() + "/" + family.path().filename().string() + "_0001";
     for (const std::string form : {".yaml", ".octomap.yaml"})
-      if (std::filesystem::exists(stem + form)) expectGridKeepsVerdicts(Scene::load(stem + form), stem + form, rng, clears);
+      if (std::filesystem::exists(stem + form)) {
+        expectGridKeepsVerdicts(Scene::load(stem + form), stem + form, rng, clears);
+        if (form == ".yaml") expectGridKeepsVerdicts(Scene::load(stem + form, hull), stem + form + " (hull)", rng, clears);
+      }
   }
   std::printf("the grid cleared %lld links\n", clears);
 }

@@ -33,7 +33,7 @@ class ClearanceGrid {
   explicit ClearanceGrid(const std::vector<Aabb>& boxes, int max_cells = kDefaultCells);
 
   /// A lower bound on the distance from p to every box given: +∞ when there are none; 0 or less proves
-  /// nothing (and a non-finite p gives 0).
+  /// nothing (and a p with a NaN or an infinity gives 0).
   /// (Inlined into the per-link loops that call it: a call costs as much as the look-up.)
   [[gnu::always_inline]] double lowerBound(const Vec3& p) const noexcept {
     const double slack = slack_ + 1e-9 * p.cwiseAbs().maxCoeff();

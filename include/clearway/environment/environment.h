@@ -100,10 +100,9 @@ class Environment {
   }
   bool hasMovingObstacles() const noexcept { return !moving_.empty(); }
   /// The static obstacles' and voxels' clearance grid (clearance_grid.h), once built, else null. While no
-  /// obstacle moves, Scene::isFree and hullLowerBound read it before the trees: a link inside balls it
-  /// clears is free of all of them. A version builds its own once kClearanceAfter link queries have been
-  /// asked of it (copies that keep the static items share it), so a world edited between every few
-  /// queries never pays for one.
+  /// obstacle moves, Scene::isFree reads it before the trees: a link inside balls it clears is free of
+  /// all of them. A version builds its own once kClearanceAfter link queries have been asked of it (copies
+  /// that keep the static items share it), so a world edited between every few queries never pays for one.
   const ClearanceGrid* clearanceGrid() const noexcept;
   /// The slack linkIntersects grows a link's box by: `padding`, and the narrow phase's band for a link
   /// whose coordinates lie within `extent` of the origin. While no obstacle moves, a link inside a ball
@@ -117,7 +116,8 @@ class Environment {
   static constexpr int kClearanceAfter = 16384;
   /// Builds the clearance grid now, if this version has none (thread-safe; a failed allocation leaves none).
   void prepareClearanceGrid() const noexcept;
-  /// This world, never with a clearance grid: every query walks the trees (for comparing verdicts and cost).
+  /// This world, never with a clearance grid, nor any world edited from it: every query walks the trees
+  /// (for comparing verdicts and cost).
   Environment withoutClearanceGrid() const;
 
   /// This world with one obstacle more: O(log n). Throws std::invalid_argument for an empty name or one
@@ -234,7 +234,7 @@ class Environment {
   int slot_count_ = 0;
   std::size_t named_count_ = 0;
   int point_voxels_ = 0;
-  std::shared_ptr<Clearance> clearance_;  // null: never a grid
+  std::shared_ptr<Clearance> clearance_;  // null: never a grid (withoutClearanceGrid), in edits too
   double scale_ = 0.0;            // the largest |coordinate| of the trees' bounds (sizes the rounding band)
 };
 
