@@ -58,9 +58,6 @@ double maxAbs(const Aabb& b) noexcept {
   return b.isEmpty() ? 0.0 : b.min.cwiseAbs().cwiseMax(b.max.cwiseAbs()).maxCoeff();
 }
 
-// The culls' band: four times the narrow phase's, for the roundings of placing boxes in the world.
-double bandOf(double scale, const Tolerances& tol) noexcept { return 4.0 * narrowBand(scale, tol); }
-
 // The radius of the link's bounding ball placed by `pose` (centre pose · sphereCenter()), grown by the
 // rounding of that product (R·c + t rounds by a few ulps of |c| + |t|).
 double ballReach(const LinkGeometry& link, const Pose& pose) noexcept {
@@ -189,12 +186,10 @@ const ClearanceGrid* Environment::clearanceGrid() const noexcept {
   return clearance_ ? clearance_->ready.load(std::memory_order_acquire) : nullptr;
 }
 
-const ClearanceGrid* Environment::clearanceFor(bool asked) const noexcept {
-  if (!clearance_) return nullptr;
-  if (const ClearanceGrid* g = clearance_->ready.load(std::memory_order_acquire)) return g;
+void Environment::countQuery() const noexcept {
+  if (!clearance_ || clearance_->ready.load(std::memory_order_acquire)) return;
   // One query, the one that reaches the count, builds it; the others go on without it meanwhile.
-  if (asked && clearance_->asked.fetch_add(1, std::memory_order_relaxed) == kClearanceAfter) prepareClearanceGrid();
-  return nullptr;
+  if (clearance_->asked.fetch_add(1, std::memory_order_relaxed) == kClearanceAfter) prepareClearanceGrid();
 }
 
 void Environment::prepareClearanceGrid() const noexcept {
@@ -443,7 +438,7 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
   // Most links of a state overlap no item's box at all: the trees alone say so, before the culls and hull
   // tests below are set up (which cost more than the walk). Moving obstacles take the full path.
   if (moving_.empty()) {
-    clearanceFor(true);  // (counts the query toward the grid; Scene::isFree reads the grid before it calls here)
+    countQuery();  // (Scene::isFree reads the grid, once built, before it calls here)
     const auto any = [](const auto&...) { return true; };
     if (!static_.query(query, any) && !(voxel_tree_ && voxel_tree_->query(query, any))) return false;
   }
@@ -691,7 +686,7 @@ double Environment::linkCast(const LinkGeometry& link, const Pose& pose, const V
   Aabb swept = start;
   swept.min += (max_s * velocity).cwiseMin(Vec3::Zero());
   swept.max += (max_s * velocity).cwiseMax(Vec3::Zero());
-  const double band = bandOf(scale_ + maxAbs(swept), tol);
+  const double band = cullBand(scale_ + maxAbs(swept), tol);
   swept = swept.inflated(band);
   const Margin<ConvexHull> grown{link.hull(), margin};
   double first = kNone;

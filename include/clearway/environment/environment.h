@@ -109,7 +109,7 @@ class Environment {
   /// (or inside balls) whose clearanceGrid()->lowerBound() at the centre exceeds its radius plus this
   /// makes linkIntersects answer false.
   double linkSlack(double padding, double extent, const Tolerances& tol) const noexcept {
-    return padding + 4.0 * narrowBand(scale_ + extent + padding, tol);
+    return padding + cullBand(scale_ + extent + padding, tol);
   }
   /// The link queries a version answers before it builds its clearance grid.
   /// (About 4 ms of link queries on the shared problems, as long as a grid takes to build there.)
@@ -221,9 +221,11 @@ class Environment {
   };
   Environment withStatic(std::shared_ptr<const Obstacle> o) const;  // adds (name checked by the caller)
   void rescale();  // after the static items changed: their scale, and a new (unbuilt) clearance grid
+  // The culls' band: four times the narrow phase's, for the roundings of placing boxes in the world.
+  static double cullBand(double scale, const Tolerances& tol) noexcept { return 4.0 * narrowBand(scale, tol); }
   // The clearance grid of one version of the static items, built at most once.
   struct Clearance;
-  const ClearanceGrid* clearanceFor(bool asked) const noexcept;  // the grid; `asked`: counts a query
+  void countQuery() const noexcept;  // one link query toward the grid: the one that reaches the count builds it
 
   std::shared_ptr<const OccupancyMap> map_;
   StaticTree static_;                  // static obstacles and point voxels, world frame
