@@ -77,18 +77,19 @@ struct InscribedBalls {
 
 }  // namespace
 
+double LinkGeometry::surfaceDistance(const Vec3& p, double cutoff) const noexcept {
+  tree_.forEachWithin(Aabb::ofPoint(p), cutoff, [&](std::int32_t t) {
+    cutoff = std::min(cutoff, triangleDistance(triangles_[t], p));
+    return false;
+  });
+  return cutoff;
+}
+
 void LinkGeometry::findCores() {
   const double m = margin(bounding_radius_);
   std::vector<Ball> candidates;
   // The distance from p to the nearest triangle of the link (any piece: more than the ball needs).
-  const auto clearance = [&](const Vec3& p) {
-    double cutoff = std::numeric_limits<double>::infinity();
-    tree_.forEachWithin(Aabb::ofPoint(p), cutoff, [&](std::int32_t t) {
-      cutoff = std::min(cutoff, triangleDistance(triangles_[t], p));
-      return false;
-    });
-    return cutoff;
-  };
+  const auto clearance = [&](const Vec3& p) { return surfaceDistance(p, std::numeric_limits<double>::infinity()); };
   double volume = 0.0;
   for (const Aabb& box : solid_boxes_) volume += box.extents().prod();
   for (int s = 0; s < solidCount(); ++s) {

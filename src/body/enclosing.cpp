@@ -15,11 +15,12 @@ EnclosingBalls::EnclosingBalls(const RobotGeometry& geometry) : geometry_(&geome
     links_[i].first = static_cast<int>(local_.size());
     local_.push_back(g.sphereCenter());
     radii_.push_back(g.sphereRadius());
-    // Parts' balls only when there are several: one part's ball is no tighter than the bounding ball.
-    if (g.parts().size() > 1)
+    // Parts' balls only when there are several (one part's ball is no tighter than the bounding ball), and
+    // grown to hold the inside of closed meshes too, where that was proven.
+    if (g.parts().size() > 1 && std::isfinite(g.partBallMargin()))
       for (const LinkGeometry::Part& p : g.parts()) {
         local_.push_back(p.center);
-        radii_.push_back(p.radius);
+        radii_.push_back(p.radius + g.partBallMargin());
       }
     links_[i].count = static_cast<int>(local_.size()) - links_[i].first;
   }

@@ -269,6 +269,7 @@ LinkGeometry::LinkGeometry(std::vector<Triangle> triangles, std::vector<Primitiv
   buildParts();
   findSolids();
   findCores();
+  coverSolids();
 }
 
 void LinkGeometry::buildParts() {

@@ -429,7 +429,7 @@ bool Scene::posedFree(const Pose* poses, const double* q, SceneContext& ctx, Col
     const double time = fx.moving ? t : 0.0;
     // Once the environment has its clearance grid, the enclosing balls (placed after the lead link for
     // the self check too) clear most links with a look-up each: the bounding ball, else every part's ball
-    // (whose union holds the link's surfaces, but neither the inside of a closed mesh nor the hull).
+    // (whose union holds the link, the inside of its closed meshes included, but not its hull).
     const Environment& env = *environment_;
     EnclosingBalls& balls = ctx.self.balls;
     const ClearanceGrid* grid = nullptr;
@@ -441,7 +441,7 @@ bool Scene::posedFree(const Pose* poses, const double* q, SceneContext& ctx, Col
                                          options_.tolerances);
       if (grid->lowerBound(bound.center) > bound.radius + slack) return true;
       // (Not in Hull mode, where linkIntersects tests the hull, which the parts' balls need not hold.)
-      if (n == 1 || options_.mode != GeometryMode::Mesh || geometry_->link(i)->solidCount() > 0) return false;
+      if (n == 1 || options_.mode != GeometryMode::Mesh) return false;
       for (int k = 1; k < n; ++k) {
         const EnclosingBalls::Placed part = balls.placed(i, k);
         if (!(grid->lowerBound(part.center) > part.radius + slack)) return false;

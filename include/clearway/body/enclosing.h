@@ -43,11 +43,11 @@ class EnclosingBalls {
     double radius;  ///< grown by the rounding of the placement: it holds what the link-frame ball held
   };
   /// How many balls link i has: 0 without geometry, else its bounding ball and, when it has several
-  /// parts, one per part.
+  /// parts whose balls were proven to hold it (LinkGeometry::partBallMargin), one per part.
   int ballCount(int i) const noexcept { return links_[i].count; }
   /// Link i's ball k as last placed: k = 0 its bounding ball; 1 ≤ k < ballCount(i) its parts' (placed at
-  /// the first such call since place()). The parts' balls together hold the link's surfaces and
-  /// primitives, not the inside of its closed meshes.
+  /// the first such call since place()). The parts' balls together hold the whole link, the inside of its
+  /// closed meshes included.
   Placed placed(int i, int k) noexcept {
     Link& l = links_[i];
     if (k > 0 && !l.parts_placed) placeParts(i);

@@ -103,12 +103,23 @@ class LinkGeometry {
   /// Balls wholly inside the link's solids (closed meshes and primitives), largest first: two bodies whose
   /// cores overlap share interior points, so they collide at any padding. Empty when the link has no solid.
   const std::vector<Ball>& cores() const noexcept { return cores_; }
+  /// How far every part's ball must grow for their union to hold the whole link, the inside of its closed
+  /// meshes included (the parts hold only their surfaces): 0 for a link without closed meshes, a proven
+  /// small margin for one with them, +∞ where no proof was found (then only the bounding ball holds it).
+  double partBallMargin() const noexcept { return part_ball_margin_; }
+  /// True when the balls (link frame), each grown by `margin`, provably hold every point inside the
+  /// link's closed meshes (true without closed meshes). False proves nothing: the proof gives up after a
+  /// bounded amount of work.
+  bool ballsHoldSolids(const std::vector<Ball>& balls, double margin) const;
 
  private:
   LinkGeometry(std::vector<Triangle> triangles, std::vector<Primitive> primitives, const TreeBuildOptions& options);
   void buildParts();
   void findSolids();
   void findCores();
+  void coverSolids();
+  // The distance from p to the nearest triangle, or `cutoff` when none is nearer.
+  double surfaceDistance(const Vec3& p, double cutoff) const noexcept;
   // Ray parity of solid s at p along `dir`: 1 inside, 0 outside, −1 when the ray passes too near an edge,
   // a vertex or a plane to tell.
   int rayParity(int s, const Vec3& p, const Vec3& dir) const noexcept;
@@ -128,6 +139,7 @@ class LinkGeometry {
   std::vector<Aabb> solid_boxes_;       // per closed piece
   std::vector<Vec3> probes_;
   std::vector<Ball> cores_;
+  double part_ball_margin_ = 0.0;
 };
 
 /// The box, in the frame `pose` is given in, of a convex shape placed by it: 6 support queries plus its
