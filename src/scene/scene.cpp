@@ -440,8 +440,10 @@ bool Scene::posedFree(const Pose* poses, const double* q, SceneContext& ctx, Col
       const double slack = env.linkSlack(link_padding_[i], bound.center.cwiseAbs().maxCoeff() + bound.radius,
                                          options_.tolerances);
       if (grid->lowerBound(bound.center) > bound.radius + slack) return true;
-      // (Not in Hull mode, where linkIntersects tests the hull, which the parts' balls need not hold.)
-      if (n == 1 || options_.mode != GeometryMode::Mesh) return false;
+      // (Not in Hull mode, where linkIntersects tests the hull, which the parts' balls need not hold. Nor for
+      // closed meshes, which they hold only grown: on the shared robots, whose links are all closed, the
+      // parts cleared too few links to pay for their look-ups, +3.8% instructions on box_panda's states.)
+      if (n == 1 || options_.mode != GeometryMode::Mesh || geometry_->link(i)->solidCount() > 0) return false;
       for (int k = 1; k < n; ++k) {
         const EnclosingBalls::Placed part = balls.placed(i, k);
         if (!(grid->lowerBound(part.center) > part.radius + slack)) return false;
