@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace clearway::test {
 
@@ -38,6 +39,17 @@ inline std::string sharedMissing(const std::string& rel) {
          (sharedDataRequired() ? ": required because CI=true" : "");
 }
 
+/// The shared robots that tests of "every robot" run beside ours (folder-relative URDF paths).
+inline const char* const kSharedArms[] = {"robots/panda/panda.urdf", "robots/ur5/ur5.urdf"};
+
+/// Our two arms, then the shared Panda and UR5 (a test requires those first: CLEARWAY_REQUIRE_SHARED_ARMS).
+inline std::vector<std::string> allArms() {
+  std::vector<std::string> urdfs{std::string(CLEARWAY_SOURCE_DIR) + "/robots/arm6/arm6.urdf",
+                                 std::string(CLEARWAY_SOURCE_DIR) + "/robots/twin_arm/twin_arm.urdf"};
+  for (const char* rel : kSharedArms) urdfs.push_back(sharedPath(rel));
+  return urdfs;
+}
+
 }  // namespace clearway::test
 
 /// Fails the test (CI=true) or skips it (otherwise) when sharedDir()/rel is missing. For use in the body
@@ -54,3 +66,7 @@ inline std::string sharedMissing(const std::string& rel) {
 #define CLEARWAY_SHARED_OR_SKIP(var, rel)                                                              \
   CLEARWAY_REQUIRE_SHARED(rel);                                                                      \
   const std::string var = ::clearway::test::sharedPath(rel)
+
+/// CLEARWAY_REQUIRE_SHARED for each of the shared arms allArms() lists.
+#define CLEARWAY_REQUIRE_SHARED_ARMS() \
+  for (const char* rel_ : ::clearway::test::kSharedArms) CLEARWAY_REQUIRE_SHARED(rel_)

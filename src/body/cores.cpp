@@ -23,13 +23,26 @@ constexpr int kClimbSteps = 6;
 constexpr double kNewReach = 0.5;
 constexpr double kSmallest = 0.1;
 
+// The distance from p to segment ab, given a − p and b − p (a point-sized segment: the distance to a).
+double segmentDistance(const Vec3& a, const Vec3& b) noexcept {
+  const Vec3 e = b - a;
+  const double ee = e.squaredNorm();
+  const double t = ee > 0.0 ? std::clamp(-a.dot(e) / ee, 0.0, 1.0) : 0.0;
+  return (a + t * e).norm();
+}
+
+// Never above the distance but for rounding: the closest point of the triangle's plane (signed volumes)
+// is inside the triangle, but a sliver's plane is known only roughly, and that point can lie farther than
+// the nearest; the nearest point of a sliver is on an edge, whose distance each edge's own test gives.
 double triangleDistance(const Triangle& t, const Vec3& p) noexcept {
   detail::Simplex s;
   s.n = 3;
   for (int i = 0; i < 3; ++i) s.p[i].w = t.v[i] - p;
   double l[4];
   detail::closestWeights(s, l);
-  return (l[0] * s.p[0].w + l[1] * s.p[1].w + l[2] * s.p[2].w).norm();
+  const double face = (l[0] * s.p[0].w + l[1] * s.p[1].w + l[2] * s.p[2].w).norm();
+  const Vec3 &a = s.p[0].w, &b = s.p[1].w, &c = s.p[2].w;
+  return std::min({face, segmentDistance(a, b), segmentDistance(b, c), segmentDistance(c, a)});
 }
 
 // A ball's margin: far above the rounding of the distances (a few ulps of the link's size).

@@ -269,7 +269,6 @@ LinkGeometry::LinkGeometry(std::vector<Triangle> triangles, std::vector<Primitiv
   buildParts();
   findSolids();
   findCores();
-  coverSolids();
 }
 
 void LinkGeometry::buildParts() {

@@ -45,7 +45,9 @@ bool LinkGeometry::ballsHoldSolids(const std::vector<Ball>& balls, double margin
       const Vec3 c = cell.center();
       const double h = 0.5 * (cell.max - cell.min).norm();
       const bool held = std::any_of(balls.begin(), balls.end(), [&](const Ball& b) {
-        return (c - b.center).norm() + h + rounding <= b.radius + margin;
+        // (A ball's own size adds to the rounding: balls given far from the link.)
+        const double own = 1e-15 * (b.center.norm() + b.radius);
+        return (c - b.center).norm() + h + rounding + own <= b.radius + margin;
       });
       if (held) continue;
       if (!(surfaceDistance(c, 2.0 * (h + rounding)) > h + rounding)) {  // a surface may cross it
@@ -71,12 +73,23 @@ bool LinkGeometry::ballsHoldSolids(const std::vector<Ball>& balls, double margin
   return true;
 }
 
-void LinkGeometry::coverSolids() {
-  if (solid_boxes_.empty()) return;  // the parts hold every surface and primitive: no growth needed
+double LinkGeometry::partBallMargin() const {
+  double margin = part_ball_margin_.value.load(std::memory_order_relaxed);
+  if (std::isnan(margin)) {
+    margin = coverSolids();
+    part_ball_margin_.value.store(margin, std::memory_order_relaxed);
+  }
+  return margin;
+}
+
+double LinkGeometry::coverSolids() const {
+  // Without closed meshes the parts hold every surface and primitive; one part's hull holds all triangles,
+  // so the inside of the closed meshes they bound too.
+  if (solid_boxes_.empty() || parts_.size() <= 1) return 0.0;
   std::vector<Ball> balls;
   for (const Part& p : parts_) balls.push_back({p.center, p.radius});
   const double margin = kMarginFraction * sphere_radius_;
-  part_ball_margin_ = ballsHoldSolids(balls, margin) ? margin : std::numeric_limits<double>::infinity();
+  return ballsHoldSolids(balls, margin) ? margin : std::numeric_limits<double>::infinity();
 }
 
 }  // namespace clearway

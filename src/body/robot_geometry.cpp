@@ -28,6 +28,7 @@ RobotGeometry::RobotGeometry(std::shared_ptr<const RobotModel> model, const Robo
     }
     try {
       links_[i] = std::make_shared<const LinkGeometry>(link.collisions, model_->meshes(), options);
+      links_[i]->partBallMargin();  // (proven now, at load, rather than in the first query)
     } catch (const std::exception& e) {
       throw ShapeError("robot '" + model_->name() + "': link '" + link.name + "': " + e.what());
     }

@@ -148,7 +148,10 @@ int LinkGeometry::rayParity(int s, const Vec3& p, const Vec3& dir) const noexcep
       const double wa = dir.dot(b.cross(c)), wb = dir.dot(c.cross(a)), wc = dir.dot(a.cross(b));
       const double sum = wa + wb + wc;  // = dir · normal
       if (std::abs(sum) <= kParallelMargin * nn) {  // the ray runs along the plane: in it, or beside it?
-        if (std::abs(normal.dot(a)) <= kParallelMargin * nn * (a.norm() + 1e-300)) return -1;
+        // Beside it, the plane is crossed at t = |n·a| / |d·n| > max(|a|, |b|, |c|): past every vertex, so off
+        // the triangle.
+        const double reach = std::max({a.norm(), b.norm(), c.norm()});
+        if (std::abs(normal.dot(a)) <= kParallelMargin * nn * (reach + 1e-300)) return -1;
         continue;
       }
       const double la = wa / sum, lb = wb / sum, lc = wc / sum;

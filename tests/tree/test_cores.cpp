@@ -88,13 +88,8 @@ TEST(Cores, LieInsidePrimitives) {
 }
 
 TEST(Cores, LieInsideTheLinksOfRealRobots) {
-  std::vector<std::string> urdfs{std::string(CLEARWAY_SOURCE_DIR) + "/robots/arm6/arm6.urdf",
-                                 std::string(CLEARWAY_SOURCE_DIR) + "/robots/twin_arm/twin_arm.urdf"};
-  for (const char* rel : {"robots/panda/panda.urdf", "robots/ur5/ur5.urdf"}) {
-    CLEARWAY_REQUIRE_SHARED(rel);
-    urdfs.push_back(test::sharedPath(rel));
-  }
-  for (const std::string& urdf : urdfs) {
+  CLEARWAY_REQUIRE_SHARED_ARMS();
+  for (const std::string& urdf : test::allArms()) {
     const RobotGeometry geometry(std::make_shared<const RobotModel>(loadRobot(urdf)));
     int with_cores = 0, solid = 0;
     for (int i : geometry.geometricLinks()) {

@@ -45,19 +45,10 @@ struct Arm {
   EnclosingBalls balls;
 };
 
-// Our two arms and the shared Panda and UR5 (paths in ../shared; a test requires them first).
-const char* const kSharedArms[] = {"robots/panda/panda.urdf", "robots/ur5/ur5.urdf"};
-std::vector<std::string> arms() {
-  std::vector<std::string> urdfs{std::string(CLEARWAY_SOURCE_DIR) + "/robots/arm6/arm6.urdf",
-                                 std::string(CLEARWAY_SOURCE_DIR) + "/robots/twin_arm/twin_arm.urdf"};
-  for (const char* rel : kSharedArms) urdfs.push_back(test::sharedPath(rel));
-  return urdfs;
-}
-
 TEST(EnclosingBalls, ApartOnlyWhereTheMeshesAreApart) {
-  for (const char* rel : kSharedArms) CLEARWAY_REQUIRE_SHARED(rel);
+  CLEARWAY_REQUIRE_SHARED_ARMS();
   const Tolerances tol;
-  for (const std::string& urdf : arms()) {
+  for (const std::string& urdf : test::allArms()) {
     Arm arm(urdf);
     const auto& [model, geometry, balls] = std::tie(arm.model, arm.geometry, arm.balls);
     ASSERT_TRUE(balls.madeFor(geometry));
@@ -85,6 +76,19 @@ TEST(EnclosingBalls, ApartOnlyWhereTheMeshesAreApart) {
         }
     }
     std::printf("  %s: %d of %d pairs apart, %d of them by the parts' balls\n", urdf.c_str(), apart, pairs, by_parts);
+    // The parts' balls are grown to hold the inside of closed meshes (PartCover proves the margin).
+    for (int a : links) {
+      const LinkGeometry& g = *geometry.link(a);
+      const double margin = g.partBallMargin();
+      if (g.parts().size() < 2 || !std::isfinite(margin)) {
+        EXPECT_EQ(balls.ballCount(a), 1) << urdf << " link " << model->link(a).name;
+        continue;
+      }
+      ASSERT_EQ(balls.ballCount(a), static_cast<int>(g.parts().size()) + 1);
+      if (g.solidCount() > 0) EXPECT_GT(margin, 0.0);
+      for (int k = 1; k < balls.ballCount(a); ++k)
+        EXPECT_GE(balls.placed(a, k).radius, g.parts()[k - 1].radius + margin) << urdf << " link " << model->link(a).name;
+    }
     EXPECT_GT(apart, 0);
     bool several = false;  // (a link of one primitive has one part: only its bounding ball)
     for (int a : links) several |= geometry.link(a)->parts().size() > 1;
@@ -102,9 +106,9 @@ TEST(EnclosingBalls, BoundsApartInLanesIsApartsFirstTest) {
   // this kernel is not compiled for falls back to one it is), in batches of every length, so that both the
   // lanes and the one-at-a-time tail run: a pair the lanes call apart is apart by apart() and by the exact
   // meshes, and the lanes call apart every pair whose bounding balls are apart by more than the band.
-  for (const char* rel : kSharedArms) CLEARWAY_REQUIRE_SHARED(rel);
+  CLEARWAY_REQUIRE_SHARED_ARMS();
   const Tolerances tol;
-  for (const std::string& urdf : arms()) {
+  for (const std::string& urdf : test::allArms()) {
     Arm arm(urdf);
     const auto& [model, geometry, balls] = std::tie(arm.model, arm.geometry, arm.balls);
     std::vector<std::int64_t> a, b;

@@ -71,6 +71,13 @@ TEST(PartCover, ProvesOnlyBallsThatHoldTheCube) {
   EXPECT_FALSE(cube.ballsHoldSolids(octants, 0.0));
   EXPECT_FALSE(cube.ballsHoldSolids(octants, std::nan("")));
   EXPECT_FALSE(cube.ballsHoldSolids(octants, std::numeric_limits<double>::infinity()));
+  // The margin counts as stated: balls 0.4 margins short of the octants' corners are proven (the bottom
+  // cells reach half a margin past a ball's boundary), 3 margins short refused (the corners stick out).
+  Balls short_by = octants;
+  for (LinkGeometry::Ball& b : short_by) b.radius = std::sqrt(0.75) - 0.4 * m;
+  EXPECT_TRUE(cube.ballsHoldSolids(short_by, m));
+  for (LinkGeometry::Ball& b : short_by) b.radius = std::sqrt(0.75) - 3.0 * m;
+  EXPECT_FALSE(cube.ballsHoldSolids(short_by, m));
   // One octant missing leaves a corner of the cube held by nothing.
   Balls seven(octants.begin() + 1, octants.end());
   EXPECT_FALSE(cube.ballsHoldSolids(seven, m));
@@ -138,13 +145,8 @@ TEST(PartCover, EveryProvenSetHoldsTheSampledInside) {
 }
 
 TEST(PartCover, EveryLinkOfRealRobotsHasAProvenMargin) {
-  std::vector<std::string> urdfs{std::string(CLEARWAY_SOURCE_DIR) + "/robots/arm6/arm6.urdf",
-                                 std::string(CLEARWAY_SOURCE_DIR) + "/robots/twin_arm/twin_arm.urdf"};
-  for (const char* rel : {"robots/panda/panda.urdf", "robots/ur5/ur5.urdf"}) {
-    CLEARWAY_REQUIRE_SHARED(rel);
-    urdfs.push_back(test::sharedPath(rel));
-  }
-  for (const std::string& urdf : urdfs) {
+  CLEARWAY_REQUIRE_SHARED_ARMS();
+  for (const std::string& urdf : test::allArms()) {
     const RobotGeometry geometry(std::make_shared<const RobotModel>(loadRobot(urdf)));
     int solid = 0;
     for (int i : geometry.geometricLinks()) {

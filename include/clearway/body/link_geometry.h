@@ -21,6 +21,7 @@
 #include <clearway/tolerances.h>
 #include <clearway/tree/aabb_tree.h>
 
+#include <atomic>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -65,9 +66,10 @@ class LinkGeometry {
   const Aabb& bounds() const noexcept { return bounds_; }
   /// The largest distance of a hull vertex from the link frame's origin.
   double boundingRadius() const noexcept { return bounding_radius_; }
-  /// Convex pieces whose union contains the link: the hulls of the triangles under the tree's top nodes
-  /// (up to kMaxParts), and one per primitive; each with a ball that contains it (link frame). Tighter
-  /// than hull() where the link is concave, and far cheaper than the triangles.
+  /// Convex pieces whose union contains the link's triangles and primitives (not the inside of its closed
+  /// meshes: see partBallMargin): the hulls of the triangles under the tree's top nodes (up to kMaxParts),
+  /// and one per primitive; each with a ball that contains it (link frame). Tighter than hull() where the
+  /// link is concave, and far cheaper than the triangles.
   struct Part {
     ConvexHull hull;
     Vec3 center;
@@ -104,9 +106,10 @@ class LinkGeometry {
   /// cores overlap share interior points, so they collide at any padding. Empty when the link has no solid.
   const std::vector<Ball>& cores() const noexcept { return cores_; }
   /// How far every part's ball must grow for their union to hold the whole link, the inside of its closed
-  /// meshes included (the parts hold only their surfaces): 0 for a link without closed meshes, a proven
-  /// small margin for one with them, +∞ where no proof was found (then only the bounding ball holds it).
-  double partBallMargin() const noexcept { return part_ball_margin_; }
+  /// meshes included (the parts hold only their surfaces): 0 for a link without closed meshes or with one
+  /// part, a proven small margin for one with them, +∞ where no proof was found (then only the bounding
+  /// ball holds it). Proven at the first call (thread-safe): only the enclosing layer asks, for robot links.
+  double partBallMargin() const;
   /// True when the balls (link frame), each grown by `margin`, provably hold every point inside the
   /// link's closed meshes (true without closed meshes). False proves nothing: the proof gives up after a
   /// bounded amount of work.
@@ -117,7 +120,7 @@ class LinkGeometry {
   void buildParts();
   void findSolids();
   void findCores();
-  void coverSolids();
+  double coverSolids() const;
   // The distance from p to the nearest triangle, or `cutoff` when none is nearer.
   double surfaceDistance(const Vec3& p, double cutoff) const noexcept;
   // Ray parity of solid s at p along `dir`: 1 inside, 0 outside, −1 when the ray passes too near an edge,
@@ -139,7 +142,18 @@ class LinkGeometry {
   std::vector<Aabb> solid_boxes_;       // per closed piece
   std::vector<Vec3> probes_;
   std::vector<Ball> cores_;
-  double part_ball_margin_ = 0.0;
+  // partBallMargin once proven (NaN before). Copies keep it; two threads asking at once both prove it, to the
+  // same value.
+  struct Proven {
+    mutable std::atomic<double> value{std::numeric_limits<double>::quiet_NaN()};
+    Proven() = default;
+    Proven(const Proven& o) noexcept : value(o.value.load(std::memory_order_relaxed)) {}
+    Proven& operator=(const Proven& o) noexcept {
+      value.store(o.value.load(std::memory_order_relaxed), std::memory_order_relaxed);
+      return *this;
+    }
+  };
+  Proven part_ball_margin_;
 };
 
 /// The box, in the frame `pose` is given in, of a convex shape placed by it: 6 support queries plus its
