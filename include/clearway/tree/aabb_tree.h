@@ -288,8 +288,14 @@ bool AabbTree::forEachWithin(const Aabb& box, const Pose& box_in_tree, double& c
   const Aabb bounds = transformed(box, box_in_tree);
   const detail::OrientedBoxTest test(box_in_tree, 0.0, detail::treePairScale(nodes_[0].box, box, box_in_tree));
   const detail::OrientedBoxTest::PlacedB placed = test.place(box);
-  return forEachWithinBy([&](const Aabb& node) { return std::max(boxDistance(node, bounds), test.gap(node, placed)); },
-                         cutoff, on_item);
+  // The oriented gap only where the bounds' distance leaves the node within the cutoff: beyond it, the gap
+  // could only add to a distance already pruned (the cutoff only falls), and it costs ten times more.
+  return forEachWithinBy(
+      [&](const Aabb& node) {
+        const double d = boxDistance(node, bounds);
+        return d > cutoff ? d : std::max(d, test.gap(node, placed));
+      },
+      cutoff, on_item);
 }
 
 template <class D, class F>

@@ -245,9 +245,13 @@ bool VersionedAabbTree<T>::forEachWithin(const Aabb& box, const Pose& box_in_tre
   const Aabb placed_bounds = transformed(box, box_in_tree);
   const detail::OrientedBoxTest test(box_in_tree, 0.0, detail::treePairScale(bounds(), box, box_in_tree));
   const detail::OrientedBoxTest::PlacedB placed = test.place(box);
+  // (The gap only within the cutoff, as in AabbTree::forEachWithin.)
   return forEachWithinBy(
-      [&](const Aabb& node) { return std::max(boxDistance(node, placed_bounds), test.gap(node, placed)); }, cutoff,
-      on_item);
+      [&](const Aabb& node) {
+        const double d = boxDistance(node, placed_bounds);
+        return d > cutoff ? d : std::max(d, test.gap(node, placed));
+      },
+      cutoff, on_item);
 }
 
 template <class T>
