@@ -487,6 +487,9 @@ bool shapeIntersectsLink(const Shape& shape, const Pose& pose_shape, const LinkG
   const double scale = link.boundingRadius() + shape_in_link.t.norm() + boundingRadius(shape);
   const double slack = padding + narrowBand(scale + padding, tol);
   if (detail::OrientedBoxTest(shape_in_link, slack, scale).separated<true>(link.bounds(), localBox(shape))) return false;
+  // A core (inside the link, so inside its hull) that meets the shape settles a contact in either mode, for
+  // a few point distances where the hulls' GJK and the triangles cost far more: a link in an obstacle.
+  if (coreMeetsShape(shape, shape_in_link, link)) return true;
   SimplexCache scratch;
   SimplexCache& cache = hull_cache ? *hull_cache : scratch;
   const bool hulls = std::visit(
@@ -497,7 +500,6 @@ bool shapeIntersectsLink(const Shape& shape, const Pose& pose_shape, const LinkG
       shape);
   if (!hulls) return false;
   if (mode == GeometryMode::Hull) return true;
-  if (coreMeetsShape(shape, shape_in_link, link)) return true;
   if (shapeIntersectsTriangles(shape, shape_in_link, link, tol, padding, slack)) return true;
   for (const auto& p : link.primitives())
     if (shapesIntersect(shape, shape_in_link, p.shape, p.pose, tol, padding)) return true;
