@@ -291,6 +291,7 @@ MotionContext MotionChecker::makeContext() const {
     for (int k = 0; k < env_items; ++k) c.env_slot[k] = static_cast<int>(k * obstacles);
     c.env_cache.resize(env_items * obstacles);
   }
+  c.probe_states.resize(static_cast<std::size_t>(motion_detail::kProbes) * scene_->dimension());
   c.pose_stamp.assign(scene_->robot().linkCount(), 0);
   c.pose_path.reserve(scene_->robot().linkCount());
   c.intervals.reserve(256);

@@ -49,12 +49,17 @@ struct Scratch {
   // it ran on), and the segments since it last ran.
   double probe_rate = 1.0;
   int probe_skipped = 0;
+  std::vector<double> probe_states;  // the probe's states, one after another (kProbes·dimension)
 };
 
+// How many states the probe checks.
+constexpr int kProbes = 4;
+
 // A verdict-only check's first look (probe.cpp): the states at s = 1, 1/2, 1/4 and 3/4, checked as the
-// validity checker checks states. True, with r filled (a contact at that s, the state's report), when one
-// collides: the segment is then not free whatever the items would measure. Only where it has lately
-// paid for itself (planners' segments often collide; a path's or a benchmark's seldom do).
+// validity checker checks states (all their obstacles before any of their self pairs: Scene::anyCollides).
+// True, with r filled (a contact at that s, the state's report), when one collides: the segment is then not
+// free whatever the items would measure. Only where it has lately paid for itself (planners' segments
+// often collide; a path's or a benchmark's seldom do).
 bool probeCollides(const MotionChecker& checker, const double* q0, double t0, const double* q1, double t1,
                    Scratch& ctx, MotionResult& r) noexcept;
 

@@ -423,8 +423,13 @@ bool Scene::isFree(const double* state, SceneContext& ctx, CollisionReport* repo
 
 bool Scene::posedFree(const Pose* poses, const double* q, SceneContext& ctx, CollisionReport& r,
                       double t) const noexcept {
-  const Effects& fx = description_.effects;
   bool balls_placed = false;
+  return environmentFree(poses, ctx, r, t, balls_placed) && selfFree(poses, q, ctx, r, balls_placed);
+}
+
+bool Scene::environmentFree(const Pose* poses, SceneContext& ctx, CollisionReport& r, double t,
+                            bool& balls_placed) const noexcept {
+  const Effects& fx = description_.effects;
   if (fx.environment && !environment_->empty()) {
     const double time = fx.moving ? t : 0.0;
     // Once the environment has its clearance grid, the enclosing balls (placed after the lead link for
@@ -476,6 +481,12 @@ bool Scene::posedFree(const Pose* poses, const double* q, SceneContext& ctx, Col
     for (int k = 0; k < n; ++k)
       if (k != lead && hits(k)) return false;
   }
+  return true;
+}
+
+bool Scene::selfFree(const Pose* poses, const double* q, SceneContext& ctx, CollisionReport& r,
+                     bool balls_placed) const noexcept {
+  const Effects& fx = description_.effects;
   if (fx.self) {
     const long long before = ctx.self.pair_tests;
     const LinkPair* hit = self_.firstCollision(poses, ctx.self, q, balls_placed);
@@ -488,6 +499,59 @@ bool Scene::posedFree(const Pose* poses, const double* q, SceneContext& ctx, Col
     }
   }
   return true;
+}
+
+int Scene::anyCollides(const double* states, int count, SceneContext& ctx, CollisionReport* report,
+                       const double* times) const noexcept {
+  CollisionReport local;
+  CollisionReport& r = report ? *report : local;
+  r = CollisionReport{};
+  const RobotModel& model = robot();
+  const int dim = dimension();
+  const auto state = [&](int s) { return states + static_cast<std::ptrdiff_t>(s) * dim; };
+  const auto time = [&](int s) { return times ? times[s] : 0.0; };
+  // A context made for another robot (or before lanes existed) takes the states one at a time.
+  if (!ctx.lanes || !ctx.lanes->madeFor(model) || ctx.poses.size() != static_cast<std::size_t>(model.linkCount())) {
+    for (int s = 0; s < count; ++s)
+      if (!isFree(state(s), ctx, &r, time(s))) return s;
+    return -1;
+  }
+  const Effects& fx = description_.effects;
+  const int variables = model.variableCount(), links = model.linkCount();
+  const double* lane_q[KinematicLanes::kMaxLanes];
+  Pose* lane_poses[KinematicLanes::kMaxLanes];
+  // In chunks of as many states as the lanes' scratch holds: every environment check of a chunk, then every
+  // self check, each pass in the order given.
+  for (int first = 0; first < count; first += KinematicLanes::kMaxLanes) {
+    const int n = std::min(count - first, KinematicLanes::kMaxLanes);
+    for (int l = 0; l < n; ++l) {
+      const double* x = state(first + l);
+      ++ctx.counters.states;
+      if (!withinBounds(x)) {
+        ++ctx.counters.invalid_states;
+        r.kind = CollisionReport::Kind::Invalid;
+        return first + l;
+      }
+      if (static_collision_.kind != CollisionReport::Kind::None) {
+        r = static_collision_;
+        return first + l;
+      }
+      double* q = ctx.lane_q.data() + static_cast<std::ptrdiff_t>(l) * variables;
+      for (std::size_t i = 0; i < group_variables_.size(); ++i) q[group_variables_[i]] = x[i];
+      lane_q[l] = q;
+      lane_poses[l] = ctx.lane_poses.data() + static_cast<std::ptrdiff_t>(l) * links;
+    }
+    if (!fx.self && !fx.environment) continue;
+    ctx.lanes->compute(lane_q, n, lane_poses);
+    for (int l = 0; l < n; ++l) {
+      bool balls_placed = false;
+      if (!environmentFree(lane_poses[l], ctx, r, time(first + l), balls_placed)) return first + l;
+    }
+    // (The balls were placed for another state's grid look-ups: the self check places its own.)
+    for (int l = 0; l < n; ++l)
+      if (!selfFree(lane_poses[l], lane_q[l], ctx, r, false)) return first + l;
+  }
+  return -1;
 }
 
 void Scene::areFree(const double* states, int count, SceneContext& ctx, bool* free, double t) const noexcept {

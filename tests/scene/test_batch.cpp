@@ -1,4 +1,4 @@
-// Scene::areFree against Scene::isFree, verdict by verdict: every shared family in both its primitive and
+// Scene::areFree and Scene::anyCollides against Scene::isFree, verdict by verdict: every shared family in both its primitive and
 // its OctoMap form, our robots' scenes (floating and planar joints among them), batches of every length
 // around the lane width, invalid states inside a batch, scenes that check nothing or can never be free,
 // a context of another robot, and the lanes forced to every SIMD target this machine offers.
@@ -51,6 +51,31 @@ std::vector<double> randomStates(const Scene& scene, int count, unsigned seed) {
   return out;
 }
 
+// anyCollides over windows of 1 to 12 states (beyond its chunk of 8): −1 exactly when isFree calls every state
+// of the window free, else a state isFree calls colliding, with a report.
+void expectAnyCollidesAgrees(const Scene& scene, const std::vector<double>& states, const std::vector<char>& expected,
+                             SceneContext& ctx, const std::string& what) {
+  const int n = scene.dimension();
+  const int count = static_cast<int>(expected.size());
+  std::vector<double> times(count, 0.0);
+  for (int length = 1; length <= 12; ++length)
+    for (int first = 0; first + length <= count; first += 3 * length) {
+      bool any = false;
+      for (int s = first; s < first + length; ++s) any |= !expected[s];
+      CollisionReport report;
+      const int hit = scene.anyCollides(states.data() + static_cast<std::size_t>(first) * n, length, ctx, &report,
+                                        times.data() + first);
+      if (!any) {
+        EXPECT_EQ(hit, -1) << what << ": states " << first << " + " << length << " are free";
+        continue;
+      }
+      ASSERT_GE(hit, 0) << what << ": states " << first << " + " << length << " hold a collision";
+      ASSERT_LT(hit, length) << what;
+      EXPECT_FALSE(expected[first + hit]) << what << ": state " << first + hit << " is free";
+      EXPECT_NE(report.kind, CollisionReport::Kind::None) << what;
+    }
+}
+
 // areFree's verdicts equal isFree's for every state, in one batch and in batches of one, of a pass less
 // or more one, and of two passes and one, on every target. Returns the number of colliding states.
 int expectBatchEqualsOneByOne(const Scene& scene, const std::vector<double>& states, const std::string& what) {
@@ -79,6 +104,7 @@ int expectBatchEqualsOneByOne(const Scene& scene, const std::vector<double>& sta
     scene.areFree(states.data(), count, ctx, all.get());
     for (int s = 0; s < count; ++s)
       EXPECT_EQ(all[s], static_cast<bool>(expected[s])) << what << ", target " << hwy::TargetName(target) << ", state " << s;
+    expectAnyCollidesAgrees(scene, states, expected, ctx, what + ", target " + hwy::TargetName(target));
   }
   return colliding;
 }
@@ -141,6 +167,11 @@ TEST(SceneBatch, ScenesThatCheckNothingOrCanNeverBeFree) {
   SceneContext never_ctx = never.makeContext();
   never.areFree(q.data(), 120, never_ctx, got.get());
   for (int s = 0; s < 120; ++s) EXPECT_FALSE(got[s]) << s;
+  CollisionReport report;
+  EXPECT_EQ(never.anyCollides(q.data(), 5, never_ctx, &report), 0);
+  EXPECT_EQ(report.kind, never.staticCollision().kind);
+  SceneContext nothing_ctx = nothing.makeContext();
+  EXPECT_EQ(nothing.anyCollides(q.data(), 40, nothing_ctx), -1);  // (states 0-39: all valid)
 }
 
 TEST(SceneBatch, AContextOfAnotherRobotTakesTheStatesOneByOne) {
@@ -155,6 +186,9 @@ TEST(SceneBatch, AContextOfAnotherRobotTakesTheStatesOneByOne) {
   SceneContext none;  // default-made: no lanes, no poses
   arm.areFree(q.data(), 40, none, got.get());
   for (int s = 0; s < 40; ++s) EXPECT_FALSE(got[s]) << s;
+  CollisionReport report;
+  EXPECT_EQ(arm.anyCollides(q.data(), 40, none, &report), 0);
+  EXPECT_EQ(report.kind, CollisionReport::Kind::Invalid);
 }
 
 }  // namespace clearway

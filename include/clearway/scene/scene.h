@@ -212,6 +212,15 @@ class Scene {
   /// SIMD lanes (KinematicLanes); then each state's links meet the obstacles and each other.
   void areFree(const double* states, int count, SceneContext& context, bool* free, double t = 0.0) const noexcept;
 
+  /// A colliding state among `count` states (state s at states + s·dimension(), at time times[s], or 0
+  /// without times): its index, with `report` (optional) saying what collided, or −1 when every state is free
+  /// (each verdict as isFree gives it). Verdict only, for a segment's probe: the environment checks of
+  /// several states come before any of their self checks, so an obstacle met in a later state ends the
+  /// query before the self pairs of the earlier ones are tested; the index is a colliding state, not
+  /// necessarily the first. The kinematics run in SIMD lanes, as in areFree.
+  int anyCollides(const double* states, int count, SceneContext& context, CollisionReport* report = nullptr,
+                  const double* times = nullptr) const noexcept;
+
   /// Signed clearance: the distance from the robot to the nearest declared hazard (environment and/or
   /// self) minus padding when free; when something touches, minus the deepest penetration (EPA between
   /// convex hulls, which contain the links: never shallower than the exact depth). NaN when the scene
@@ -230,6 +239,12 @@ class Scene {
   bool withinBounds(const double* state) const noexcept;  // the cheap check of every query (no reason)
   // isFree's geometry, once the poses of the state's links (and its full joint vector q) are known.
   bool posedFree(const Pose* poses, const double* q, SceneContext& ctx, CollisionReport& r, double t) const noexcept;
+  // Its two halves: the environment (placing the enclosing balls where the clearance grid is read, which
+  // balls_placed then says), and the self pairs.
+  bool environmentFree(const Pose* poses, SceneContext& ctx, CollisionReport& r, double t,
+                       bool& balls_placed) const noexcept;
+  bool selfFree(const Pose* poses, const double* q, SceneContext& ctx, CollisionReport& r,
+                bool balls_placed) const noexcept;
 
   SceneDescription description_;
   SceneOptions options_;
