@@ -24,30 +24,44 @@ EnclosingBalls::EnclosingBalls(const RobotGeometry& geometry) : geometry_(&geome
       }
     links_[i].count = static_cast<int>(local_.size()) - links_[i].first;
   }
-  bound_x_.assign(n, 0.0);
-  bound_y_.assign(n, 0.0);
-  bound_z_.assign(n, 0.0);
+  // Never apart until placed: NaN centres (a NaN compares false), and an infinite radius for links without
+  // geometry; the radii never change.
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  bound_x_.assign(n, nan);
+  bound_y_.assign(n, nan);
+  bound_z_.assign(n, nan);
+  bound_norm_.assign(n, nan);
   bound_r_.assign(n, std::numeric_limits<double>::infinity());
-  bound_norm_.assign(n, 0.0);
+  for (int i = 0; i < n; ++i)
+    if (links_[i].count > 0) bound_r_[i] = radii_[links_[i].first];
   for (const Vec3& c : local_) local_norms_.push_back(c.norm());
   centers_.assign(local_.size(), Vec3::Constant(std::numeric_limits<double>::quiet_NaN()));
   norms_.assign(local_.size(), std::numeric_limits<double>::quiet_NaN());
 }
 
 void EnclosingBalls::place(const Pose* link_poses) noexcept {
-  // Most pairs are cleared by their bounding balls, so parts wait until a pair needs them.
+  // Most pairs are cleared by their bounding balls, so parts wait until a pair needs them (a new placement
+  // makes every link's parts stale at once).
   poses_ = link_poses;
-  for (std::size_t i = 0; i < links_.size(); ++i) {
-    Link& l = links_[i];
-    if (l.count == 0) continue;
-    centers_[l.first] = link_poses[i] * local_[l.first];
-    norms_[l.first] = centers_[l.first].norm();
-    l.parts_placed = l.count == 1;
-    bound_x_[i] = centers_[l.first].x();
-    bound_y_[i] = centers_[l.first].y();
-    bound_z_[i] = centers_[l.first].z();
-    bound_r_[i] = radii_[l.first];
-    bound_norm_[i] = norms_[l.first];
+  ++placement_;
+  // (Through raw pointers: the stores would otherwise make the compiler reload every vector's data.)
+  const Link* links = links_.data();
+  const Vec3* local = local_.data();
+  Vec3* centers = centers_.data();
+  double* norms = norms_.data();
+  double *x = bound_x_.data(), *y = bound_y_.data(), *z = bound_z_.data(), *norm = bound_norm_.data();
+  const int n = static_cast<int>(links_.size());
+  for (int i = 0; i < n; ++i) {
+    const int first = links[i].first;
+    if (links[i].count == 0) continue;
+    const Vec3 c = link_poses[i] * local[first];
+    const double length = c.norm();
+    centers[first] = c;
+    norms[first] = length;
+    x[i] = c.x();
+    y[i] = c.y();
+    z[i] = c.z();
+    norm[i] = length;
   }
 }
 
@@ -58,7 +72,7 @@ void EnclosingBalls::placeParts(int link) noexcept {
     centers_[k] = pose * local_[k];
     norms_[k] = centers_[k].norm();
   }
-  l.parts_placed = true;
+  l.parts_at = placement_;
 }
 
 bool EnclosingBalls::apart(int a, int b, double padding, const Tolerances& tol) noexcept {
@@ -74,8 +88,8 @@ bool EnclosingBalls::apart(int a, int b, double padding, const Tolerances& tol) 
   };
   if (ballsApart(la.first, lb.first)) return true;
   if (la.count == 1 && lb.count == 1) return false;
-  if (!la.parts_placed) placeParts(a);
-  if (!lb.parts_placed) placeParts(b);
+  if (la.parts_at != placement_) placeParts(a);
+  if (lb.parts_at != placement_) placeParts(b);
   // The union of a link's parts contains it: every part ball of one apart from every part ball of the other.
   const int ia = la.first + (la.count > 1), ib = lb.first + (lb.count > 1);
   for (int i = ia; i < la.first + la.count; ++i)

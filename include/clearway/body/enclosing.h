@@ -50,7 +50,7 @@ class EnclosingBalls {
   /// closed meshes included.
   Placed placed(int i, int k) noexcept {
     Link& l = links_[i];
-    if (k > 0 && !l.parts_placed) placeParts(i);
+    if (k > 0 && l.parts_at != placement_) placeParts(i);
     const int at = l.first + k;
     // R·c + t rounds by a few ulps of |c| + |t| per coordinate, and |t| ≤ |R·c + t| + |c|: 16 ulps of
     // 2|c| + |R·c + t| is more than that.
@@ -62,10 +62,11 @@ class EnclosingBalls {
   struct Link {
     int first = 0;  // its balls in centers_/radii_: [first] the bounding ball, then the parts' balls
     int count = 0;
-    bool parts_placed = false;  // since the last place()
+    std::uint64_t parts_at = 0;  // the placement its parts' balls were placed at
   };
   void placeParts(int link) noexcept;
   const Pose* poses_ = nullptr;  // as last placed
+  std::uint64_t placement_ = 0;  // place() calls (the first is 1)
   const RobotGeometry* geometry_ = nullptr;
   std::vector<Link> links_;
   std::vector<Vec3> local_;    // ball centres, link frame
