@@ -19,6 +19,8 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <string>
+#include <utility>
 #include <vector>
 
 namespace clearway::tree_ref {
@@ -324,6 +326,15 @@ inline TriangleMesh joined(const TriangleMesh& a, const TriangleMesh& b, const V
   for (const Vec3& v : b.vertices) m.vertices.push_back(v + offset);
   for (const auto& t : b.triangles) m.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
   return m;
+}
+
+/// Closed meshes of several kinds, named: round, a hole, thin, coarse, two pieces joined.
+inline std::vector<std::pair<std::string, TriangleMesh>> closedSamples() {
+  return {{"sphere", uvSphere(0.1, 10, 16)},
+          {"torus", torus(0.12, 0.03, 20, 10)},
+          {"plate", gridBox(Vec3(0.15, 0.1, 0.002), 4)},
+          {"box", gridBox(Vec3(0.05, 0.08, 0.1), 2)},
+          {"dumbbell", joined(uvSphere(0.04, 6, 10), gridBox(Vec3(0.03, 0.03, 0.03), 2), Vec3(0.2, 0.05, 0.0))}};
 }
 
 inline Mat3 randomRotation(std::mt19937_64& rng) {

@@ -51,13 +51,7 @@ void expectCoresInside(const LinkGeometry& g, const std::string& what) {
 }
 
 TEST(Cores, LieInsideGeneratedMeshes) {
-  const std::vector<std::pair<std::string, TriangleMesh>> meshes{
-      {"sphere", tree_ref::uvSphere(0.1, 10, 16)},
-      {"torus", tree_ref::torus(0.12, 0.03, 20, 10)},
-      {"plate", tree_ref::gridBox(Vec3(0.15, 0.1, 0.002), 4)},
-      {"box", tree_ref::gridBox(Vec3(0.05, 0.08, 0.1), 2)},
-      {"dumbbell", tree_ref::joined(tree_ref::uvSphere(0.04, 6, 10), tree_ref::gridBox(Vec3(0.03, 0.03, 0.03), 2),
-                                    Vec3(0.2, 0.05, 0.0))}};
+  const std::vector<std::pair<std::string, TriangleMesh>> meshes = tree_ref::closedSamples();
   for (const auto& [name, mesh] : meshes) {
     const LinkGeometry g(mesh);
     EXPECT_FALSE(g.cores().empty()) << name << ": a closed mesh without cores";

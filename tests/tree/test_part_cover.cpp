@@ -109,13 +109,7 @@ TEST(PartCover, ProvesOnlyBallsThatHoldTheCube) {
 // Random ball sets near the parts' own (radii shrunk or grown, centres moved): every set proven holds every
 // sampled inside point, and both answers occur (a proof that always refused would pass the first).
 TEST(PartCover, EveryProvenSetHoldsTheSampledInside) {
-  const std::vector<std::pair<std::string, TriangleMesh>> meshes{
-      {"sphere", tree_ref::uvSphere(0.1, 10, 16)},
-      {"torus", tree_ref::torus(0.12, 0.03, 20, 10)},
-      {"plate", tree_ref::gridBox(Vec3(0.15, 0.1, 0.002), 4)},
-      {"box", tree_ref::gridBox(Vec3(0.05, 0.08, 0.1), 2)},
-      {"dumbbell", tree_ref::joined(tree_ref::uvSphere(0.04, 6, 10), tree_ref::gridBox(Vec3(0.03, 0.03, 0.03), 2),
-                                    Vec3(0.2, 0.05, 0.0))}};
+  const std::vector<std::pair<std::string, TriangleMesh>> meshes = tree_ref::closedSamples();
   std::mt19937_64 rng(11);
   int proven = 0, refused = 0;
   for (const auto& [name, mesh] : meshes) {
