@@ -53,7 +53,12 @@ def test_threads_sharing_a_scene_get_the_single_thread_answers(arm6, panda_box):
 def test_a_check_releases_the_gil(panda_box):
     """While one thread checks a long batch, this thread keeps running Python: no gap as long as the check."""
     _, scene = panda_box
-    states = random_states(scene, 20000, seed=60)
+    # A batch long enough to tell (about 0.2 s) however fast the checks are on this build and machine.
+    probe = random_states(scene, 2000, seed=60)
+    started = time.perf_counter()
+    scene.check(probe)
+    per_state = max(time.perf_counter() - started, 1e-6) / len(probe)
+    states = random_states(scene, int(min(400000, max(20000, 0.2 / per_state))), seed=60)
     span = {}
 
     def check():
