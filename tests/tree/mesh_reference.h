@@ -10,6 +10,7 @@
 //                distances to the plane and the crossing point's distances to the triangle's edges).
 // Pairs of meshes are classified robustly colliding, robustly free, or within the band (ambiguous).
 // Also: generators of closed test meshes (UV spheres, tori, subdivided boxes and thin plates).
+#include <clearway/shape/primitives.h>
 #include <clearway/shape/triangle_mesh.h>
 #include <clearway/math.h>
 #include <clearway/tree/aabb.h>
@@ -326,6 +327,17 @@ inline TriangleMesh joined(const TriangleMesh& a, const TriangleMesh& b, const V
   for (const Vec3& v : b.vertices) m.vertices.push_back(v + offset);
   for (const auto& t : b.triangles) m.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
   return m;
+}
+
+/// The reference's mesh of a link's triangles (in the link frame), each with its own three vertices.
+inline WorldMesh placeTriangles(const std::vector<Triangle>& triangles) {
+  TriangleMesh m;
+  for (const Triangle& t : triangles) {
+    const int k = static_cast<int>(m.vertices.size());
+    for (const Vec3& v : t.v) m.vertices.push_back(v);
+    m.triangles.push_back({k, k + 1, k + 2});
+  }
+  return place(m, Pose::identity());
 }
 
 /// Closed meshes of several kinds, named: round, a hole, thin, coarse, two pieces joined.

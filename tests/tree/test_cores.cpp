@@ -22,13 +22,7 @@ namespace {
 // Every core: its centre has winding number ±1 in the link's triangles (the reference's own reading), and no triangle comes within its
 // radius (brute force over all of them, no tree).
 void expectCoresInside(const LinkGeometry& g, const std::string& what) {
-  TriangleMesh m;
-  for (const Triangle& t : g.triangles()) {
-    const int k = static_cast<int>(m.vertices.size());
-    for (const Vec3& v : t.v) m.vertices.push_back(v);
-    m.triangles.push_back({k, k + 1, k + 2});
-  }
-  const tree_ref::WorldMesh w = tree_ref::place(m, Pose::identity());
+  const tree_ref::WorldMesh w = tree_ref::placeTriangles(g.triangles());
   for (const LinkGeometry::Ball& c : g.cores()) {
     ASSERT_GT(c.radius, 0.0) << what;
     bool in_primitive = false;

@@ -29,13 +29,7 @@ struct Sampled {
   int inside = 0, loose = 0;
 };
 Sampled sampleInside(const LinkGeometry& g, const Balls& balls, double margin, int samples, std::uint64_t seed) {
-  TriangleMesh m;
-  for (const Triangle& t : g.triangles()) {
-    const int k = static_cast<int>(m.vertices.size());
-    for (const Vec3& v : t.v) m.vertices.push_back(v);
-    m.triangles.push_back({k, k + 1, k + 2});
-  }
-  const tree_ref::WorldMesh w = tree_ref::place(m, Pose::identity());
+  const tree_ref::WorldMesh w = tree_ref::placeTriangles(g.triangles());
   std::mt19937_64 rng(seed);
   Sampled s;
   const Aabb& b = g.bounds();
