@@ -142,6 +142,9 @@ void replay(const std::string& file, int seeds) {
   // over all the segments at a time: interleaved per segment, each would evict the others' data.
   const clearway::MotionChecker certified(scene);
   clearway::MotionContext context = certified.makeContext();
+  // The clearance grid, which the environment builds once asked enough (a few ms), now: the runs above may
+  // not have asked enough, and its one build would land on whichever replayed motion asked last.
+  scene->environment().prepareClearanceGrid();
   Sampled ours(*scene, [&](const ob::SpaceInformationPtr& si) { return std::make_shared<clearway::ValidityChecker>(si, scene); });
   Sampled fcl(*scene, [&](const ob::SpaceInformationPtr& si) { return std::make_shared<clearway::bench::FclValidity>(si, scene); });
   double us[2][3] = {}, queries[2] = {}, states[2] = {};
