@@ -327,8 +327,11 @@ MotionResult MotionChecker::check(const double* q0, double t0, const double* q1,
     return r;
   }
   motion_detail::Scratch& ctx = *context.scratch_;
-  // A context made by a checker of another robot (a World before an attach, say) does not fit: refused.
-  if (ctx.safe_until.size() != items_.size() || ctx.scene.poses.size() != static_cast<std::size_t>(scene_->robot().linkCount())) {
+  // A context made by a checker of another robot (a World before an attach, say), or of another group of
+  // this one (its state buffers sized for another dimension), does not fit: refused.
+  const std::size_t dim = static_cast<std::size_t>(scene_->dimension());
+  if (ctx.safe_until.size() != items_.size() || ctx.scene.poses.size() != static_cast<std::size_t>(scene_->robot().linkCount()) ||
+      ctx.q.size() != dim || ctx.dq.size() != dim || ctx.probe_states.size() != motion_detail::kProbes * dim) {
     MotionResult r;
     r.report.kind = CollisionReport::Kind::Invalid;
     return r;

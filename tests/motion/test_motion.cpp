@@ -449,6 +449,16 @@ TEST(MotionCertified, BadInput) {
     EXPECT_EQ(certified.check(ok, ok, empty).report.kind, CollisionReport::Kind::Invalid);
     empty = certified.makeContext();
     EXPECT_TRUE(certified.check(ok, ok, empty).free);
+    // A context of a checker for another group of the same robot (its items fit, its state buffers do not).
+    const std::string urdf = dir.write("slider.urdf", kSliderUrdf);
+    const auto one = Scene::load(dir.write("one.yaml", "format: 1\nname: one\nrobot:\n  urdf: " + urdf +
+                                                           "\n  group: [slide]\nenvironment:\n  obstacles:\n"
+                                                           "    - {name: wall, box: {size: [0.001, 2, 2]}, pose: {position: [0, 0, 0]}}\n"
+                                                           "checks: [environment, continuous]\n"));
+    const MotionChecker other(one);
+    MotionContext misfit = other.makeContext();
+    EXPECT_FALSE(certified.check(ok, ok, misfit).free);
+    EXPECT_EQ(certified.check(ok, ok, misfit).report.kind, CollisionReport::Kind::Invalid);
   }
   for (const double bad : {std::nan(""), std::numeric_limits<double>::infinity(), 5.0}) {
     const double q[2] = {-0.5, bad};

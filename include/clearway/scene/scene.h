@@ -214,10 +214,11 @@ class Scene {
 
   /// A colliding state among `count` states (state s at states + s·dimension(), at time times[s], or 0
   /// without times): its index, with `report` (optional) saying what collided, or −1 when every state is free
-  /// (each verdict as isFree gives it). Verdict only, for a segment's probe: the environment checks of
-  /// several states come before any of their self checks, so an obstacle met in a later state ends the
-  /// query before the self pairs of the earlier ones are tested; the index is a colliding state, not
-  /// necessarily the first. The kinematics run in SIMD lanes, as in areFree.
+  /// (each verdict as isFree gives it). Verdict only, for a segment's probe: in each chunk of
+  /// KinematicLanes::kMaxLanes states, every state's environment check comes before any self check, so an
+  /// obstacle met in a later state ends the query before the self pairs of the earlier ones are tested;
+  /// the index is a colliding state, not necessarily the first. The kinematics run in SIMD lanes, as in
+  /// areFree.
   int anyCollides(const double* states, int count, SceneContext& context, CollisionReport* report = nullptr,
                   const double* times = nullptr) const noexcept;
 
