@@ -54,10 +54,10 @@ std::vector<double> randomStates(const Scene& scene, int count, unsigned seed) {
 // anyCollides over windows of 1 to 12 states (beyond its chunk of 8): −1 exactly when isFree calls every state
 // of the window free, else a state isFree calls colliding, with a report.
 void expectAnyCollidesAgrees(const Scene& scene, const std::vector<double>& states, const std::vector<char>& expected,
-                             SceneContext& ctx, const std::string& what) {
+                             SceneContext& ctx, const std::string& what, std::vector<double> times = {}) {
   const int n = scene.dimension();
   const int count = static_cast<int>(expected.size());
-  std::vector<double> times(count, 0.0);
+  times.resize(count, 0.0);
   for (int length = 1; length <= 12; ++length)
     for (int first = 0; first + length <= count; first += 3 * length) {
       bool any = false;
@@ -172,6 +172,34 @@ TEST(SceneBatch, ScenesThatCheckNothingOrCanNeverBeFree) {
   EXPECT_EQ(report.kind, never.staticCollision().kind);
   SceneContext nothing_ctx = nothing.makeContext();
   EXPECT_EQ(nothing.anyCollides(q.data(), 40, nothing_ctx), -1);  // (states 0-39: all valid)
+}
+
+TEST(SceneBatch, AnyCollidesReadsEachStatesTime) {
+  // The planar arm and a ball falling through its reach: each state is checked where the ball is at its own
+  // time, as isFree checks it.
+  test::TempDir dir;
+  const std::string file = dir.write(
+      "moving.yaml", "format: 1\nname: moving\nrobot:\n  urdf: " + test::sourceRobot("planar_arm/planar_arm.urdf") +
+                         "\n  group: [shoulder, elbow]\nenvironment:\n  obstacles:\n"
+                         "    - {name: ball, sphere: {radius: 0.3}, pose: {position: [0.8, 2, 0]}, velocity: [0, -1, 0]}\n"
+                         "checks: [self, environment, moving]\n");
+  const Scene scene(parseSceneFile(file));
+  const std::vector<double> q = randomStates(scene, 300, 21);
+  std::vector<double> times(300);
+  std::mt19937 rng(4);
+  for (double& t : times) t = std::uniform_real_distribution<double>(0.0, 4.0)(rng);
+  SceneContext ctx = scene.makeContext();
+  std::vector<char> expected(300);
+  int colliding = 0, by_time = 0;
+  for (int s = 0; s < 300; ++s) {
+    const double* x = q.data() + static_cast<std::size_t>(s) * scene.dimension();
+    expected[s] = scene.isFree(x, ctx, nullptr, times[s]);
+    colliding += !expected[s];
+    by_time += static_cast<bool>(expected[s]) != scene.isFree(x, ctx, nullptr, 0.0);
+  }
+  EXPECT_GT(by_time, 10) << "the ball's time decides too few states to tell";
+  EXPECT_GT(colliding, 0);
+  expectAnyCollidesAgrees(scene, q, expected, ctx, "moving ball", times);
 }
 
 TEST(SceneBatch, AContextOfAnotherRobotTakesTheStatesOneByOne) {
