@@ -501,23 +501,34 @@ bool Scene::selfFree(const Pose* poses, const double* q, SceneContext& ctx, Coll
   return true;
 }
 
+bool Scene::lanesFit(const SceneContext& ctx) const noexcept {
+  const RobotModel& model = robot();
+  return ctx.lanes && ctx.lanes->madeFor(model) && ctx.poses.size() == static_cast<std::size_t>(model.linkCount());
+}
+
+void Scene::toLane(const double* state, int lane, SceneContext& ctx, const double** lane_q, Pose** lane_poses) const noexcept {
+  const RobotModel& model = robot();
+  double* q = ctx.lane_q.data() + static_cast<std::ptrdiff_t>(lane) * model.variableCount();
+  for (std::size_t i = 0; i < group_variables_.size(); ++i) q[group_variables_[i]] = state[i];
+  lane_q[lane] = q;
+  lane_poses[lane] = ctx.lane_poses.data() + static_cast<std::ptrdiff_t>(lane) * model.linkCount();
+}
+
 int Scene::anyCollides(const double* states, int count, SceneContext& ctx, CollisionReport* report,
                        const double* times) const noexcept {
   CollisionReport local;
   CollisionReport& r = report ? *report : local;
   r = CollisionReport{};
-  const RobotModel& model = robot();
   const int dim = dimension();
   const auto state = [&](int s) { return states + static_cast<std::ptrdiff_t>(s) * dim; };
   const auto time = [&](int s) { return times ? times[s] : 0.0; };
   // A context made for another robot (or before lanes existed) takes the states one at a time.
-  if (!ctx.lanes || !ctx.lanes->madeFor(model) || ctx.poses.size() != static_cast<std::size_t>(model.linkCount())) {
+  if (!lanesFit(ctx)) {
     for (int s = 0; s < count; ++s)
       if (!isFree(state(s), ctx, &r, time(s))) return s;
     return -1;
   }
   const Effects& fx = description_.effects;
-  const int variables = model.variableCount(), links = model.linkCount();
   const double* lane_q[KinematicLanes::kMaxLanes];
   Pose* lane_poses[KinematicLanes::kMaxLanes];
   // In chunks of as many states as the lanes' scratch holds: every environment check of a chunk, then every
@@ -536,10 +547,7 @@ int Scene::anyCollides(const double* states, int count, SceneContext& ctx, Colli
         r = static_collision_;
         return first + l;
       }
-      double* q = ctx.lane_q.data() + static_cast<std::ptrdiff_t>(l) * variables;
-      for (std::size_t i = 0; i < group_variables_.size(); ++i) q[group_variables_[i]] = x[i];
-      lane_q[l] = q;
-      lane_poses[l] = ctx.lane_poses.data() + static_cast<std::ptrdiff_t>(l) * links;
+      toLane(x, l, ctx, lane_q, lane_poses);
     }
     if (!fx.self && !fx.environment) continue;
     ctx.lanes->compute(lane_q, n, lane_poses);
@@ -555,16 +563,14 @@ int Scene::anyCollides(const double* states, int count, SceneContext& ctx, Colli
 }
 
 void Scene::areFree(const double* states, int count, SceneContext& ctx, bool* free, double t) const noexcept {
-  const RobotModel& model = robot();
   const int dim = dimension();
   // A context made for another robot (or before lanes existed) takes the states one at a time.
-  if (!ctx.lanes || !ctx.lanes->madeFor(model) || ctx.poses.size() != static_cast<std::size_t>(model.linkCount())) {
+  if (!lanesFit(ctx)) {
     for (int s = 0; s < count; ++s) free[s] = isFree(states + static_cast<std::ptrdiff_t>(s) * dim, ctx, nullptr, t);
     return;
   }
   const Effects& fx = description_.effects;
   const int width = std::min(KinematicLanes::width(), KinematicLanes::kMaxLanes);
-  const int variables = model.variableCount(), links = model.linkCount();
   const double* lane_q[KinematicLanes::kMaxLanes];
   Pose* lane_poses[KinematicLanes::kMaxLanes];
   int pending[KinematicLanes::kMaxLanes];  // the states in the lanes
@@ -589,10 +595,7 @@ void Scene::areFree(const double* states, int count, SceneContext& ctx, bool* fr
       free[s] = static_collision_.kind == CollisionReport::Kind::None;
       continue;
     }
-    double* q = ctx.lane_q.data() + static_cast<std::ptrdiff_t>(n) * variables;
-    for (std::size_t i = 0; i < group_variables_.size(); ++i) q[group_variables_[i]] = state[i];
-    lane_q[n] = q;
-    lane_poses[n] = ctx.lane_poses.data() + static_cast<std::ptrdiff_t>(n) * links;
+    toLane(state, n, ctx, lane_q, lane_poses);
     pending[n++] = s;
     if (n == width) flush();
   }

@@ -246,6 +246,10 @@ class Scene {
                        bool& balls_placed) const noexcept;
   bool selfFree(const Pose* poses, const double* q, SceneContext& ctx, CollisionReport& r,
                 bool balls_placed) const noexcept;
+  // True when the context has kinematic lanes for this robot (areFree, anyCollides; else one state at a time).
+  bool lanesFit(const SceneContext& ctx) const noexcept;
+  // A state into lane `lane` of the context's lanes: its full joint vector and where its poses go.
+  void toLane(const double* state, int lane, SceneContext& ctx, const double** lane_q, Pose** lane_poses) const noexcept;
 
   SceneDescription description_;
   SceneOptions options_;
