@@ -1,12 +1,13 @@
-// Mesh files → TriangleMesh through assimp. Assimp reads the file and triangulates it; everything that
-// decides what the triangles *are* (node transforms, unit and up axis, scale, welding, degenerate faces)
-// is done here in double precision, so that the result does not depend on assimp's post-processing
-// choices beyond triangulation.
+// Mesh files → TriangleMesh: STL, OBJ and COLLADA through assimp, PLY through ply_reader.cpp. The reader
+// reads the file and triangulates it; everything that decides what the triangles *are* (node transforms,
+// unit and up axis, scale, welding, degenerate faces) is done here in double precision, so that the
+// result does not depend on the reader's choices beyond triangulation.
 #include <clearway/load/input_limits.h>
 #include <clearway/load/load_error.h>
 #include <clearway/load/mesh_loader.h>
 
 #include "load/collada_check.h"
+#include "load/ply_reader.h"
 
 #include <assimp/Importer.hpp>
 #include <assimp/config.h>
@@ -20,10 +21,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
-#include <optional>
-#include <sstream>
+#include <functional>
 #include <string>
 #include <system_error>
 #include <unordered_map>
@@ -115,32 +113,25 @@ struct PositionHash {
 
 class Merger {
  public:
-  Merger(const aiScene& scene, const std::string& path, const Vec3& scale) : scene_(scene), path_(path), scale_(scale) {}
+  Merger(const std::string& path, const Vec3& scale) : path_(path), scale_(scale) {}
 
   // The node and its subtree; world is the node's own transform in the mesh frame (the root's is chosen
   // by the caller), parent * the node's transform for the others.
-  void addNode(const aiNode& node, const Affine& world) {
-    for (unsigned i = 0; i < node.mNumMeshes; ++i) addMesh(*scene_.mMeshes[node.mMeshes[i]], world);
+  void addNode(const aiScene& scene, const aiNode& node, const Affine& world) {
+    for (unsigned i = 0; i < node.mNumMeshes; ++i) addMesh(*scene.mMeshes[node.mMeshes[i]], world);
     for (unsigned i = 0; i < node.mNumChildren; ++i)
-      addNode(*node.mChildren[i], world * toAffine(node.mChildren[i]->mTransformation));
+      addNode(scene, *node.mChildren[i], world * toAffine(node.mChildren[i]->mTransformation));
   }
 
-  TriangleMesh mesh;
-  std::size_t degenerate = 0, points_and_lines = 0;
-
- private:
-  void addMesh(const aiMesh& m, const Affine& world) {
+  // Triangles over positions as written (indices in range), under world; name labels errors.
+  void addTriangles(const std::vector<Vec3>& positions, const std::vector<std::array<std::uint32_t, 3>>& triangles,
+                    const std::string& name, const Affine& world) {
     // A mirroring transform turns counter-clockwise triangles clockwise; swap two corners to undo it.
     const bool mirrored = world.A.determinant() * scale_.prod() < 0.0;
-    index_.assign(m.mNumVertices, -1);
-    for (unsigned f = 0; f < m.mNumFaces; ++f) {
-      const aiFace& face = m.mFaces[f];
-      if (face.mNumIndices != 3) {
-        ++points_and_lines;
-        continue;
-      }
+    index_.assign(positions.size(), -1);
+    for (const auto& corners : triangles) {
       std::array<std::int32_t, 3> t{};
-      for (int k = 0; k < 3; ++k) t[k] = vertex(m, face.mIndices[k], world);  // in range: checkFaceIndices
+      for (int k = 0; k < 3; ++k) t[k] = vertex(positions, corners[k], name, world);
       if (mirrored) std::swap(t[1], t[2]);
       if (isDegenerate(t)) {
         ++degenerate;
@@ -150,17 +141,34 @@ class Merger {
     }
   }
 
-  // The merged index of vertex i of mesh m (transformed, scaled and welded on first use).
-  std::int32_t vertex(const aiMesh& m, unsigned i, const Affine& world) {
+  TriangleMesh mesh;
+  std::size_t degenerate = 0, points_and_lines = 0;
+
+ private:
+  void addMesh(const aiMesh& m, const Affine& world) {
+    std::vector<Vec3> positions(m.mNumVertices);
+    for (unsigned i = 0; i < m.mNumVertices; ++i) positions[i] = Vec3(m.mVertices[i].x, m.mVertices[i].y, m.mVertices[i].z);
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    triangles.reserve(m.mNumFaces);
+    for (unsigned f = 0; f < m.mNumFaces; ++f) {
+      const aiFace& face = m.mFaces[f];
+      if (face.mNumIndices != 3) {
+        ++points_and_lines;
+        continue;
+      }
+      triangles.push_back({face.mIndices[0], face.mIndices[1], face.mIndices[2]});  // in range: checkFaceIndices
+    }
+    addTriangles(positions, triangles, m.mName.C_Str(), world);
+  }
+
+  // The merged index of vertex i (transformed, scaled and welded on first use).
+  std::int32_t vertex(const std::vector<Vec3>& positions, std::uint32_t i, const std::string& name, const Affine& world) {
     if (index_[i] >= 0) return index_[i];
-    const aiVector3D& v = m.mVertices[i];
-    Vec3 p = (world * Vec3(v.x, v.y, v.z)).cwiseProduct(scale_);
-    if (!p.allFinite())
-      throw LoadError(path_, "", "vertex " + std::to_string(i) + " of mesh '" + m.mName.C_Str() +
-                                     "' has a non-finite coordinate");
+    Vec3 p = (world * positions[i]).cwiseProduct(scale_);
+    const std::string which = "vertex " + std::to_string(i) + (name.empty() ? "" : " of mesh '" + name + "'");
+    if (!p.allFinite()) throw LoadError(path_, "", which + " has a non-finite coordinate");
     if (!(p.cwiseAbs().maxCoeff() <= kMaxInputLength))
-      throw LoadError(path_, "", "vertex " + std::to_string(i) + " of mesh '" + m.mName.C_Str() + "' lies " +
-                                     number(p.cwiseAbs().maxCoeff()) + " m from the origin after scale, beyond "
+      throw LoadError(path_, "", which + " lies " + number(p.cwiseAbs().maxCoeff()) + " m from the origin after scale, beyond "
                                      "the largest length an input may give (1e6 m)");
     p += Vec3::Zero();  // −0 → +0
     const auto [it, inserted] = welded_.try_emplace(PositionKey{p.x(), p.y(), p.z()},
@@ -179,7 +187,6 @@ class Merger {
     return !((b - a).cross(c - a).norm() > kDegenerateRelative * longest2);
   }
 
-  const aiScene& scene_;
   const std::string& path_;
   Vec3 scale_;
   std::vector<std::int32_t> index_;
@@ -205,164 +212,6 @@ void countBadEdges(const TriangleMesh& mesh, std::size_t* open, std::size_t* non
   }
 }
 
-struct PlyProperty {
-  bool list;
-  std::string count_type, item_type, name;
-};
-struct PlyElement {
-  std::string name;
-  std::uintmax_t count;
-  std::vector<PlyProperty> properties;
-};
-
-// Bytes of a PLY scalar type; 0 for a name PLY does not define.
-int plyTypeSize(const std::string& t) {
-  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
-  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
-  if (t == "int" || t == "uint" || t == "int32" || t == "uint32" || t == "float" || t == "float32") return 4;
-  if (t == "double" || t == "float64") return 8;
-  return 0;
-}
-
-// The data after a PLY header: assimp sizes every list by its count before reading its values (up to
-// 2^32 of them, 32 GB for a count of -1). Each count must be a whole number of values the data still
-// holds: on its line (ASCII, one element instance per line) or in the bytes left (binary). The walk
-// stops where the data no longer follows the header; what assimp makes of the rest is its own check.
-void checkPlyLists(const std::string& path, std::istream& in, long header_lines, const std::string& format,
-                   const std::vector<PlyElement>& elements) {
-  const auto tooMany = [&](const std::string& where, const PlyElement& e, std::uintmax_t i, const PlyProperty& p,
-                           const std::string& count, const std::string& left) {
-    return LoadError(path, where, "list '" + p.name + "' of " + e.name + " " + std::to_string(i) +
-                                      " claims " + count.substr(0, 40) + " values, but " + left);
-  };
-  if (format == "ascii") {
-    long number = header_lines;
-    std::string line;
-    for (const PlyElement& e : elements)
-      for (std::uintmax_t i = 0; i < e.count; ++i) {
-        if (!std::getline(in, line)) return;
-        ++number;
-        std::istringstream words(line);
-        std::vector<std::string> tokens{std::istream_iterator<std::string>(words), std::istream_iterator<std::string>()};
-        std::size_t next = 0;
-        for (const PlyProperty& p : e.properties) {
-          if (next >= tokens.size()) break;
-          const std::string& token = tokens[next++];
-          if (!p.list) continue;
-          const std::size_t left = tokens.size() - next;
-          const bool whole = std::all_of(token.begin(), token.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
-          if (!whole || token.size() > 19 || std::stoull(token) > left)
-            throw tooMany("line " + std::to_string(number), e, i, p, token,
-                          "the line holds " + std::to_string(left) + " more");
-          next += std::stoull(token);
-        }
-      }
-    return;
-  }
-  const bool big = format == "binary_big_endian";
-  if (!big && format != "binary_little_endian") return;
-  const std::uintmax_t start = static_cast<std::uintmax_t>(in.tellg());
-  std::error_code ec;
-  const std::uintmax_t size = std::filesystem::file_size(path, ec);
-  std::uintmax_t at = start;
-  for (const PlyElement& e : elements)
-    for (std::uintmax_t i = 0; i < e.count; ++i)
-      for (const PlyProperty& p : e.properties) {
-        const int item = plyTypeSize(p.item_type);
-        if (item == 0) return;
-        if (!p.list) {
-          at += static_cast<std::uintmax_t>(item);
-          continue;
-        }
-        const int n = plyTypeSize(p.count_type);
-        unsigned char bytes[8];
-        if (n == 0 || at + static_cast<std::uintmax_t>(n) > size) return;
-        in.seekg(static_cast<std::streamoff>(at));
-        if (!in.read(reinterpret_cast<char*>(bytes), n)) return;
-        at += static_cast<std::uintmax_t>(n);
-        std::uintmax_t count = 0;
-        for (int k = 0; k < n; ++k) count = count << 8 | bytes[big ? k : n - 1 - k];
-        // A signed count below 0 is, to assimp, a count near 2^32.
-        const bool negative = p.count_type[0] != 'u' && (bytes[big ? 0 : n - 1] & 0x80) != 0;
-        const std::uintmax_t left = (size - std::min(size, at)) / static_cast<std::uintmax_t>(item);
-        if (negative || count > left)
-          throw tooMany("byte " + std::to_string(at - static_cast<std::uintmax_t>(n)), e, i, p,
-                        negative ? "a negative number of" : std::to_string(count),
-                        "the file holds " + std::to_string(left) + " more");
-        at += count * static_cast<std::uintmax_t>(item);
-      }
-}
-
-// Assimp's PLY reader reads header lines until `end_header` without looking for the end of the file:
-// a header without that line never ends. Nor does one whose `end_header` is the file's last bytes,
-// without a line end, after a longer line (its line buffer then never reaches the end). The PLY header
-// is text, one keyword per line, each line ended.
-//
-// Its element lines too: assimp allocates an element's count N up front (read as its leading digits,
-// wrapping around 2^32), sizes the mesh by the first non-empty `element vertex` and face list (`element
-// face` or `element tristrips`), and writes every later one's instances into those arrays, over the
-// first's or past their end (heap corruption that ASan cannot see in the uninstrumented library).
-// `comment` lines are checked like element lines, as assimp's header parser may take them for one.
-void checkPlyHeader(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw LoadError(path, "", "cannot open the file");
-  std::error_code ec;
-  const std::uintmax_t file_size = std::filesystem::file_size(path, ec);
-  long vertex_line = 0, face_line = 0;
-  std::string first_faces, format;
-  std::vector<PlyElement> elements;
-  std::optional<LoadError> bad_element;  // reported once the header is known to end
-  std::string line;
-  for (long number = 1; std::getline(in, line); ++number) {
-    std::istringstream words(line);
-    std::string keyword, name, count;
-    words >> keyword >> name >> count;
-    if (keyword == "format") format = name;
-    if (keyword == "property" && !elements.empty()) {
-      std::string item_type, property;
-      words >> item_type >> property;
-      if (name == "list") elements.back().properties.push_back({true, count, item_type, property});
-      else elements.back().properties.push_back({false, "", name, count});
-    }
-    if ((keyword == "element" || keyword == "comment") && !bad_element) try {
-      const std::string where = "line " + std::to_string(number);
-      std::uintmax_t n = 0;
-      for (std::size_t i = 0; i < count.size() && std::isdigit(static_cast<unsigned char>(count[i])) && n <= file_size; ++i)
-        n = 10 * n + static_cast<std::uintmax_t>(count[i] - '0');
-      if (n > file_size)
-        throw LoadError(path, where, "element '" + name + "' has " + count.substr(0, 40) +
-                                         " instances, more than the file has bytes (" + std::to_string(file_size) + ")");
-      if (keyword == "element") elements.push_back({name, n, {}});
-      if (name == "vertex" && n > 0) {
-        if (vertex_line != 0)
-          throw LoadError(path, where, "a second 'element vertex' (the first is on line " + std::to_string(vertex_line) +
-                                           "): Clearway reads one vertex list per PLY file");
-        vertex_line = number;
-      }
-      if ((name == "face" || name == "tristrips") && n > 0) {
-        if (face_line != 0)
-          throw LoadError(path, where, "a second face list 'element " + name + "' (the first, 'element " + first_faces +
-                                           "', is on line " + std::to_string(face_line) +
-                                           "): Clearway reads one face list per PLY file");
-        face_line = number;
-        first_faces = name;
-      }
-    } catch (const LoadError& e) {
-      bad_element = e;
-    }
-    const std::size_t end = line.find_last_not_of(" \t\r");
-    if (end != std::string::npos && line.compare(0, end + 1, "end_header") == 0) {
-      if (in.eof() && line.back() != '\r')
-        throw LoadError(path, "line " + std::to_string(number),
-                        "the PLY header's 'end_header' line has no line end (the file ends there)");
-      if (bad_element) throw *bad_element;
-      checkPlyLists(path, in, number, format, elements);
-      return;
-    }
-  }
-  throw LoadError(path, "", "the PLY header has no 'end_header' line");
-}
-
 // Assimp's PLY reader passes faces on unchecked, and its post-processing (triangulation) reads through
 // their indices and aborts on an empty one: check them in the scene as read, before any step runs.
 void checkFaceIndices(const aiScene& scene, const std::string& path) {
@@ -381,32 +230,11 @@ void checkFaceIndices(const aiScene& scene, const std::string& path) {
   }
 }
 
-}  // namespace
-
-bool isClosed(const TriangleMesh& mesh) {
-  std::size_t open = 0, non_manifold = 0;
-  countBadEdges(mesh, &open, &non_manifold);
-  return !mesh.triangles.empty() && open == 0 && non_manifold == 0;
-}
-
-TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<std::string>* warnings,
-                      const MeshOptions& options) {
-  auto warn = [&](const std::string& reason) {
-    if (warnings) warnings->push_back(LoadError::format(path, "", reason));
-  };
-  if (!scale.allFinite() || (scale.array() == 0.0).any())
-    throw LoadError(path, "", "scale must be finite and non-zero in every component");
-
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw LoadError(path, "", "mesh file not found");
-  if (std::filesystem::file_size(path, ec) == 0) throw LoadError(path, "", "empty mesh: the file is empty");
-
-  const std::string ext = lowerExtension(path);
+// Every mesh of a file assimp reads (STL, OBJ, COLLADA), merged under the root transform ROS would use.
+void mergeThroughAssimp(const std::string& path, const std::string& ext, const MeshOptions& options,
+                        const std::function<void(const std::string&)>& warn, Merger* merger) {
   Assimp::Importer importer;
-  if (std::none_of(std::begin(kFormats), std::end(kFormats), [&](const char* f) { return ext == f; }))
-    throw LoadError(path, "", "unsupported mesh format '" + ext + "' (Clearway reads " + kFormatList + ")");
   if (ext == "dae") detail::checkCollada(path);
-  if (ext == "ply") checkPlyHeader(path);
 
   // Only positions matter. Vertices are joined below by exact position, not by assimp's
   // JoinIdenticalVertices: on every mesh of ../shared/robots both give the same vertices, ours in a
@@ -451,8 +279,40 @@ TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<st
     }
   }
 
-  Merger merger(*scene, path, scale);
-  merger.addNode(*scene->mRootNode, root);
+  merger->addNode(*scene, *scene->mRootNode, root);
+}
+
+}  // namespace
+
+bool isClosed(const TriangleMesh& mesh) {
+  std::size_t open = 0, non_manifold = 0;
+  countBadEdges(mesh, &open, &non_manifold);
+  return !mesh.triangles.empty() && open == 0 && non_manifold == 0;
+}
+
+TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<std::string>* warnings,
+                      const MeshOptions& options) {
+  auto warn = [&](const std::string& reason) {
+    if (warnings) warnings->push_back(LoadError::format(path, "", reason));
+  };
+  if (!scale.allFinite() || (scale.array() == 0.0).any())
+    throw LoadError(path, "", "scale must be finite and non-zero in every component");
+
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw LoadError(path, "", "mesh file not found");
+  if (std::filesystem::file_size(path, ec) == 0) throw LoadError(path, "", "empty mesh: the file is empty");
+
+  const std::string ext = lowerExtension(path);
+  if (std::none_of(std::begin(kFormats), std::end(kFormats), [&](const char* f) { return ext == f; }))
+    throw LoadError(path, "", "unsupported mesh format '" + ext + "' (Clearway reads " + kFormatList + ")");
+  Merger merger(path, scale);
+  if (ext == "ply") {
+    detail::PlyMesh ply = detail::readPly(path, warnings);
+    merger.addTriangles(ply.vertices, ply.triangles, "", Affine{});
+    merger.points_and_lines += ply.points_and_lines;
+  } else {
+    mergeThroughAssimp(path, ext, options, warn, &merger);
+  }
   TriangleMesh mesh = std::move(merger.mesh);
 
   if (merger.points_and_lines > 0)

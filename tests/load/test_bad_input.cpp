@@ -324,7 +324,7 @@ TEST_F(BadInput, MeshFormatsAndPlyIndices) {
   EXPECT_LOAD_ERROR(loadMesh(short_list, Vec3::Ones()), short_list, "", "uses vertex 3, but the mesh has 3 vertices");
   // Found by fuzz_mesh_ply: a face of length 0 aborted assimp's triangulation.
   const std::string empty_face = dir.write("empty_face.ply", header + "0\n3 0 2 1\n3 0 1 3\n3 0 3 2\n");
-  EXPECT_LOAD_ERROR(loadMesh(empty_face, Vec3::Ones()), empty_face, "", "face 0 of mesh '' has no vertices");
+  EXPECT_LOAD_ERROR(loadMesh(empty_face, Vec3::Ones()), empty_face, "", "face 0 has no vertices");
   // Formats other than these four are refused, by the name the error gives them.
   for (const std::string name : {"garbage.x", "model.3ds", "archive.zae", "scene.fbx"}) {
     const std::string path = dir.write(name, "xof 0302txt 0064\ngarbage");

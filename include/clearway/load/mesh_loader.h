@@ -17,8 +17,8 @@ struct MeshOptions {
   bool honour_up_axis = false;
 };
 
-/// Loads every mesh of a file through assimp (STL binary and ASCII, COLLADA, OBJ and any other format
-/// assimp reads) into one TriangleMesh:
+/// Loads every mesh of a file (STL binary and ASCII, COLLADA and OBJ through assimp; PLY, ASCII or binary,
+/// through Clearway's own reader, which refuses counts beyond the file's data) into one TriangleMesh:
 ///  - node transforms are applied and all meshes of the scene are merged; vertices at identical
 ///    positions are joined (within and across meshes), so shared edges are shared in the index list;
 ///  - COLLADA (.dae, .zae): the <unit> is honoured; the <up_axis> is ignored as ROS, RViz and MoveIt

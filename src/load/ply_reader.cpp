@@ -1,0 +1,483 @@
+// PLY → vertices and triangles. The header is read line by line; the data by one cursor that knows
+// where each value lies (ASCII: one element instance per line, values separated by spaces or tabs;
+// binary: the declared sizes, in the declared byte order). Every loop over an element's instances or a
+// list's values consumes at least one byte or one token per step, or throws: it ends with the file.
+#include "load/ply_reader.h"
+
+#include <clearway/load/load_error.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <sstream>
+#include <string_view>
+#include <system_error>
+
+namespace clearway::detail {
+namespace {
+
+enum class Type { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64, None };
+
+Type typeNamed(const std::string& t) {
+  if (t == "char" || t == "int8") return Type::Int8;
+  if (t == "uchar" || t == "uint8") return Type::UInt8;
+  if (t == "short" || t == "int16") return Type::Int16;
+  if (t == "ushort" || t == "uint16") return Type::UInt16;
+  if (t == "int" || t == "int32") return Type::Int32;
+  if (t == "uint" || t == "uint32") return Type::UInt32;
+  if (t == "float" || t == "float32") return Type::Float32;
+  if (t == "double" || t == "float64") return Type::Float64;
+  return Type::None;
+}
+
+std::size_t sizeOf(Type t) {
+  switch (t) {
+    case Type::Int8: case Type::UInt8: return 1;
+    case Type::Int16: case Type::UInt16: return 2;
+    case Type::Int32: case Type::UInt32: case Type::Float32: return 4;
+    case Type::Float64: return 8;
+    default: return 0;
+  }
+}
+
+bool isInteger(Type t) { return t != Type::Float32 && t != Type::Float64; }
+
+struct Property {
+  std::string name;
+  bool list = false;
+  Type count = Type::None, item = Type::None;
+};
+
+struct Element {
+  std::string name;
+  std::uint64_t count = 0;
+  std::vector<Property> properties;
+  long line = 0;
+};
+
+enum class Format { Ascii, Little, Big };
+
+std::vector<std::string> words(std::string_view line) {
+  std::vector<std::string> out;
+  std::size_t i = 0;
+  const auto space = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; };
+  while (i < line.size()) {
+    while (i < line.size() && space(line[i])) ++i;
+    const std::size_t start = i;
+    while (i < line.size() && !space(line[i])) ++i;
+    if (i > start) out.emplace_back(line.substr(start, i - start));
+  }
+  return out;
+}
+
+// A whole token as a number of the given type; false when the token is not one (or out of its range).
+bool parse(const std::string& token, Type type, double* value) {
+  const char* first = token.data();
+  const char* last = first + token.size();
+  if (first != last && *first == '+') ++first;
+  if (isInteger(type)) {
+    std::int64_t v = 0;
+    const auto [end, ec] = std::from_chars(first, last, v);
+    if (ec != std::errc() || end != last) return false;
+    static constexpr std::int64_t kLow[] = {-128, 0, -32768, 0, -2147483648LL, 0};
+    static constexpr std::int64_t kHigh[] = {127, 255, 32767, 65535, 2147483647LL, 4294967295LL};
+    const auto k = static_cast<int>(type);
+    if (v < kLow[k] || v > kHigh[k]) return false;
+    *value = static_cast<double>(v);
+    return true;
+  }
+  if (type == Type::Float32) {  // rounded once, to the float the file declares
+    float v = 0.0f;
+    const auto [end, ec] = std::from_chars(first, last, v);
+    if (ec != std::errc() || end != last) return false;
+    *value = v;
+    return true;
+  }
+  const auto [end, ec] = std::from_chars(first, last, *value);
+  return ec == std::errc() && end == last;
+}
+
+const char* kTypeList = "char, uchar, short, ushort, int, uint, float, double, int8, uint8, int16, uint16, int32, "
+                        "uint32, float32 or float64";
+
+class Reader {
+ public:
+  Reader(std::string path, std::vector<std::string>* warnings) : path_(std::move(path)), warnings_(warnings) {}
+
+  PlyMesh read() {
+    {
+      std::ifstream in(path_, std::ios::binary);
+      if (!in) throw LoadError(path_, "", "cannot open the file");
+      bytes_.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    readHeader();
+    for (std::size_t e = 0; e < elements_.size(); ++e) readElement(e);
+    return finish();
+  }
+
+ private:
+  void warn(const std::string& where, const std::string& reason) {
+    if (warnings_) warnings_->push_back(LoadError::format(path_, where, reason));
+  }
+  static std::string lineName(long n) { return "line " + std::to_string(n); }
+
+  // The header, up to the byte after end_header's line end (at_).
+  void readHeader() {
+    bool have_format = false;
+    for (long number = 1;; ++number) {
+      const std::size_t end = bytes_.find('\n', at_);
+      if (end == std::string::npos) {
+        const std::vector<std::string> last = words(std::string_view(bytes_).substr(at_));
+        if (!last.empty() && last[0] == "end_header")
+          throw LoadError(path_, lineName(number), "the PLY header's 'end_header' line has no line end (the file ends there)");
+        throw LoadError(path_, "", "the PLY header has no 'end_header' line");
+      }
+      const std::vector<std::string> w = words(std::string_view(bytes_).substr(at_, end - at_));
+      at_ = end + 1;
+      line_ = number + 1;
+      if (number == 1) {
+        if (w.size() != 1 || w[0] != "ply") throw LoadError(path_, lineName(1), "not a PLY file: the first line is not 'ply'");
+        continue;
+      }
+      if (w.empty() || w[0] == "comment" || w[0] == "obj_info") continue;
+      const std::string where = lineName(number);
+      if (w[0] == "end_header") {
+        if (!have_format) throw LoadError(path_, where, "the PLY header has no 'format' line");
+        return;
+      }
+      if (w[0] == "format") {
+        if (w.size() < 2 || (w[1] != "ascii" && w[1] != "binary_little_endian" && w[1] != "binary_big_endian"))
+          throw LoadError(path_, where, "the format is not ascii, binary_little_endian or binary_big_endian");
+        format_ = w[1] == "ascii" ? Format::Ascii : w[1] == "binary_little_endian" ? Format::Little : Format::Big;
+        have_format = true;
+      } else if (w[0] == "element") {
+        readElementLine(w, number);
+      } else if (w[0] == "property") {
+        readPropertyLine(w, where);
+      } else {
+        warn(where, "header line '" + w[0].substr(0, 40) + "' is not PLY; skipped");
+      }
+    }
+  }
+
+  void readElementLine(const std::vector<std::string>& w, long number) {
+    const std::string where = lineName(number);
+    if (w.size() < 3) throw LoadError(path_, where, "'element' needs a name and a count");
+    const std::string& count = w[2];
+    std::uint64_t n = 0;
+    const bool digits = std::all_of(count.begin(), count.end(), [](char c) { return c >= '0' && c <= '9'; });
+    for (std::size_t i = 0; digits && i < count.size() && n <= bytes_.size(); ++i) n = 10 * n + static_cast<std::uint64_t>(count[i] - '0');
+    if (!digits) throw LoadError(path_, where, "element '" + w[1] + "' has count '" + count.substr(0, 40) + "', not a whole number");
+    // Every instance takes at least one byte (see readElement): a larger count cannot be the file's.
+    if (n > bytes_.size())
+      throw LoadError(path_, where, "element '" + w[1] + "' has " + count.substr(0, 40) +
+                                        " instances, more than the file has bytes (" + std::to_string(bytes_.size()) + ")");
+    const bool faces = w[1] == "face" || w[1] == "tristrips";
+    if (n > 0 && (w[1] == "vertex" || faces)) {
+      long& first = w[1] == "vertex" ? vertex_line_ : face_line_;
+      if (first != 0) {
+        if (w[1] == "vertex")
+          throw LoadError(path_, where, "a second 'element vertex' (the first is on line " + std::to_string(first) +
+                                            "): Clearway reads one vertex list per PLY file");
+        throw LoadError(path_, where, "a second face list 'element " + w[1] + "' (the first, 'element " +
+                                          elements_[face_element_].name + "', is on line " + std::to_string(first) +
+                                          "): Clearway reads one face list per PLY file");
+      }
+      first = number;
+      (w[1] == "vertex" ? vertex_element_ : face_element_) = elements_.size();
+    }
+    elements_.push_back({w[1], n, {}, number});
+  }
+
+  void readPropertyLine(const std::vector<std::string>& w, const std::string& where) {
+    if (elements_.empty()) {
+      warn(where, "a property before any element; skipped");
+      return;
+    }
+    Property p;
+    p.list = w.size() > 1 && w[1] == "list";
+    const std::size_t need = p.list ? 5 : 3;
+    if (w.size() < need)
+      throw LoadError(path_, where, p.list ? "'property list' needs a count type, an item type and a name"
+                                           : "'property' needs a type and a name");
+    p.name = w[need - 1];
+    const std::size_t first_type = p.list ? 2 : 1;
+    for (std::size_t k = first_type; k < need - 1; ++k) {
+      const Type t = typeNamed(w[k]);
+      if (t == Type::None)
+        throw LoadError(path_, where, "property '" + p.name.substr(0, 40) + "' has type '" + w[k].substr(0, 40) +
+                                          "', which PLY does not define (" + kTypeList + ")");
+      if (p.list && k == first_type && !isInteger(t))
+        throw LoadError(path_, where, "list '" + p.name.substr(0, 40) + "' is counted by a " + w[k] +
+                                          ", not by an integer type");
+      (p.list && k == first_type ? p.count : p.item) = t;
+    }
+    elements_.back().properties.push_back(p);
+  }
+
+  // The next instance's values on an ASCII line (blank lines skipped), or false at the end of the file.
+  bool nextLine() {
+    while (at_ < bytes_.size()) {
+      const std::size_t end = std::min(bytes_.find('\n', at_), bytes_.size());
+      tokens_ = words(std::string_view(bytes_).substr(at_, end - at_));
+      at_ = end + 1;
+      token_line_ = line_++;
+      next_token_ = 0;
+      if (!tokens_.empty()) return true;
+    }
+    return false;
+  }
+
+  std::string instanceName(const Element& e, std::uint64_t i) const { return e.name + " " + std::to_string(i); }
+
+  // One value of the given type at the cursor.
+  double value(Type type, const Element& e, std::uint64_t i, const Property& p) {
+    if (format_ == Format::Ascii) {
+      if (next_token_ >= tokens_.size())
+        throw LoadError(path_, lineName(token_line_), instanceName(e, i) + " ends before its property '" + p.name + "'");
+      const std::string& token = tokens_[next_token_++];
+      double v = 0.0;
+      if (!parse(token, type, &v))
+        throw LoadError(path_, lineName(token_line_), "'" + token.substr(0, 40) + "' (property '" + p.name + "' of " +
+                                                          instanceName(e, i) + ") is not a number of its type");
+      return v;
+    }
+    const std::size_t n = sizeOf(type);
+    if (bytes_.size() - std::min(bytes_.size(), at_) < n)
+      throw LoadError(path_, "byte " + std::to_string(at_),
+                      "the file ends inside " + instanceName(e, i) + " (property '" + p.name + "')");
+    unsigned char b[8];
+    std::memcpy(b, bytes_.data() + at_, n);
+    at_ += n;
+    if ((format_ == Format::Big) == littleEndianMachine()) std::reverse(b, b + n);
+    return decode(type, b);
+  }
+
+  static bool littleEndianMachine() {
+    const std::uint16_t one = 1;
+    unsigned char first = 0;
+    std::memcpy(&first, &one, 1);
+    return first == 1;
+  }
+
+  static double decode(Type type, const unsigned char* b) {
+    switch (type) {
+      case Type::Int8: { std::int8_t v; std::memcpy(&v, b, 1); return v; }
+      case Type::UInt8: return b[0];
+      case Type::Int16: { std::int16_t v; std::memcpy(&v, b, 2); return v; }
+      case Type::UInt16: { std::uint16_t v; std::memcpy(&v, b, 2); return v; }
+      case Type::Int32: { std::int32_t v; std::memcpy(&v, b, 4); return v; }
+      case Type::UInt32: { std::uint32_t v; std::memcpy(&v, b, 4); return v; }
+      case Type::Float32: { float v; std::memcpy(&v, b, 4); return v; }
+      default: { double v; std::memcpy(&v, b, 8); return v; }
+    }
+  }
+
+  // A list's length, refused when negative or longer than the data left for it.
+  std::uint64_t listLength(const Element& e, std::uint64_t i, const Property& p) {
+    const std::size_t count_at = at_;
+    const std::string claim = "list '" + p.name + "' of " + instanceName(e, i) + " claims ";
+    if (format_ == Format::Ascii && next_token_ < tokens_.size()) {
+      // A count beyond the line (or below 0) is named as such, whatever its type's range.
+      const std::string& token = tokens_[next_token_];
+      const std::size_t left = tokens_.size() - next_token_ - 1;
+      const std::size_t digits = token[0] == '-' || token[0] == '+' ? 1 : 0;
+      const bool whole = token.size() > digits &&
+                         std::all_of(token.begin() + static_cast<std::ptrdiff_t>(digits), token.end(), [](char c) { return c >= '0' && c <= '9'; });
+      if (whole && (token[0] == '-' || token.size() - digits > 19 || std::stoull(token.substr(digits)) > left))
+        throw LoadError(path_, lineName(token_line_), claim + token.substr(0, 40) + " values, but the line holds " +
+                                                          std::to_string(left) + " more");
+    }
+    const double n = value(p.count, e, i, p);
+    if (format_ != Format::Ascii) {
+      const std::size_t left = (bytes_.size() - std::min(bytes_.size(), at_)) / sizeOf(p.item);
+      if (n < 0 || n > static_cast<double>(left))
+        throw LoadError(path_, "byte " + std::to_string(count_at),
+                        claim + (n < 0 ? std::string("a negative number of") : std::to_string(static_cast<std::uint64_t>(n))) +
+                            " values, but the file holds " + std::to_string(left) + " more");
+    }
+    return static_cast<std::uint64_t>(n);
+  }
+
+  void readElement(std::size_t index) {
+    const Element& e = elements_[index];
+    // An instance without properties takes no data (none in binary; assimp neither reads lines for it).
+    if (e.properties.empty()) return;
+    const bool vertices = index == vertex_element_, faces = index == face_element_;
+    int xyz[3] = {-1, -1, -1};
+    int corners = -1;
+    for (std::size_t k = 0; k < e.properties.size(); ++k) {
+      const Property& p = e.properties[k];
+      for (int a = 0; a < 3 && vertices && !p.list; ++a)
+        if (xyz[a] < 0 && p.name == std::string(1, static_cast<char>('x' + a))) xyz[a] = static_cast<int>(k);
+      if (faces && p.list && corners < 0 && (p.name == "vertex_indices" || p.name == "vertex_index")) corners = static_cast<int>(k);
+    }
+    if (vertices)
+      for (int a = 0; a < 3; ++a)
+        if (xyz[a] < 0)
+          throw LoadError(path_, lineName(e.line), "element 'vertex' has no property '" + std::string(1, static_cast<char>('x' + a)) + "'");
+    if (faces && corners < 0)
+      throw LoadError(path_, lineName(e.line), "element '" + e.name + "' has no list 'vertex_indices' (or 'vertex_index')");
+
+    std::vector<double> list;
+    for (std::uint64_t i = 0; i < e.count; ++i) {
+      if (format_ == Format::Ascii && !nextLine())
+        throw LoadError(path_, "", "the file ends before " + instanceName(e, i) + " (the header declares " +
+                                       std::to_string(e.count) + ")");
+      Vec3 point = Vec3::Zero();
+      for (std::size_t k = 0; k < e.properties.size(); ++k) {
+        const Property& p = e.properties[k];
+        if (!p.list) {
+          const double v = value(p.item, e, i, p);
+          for (int a = 0; a < 3; ++a)
+            if (vertices && xyz[a] == static_cast<int>(k)) point[a] = v;
+          continue;
+        }
+        const std::uint64_t n = listLength(e, i, p);
+        const bool keep = faces && corners == static_cast<int>(k);
+        list.clear();
+        for (std::uint64_t j = 0; j < n; ++j) {
+          const double v = value(p.item, e, i, p);
+          if (keep) list.push_back(v);
+        }
+        if (keep) addFace(e, i, list);
+      }
+      if (vertices) mesh_.vertices.push_back(point);
+    }
+  }
+
+  // A face's corners (or a strip's indices), checked when every vertex is known (finish).
+  void addFace(const Element& e, std::uint64_t i, const std::vector<double>& list) {
+    if (list.empty()) throw LoadError(path_, "", e.name + " " + std::to_string(i) + " has no vertices");
+    for (const double v : list)
+      if (v != std::floor(v)) throw LoadError(path_, "", e.name + " " + std::to_string(i) + " uses vertex " + std::to_string(v) + ", not a whole number");
+    faces_.push_back({i, corners_.size(), list.size()});
+    corners_.insert(corners_.end(), list.begin(), list.end());
+  }
+
+  struct Face {
+    std::uint64_t instance;
+    std::size_t first, size;
+  };
+
+  PlyMesh finish() {
+    const bool strips = face_element_ < elements_.size() && elements_[face_element_].name == "tristrips";
+    const double vertex_count = static_cast<double>(mesh_.vertices.size());
+    const std::string face_name = face_element_ < elements_.size() ? elements_[face_element_].name : "face";
+    for (const Face& f : faces_)
+      for (std::size_t k = 0; k < f.size; ++k) {
+        const double v = corners_[f.first + k];
+        if ((v < 0 && !(strips && v == -1)) || v >= vertex_count)
+          throw LoadError(path_, "", face_name + " " + std::to_string(f.instance) + " uses vertex " +
+                                         std::to_string(static_cast<long long>(v)) + ", but the mesh has " +
+                                         std::to_string(mesh_.vertices.size()) + " vertices");
+      }
+    for (const Face& f : faces_) strips ? unrollStrip(f) : triangulate(f);
+    return std::move(mesh_);
+  }
+
+  std::uint32_t corner(const Face& f, std::size_t k) const { return static_cast<std::uint32_t>(corners_[f.first + k]); }
+
+  // Triangle strips, restarted at each -1; every other triangle turned to keep one winding.
+  void unrollStrip(const Face& f) {
+    std::size_t run = 0;
+    for (std::size_t k = 0; k < f.size; ++k) {
+      if (corners_[f.first + k] < 0) {
+        run = 0;
+        continue;
+      }
+      if (++run < 3) continue;
+      const std::uint32_t a = corner(f, k - 2), b = corner(f, k - 1), c = corner(f, k);
+      mesh_.triangles.push_back(run % 2 == 1 ? std::array<std::uint32_t, 3>{a, b, c} : std::array<std::uint32_t, 3>{b, a, c});
+    }
+  }
+
+  // A polygon in its plane: a fan when convex, ear clipping otherwise (up to kMaxClipped corners).
+  void triangulate(const Face& f) {
+    if (f.size < 3) {
+      ++mesh_.points_and_lines;
+      return;
+    }
+    const auto fan = [&] {
+      for (std::size_t k = 1; k + 1 < f.size; ++k) mesh_.triangles.push_back({corner(f, 0), corner(f, k), corner(f, k + 1)});
+    };
+    if (f.size == 3) return fan();
+    // Newell's normal; the plane's 2-D coordinates drop its largest axis, turned so that the polygon
+    // runs counter-clockwise.
+    Vec3 normal = Vec3::Zero();
+    for (std::size_t k = 0; k < f.size; ++k) {
+      const Vec3& p = mesh_.vertices[corner(f, k)];
+      const Vec3& q = mesh_.vertices[corner(f, (k + 1) % f.size)];
+      normal += Vec3((p.y() - q.y()) * (p.z() + q.z()), (p.z() - q.z()) * (p.x() + q.x()), (p.x() - q.x()) * (p.y() + q.y()));
+    }
+    int axis = 0;
+    normal.cwiseAbs().maxCoeff(&axis);
+    if (!(std::abs(normal[axis]) > 0.0)) return fan();  // no area: every triangle is dropped as degenerate
+    const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+    const double turn = normal[axis] > 0 ? 1.0 : -1.0;
+    std::vector<std::uint32_t> ring(f.size);
+    for (std::size_t k = 0; k < f.size; ++k) ring[k] = corner(f, k);
+    const auto cross = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+      const Vec3 &p = mesh_.vertices[a], &q = mesh_.vertices[b], &r = mesh_.vertices[c];
+      return turn * ((q[u] - p[u]) * (r[v] - p[v]) - (q[v] - p[v]) * (r[u] - p[u]));
+    };
+    bool convex = true;
+    for (std::size_t k = 0; k < f.size && convex; ++k) convex = cross(ring[k], ring[(k + 1) % f.size], ring[(k + 2) % f.size]) >= 0.0;
+    if (convex) return fan();
+    constexpr std::size_t kMaxClipped = 256;  // ear clipping is cubic in the corners at worst
+    if (f.size > kMaxClipped)
+      throw LoadError(path_, "", "face " + std::to_string(f.instance) + " has " + std::to_string(f.size) +
+                                     " corners and is not convex: Clearway triangulates such faces up to " +
+                                     std::to_string(kMaxClipped) + " corners");
+    const auto inside = [&](std::uint32_t p, std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+      return cross(a, b, p) >= 0.0 && cross(b, c, p) >= 0.0 && cross(c, a, p) >= 0.0;
+    };
+    while (ring.size() > 3) {
+      bool clipped = false;
+      for (std::size_t k = 0; k < ring.size() && !clipped; ++k) {
+        const std::uint32_t a = ring[(k + ring.size() - 1) % ring.size()], b = ring[k], c = ring[(k + 1) % ring.size()];
+        if (!(cross(a, b, c) > 0.0)) continue;
+        bool empty = true;
+        for (const std::uint32_t p : ring)
+          if (p != a && p != b && p != c && inside(p, a, b, c)) empty = false;
+        if (!empty) continue;
+        mesh_.triangles.push_back({a, b, c});
+        ring.erase(ring.begin() + static_cast<std::ptrdiff_t>(k));
+        clipped = true;
+      }
+      if (!clipped) {  // the polygon crosses itself: no ear is free of other corners
+        warn("", "face " + std::to_string(f.instance) + " crosses itself; the rest of it is triangulated as a fan");
+        break;
+      }
+    }
+    for (std::size_t k = 1; k + 1 < ring.size(); ++k) mesh_.triangles.push_back({ring[0], ring[k], ring[k + 1]});
+  }
+
+  std::string path_;
+  std::vector<std::string>* warnings_;
+  std::string bytes_;
+  std::size_t at_ = 0;  // the next byte to read
+  long line_ = 1;       // the line at_ starts (ASCII)
+  Format format_ = Format::Ascii;
+  std::vector<Element> elements_;
+  std::size_t vertex_element_ = std::numeric_limits<std::size_t>::max();
+  std::size_t face_element_ = std::numeric_limits<std::size_t>::max();
+  long vertex_line_ = 0, face_line_ = 0;
+  std::vector<std::string> tokens_;
+  std::size_t next_token_ = 0;
+  long token_line_ = 0;
+  std::vector<double> corners_;
+  std::vector<Face> faces_;
+  PlyMesh mesh_;
+};
+
+}  // namespace
+
+PlyMesh readPly(const std::string& path, std::vector<std::string>* warnings) { return Reader(path, warnings).read(); }
+
+}  // namespace clearway::detail

@@ -1,0 +1,319 @@
+// PLY files, which Clearway reads itself (src/load/ply_reader.cpp): the same triangles as assimp (and so
+// MoveIt) on well-formed files in every encoding and type, polygons and strips triangulated in their
+// plane, and a LoadError naming the line or byte for what the header does not account for.
+#include <clearway/load/load_error.h>
+#include <clearway/load/mesh_loader.h>
+
+#include "load/robot_files.h"
+
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+using namespace clearway;
+using clearway::test::TempDir;
+
+namespace {
+
+// A triangle as its three corners' positions, rotated so that the smallest corner comes first (the
+// winding is kept): equal for equal triangles whatever the indexing.
+using Corners = std::array<std::array<double, 3>, 3>;
+Corners canonical(Corners t) {
+  std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+  return t;
+}
+
+std::vector<Corners> trianglesOf(const TriangleMesh& m) {
+  std::vector<Corners> out;
+  for (const auto& t : m.triangles) {
+    Corners c;
+    for (int k = 0; k < 3; ++k) c[k] = {m.vertices[t[k]].x(), m.vertices[t[k]].y(), m.vertices[t[k]].z()};
+    out.push_back(canonical(c));
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// What assimp makes of the file (triangulated, as MoveIt loads it), as the same canonical triangles.
+std::vector<Corners> assimpTriangles(const std::string& path) {
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate);
+  std::vector<Corners> out;
+  if (scene == nullptr) return out;
+  for (unsigned i = 0; i < scene->mNumMeshes; ++i) {
+    const aiMesh& m = *scene->mMeshes[i];
+    for (unsigned f = 0; f < m.mNumFaces; ++f) {
+      if (m.mFaces[f].mNumIndices != 3) continue;
+      Corners c;
+      for (int k = 0; k < 3; ++k) {
+        const aiVector3D& v = m.mVertices[m.mFaces[f].mIndices[k]];
+        c[k] = {v.x, v.y, v.z};
+      }
+      out.push_back(canonical(c));
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// A PLY writer: the header's types decide each value's encoding.
+struct PlyWriter {
+  std::string format;  // ascii, binary_little_endian, binary_big_endian
+  std::string data;
+
+  template <class T>
+  void binary(T v) {
+    char b[sizeof v];
+    std::memcpy(b, &v, sizeof v);
+    if (format == "binary_big_endian") std::reverse(b, b + sizeof v);
+    data.append(b, sizeof v);
+  }
+  // One value of PLY type `type`.
+  void value(const std::string& type, double v, bool last = false) {
+    if (format == "ascii") {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "%.17g%s", v, last ? "\n" : " ");
+      data += buf;
+      return;
+    }
+    if (type == "float") binary(static_cast<float>(v));
+    else if (type == "double") binary(v);
+    else if (type == "uchar") binary(static_cast<std::uint8_t>(v));
+    else if (type == "ushort") binary(static_cast<std::uint16_t>(v));
+    else if (type == "short") binary(static_cast<std::int16_t>(v));
+    else if (type == "int") binary(static_cast<std::int32_t>(v));
+    else if (type == "uint") binary(static_cast<std::uint32_t>(v));
+    else ADD_FAILURE() << "type " << type;
+  }
+};
+
+// A box of nx × ny × nz cells as quads (planar, convex, outward), corners at multiples of 1/64 so that
+// every encoding holds them exactly.
+struct Polyhedron {
+  std::vector<std::array<double, 3>> vertices;
+  std::vector<std::vector<int>> faces;
+};
+
+Polyhedron gridBox(std::mt19937& rng) {
+  std::uniform_int_distribution<int> cells(1, 3), offset(-64, 64), size(16, 128);
+  const int n[3] = {cells(rng), cells(rng), cells(rng)};
+  const double step[3] = {size(rng) / 64.0, size(rng) / 64.0, size(rng) / 64.0};
+  const double origin[3] = {offset(rng) / 64.0, offset(rng) / 64.0, offset(rng) / 64.0};
+  Polyhedron p;
+  std::vector<int> index((n[0] + 1) * (n[1] + 1) * (n[2] + 1), -1);
+  const auto vertex = [&](int i, int j, int k) {
+    int& v = index[(i * (n[1] + 1) + j) * (n[2] + 1) + k];
+    if (v < 0) {
+      v = static_cast<int>(p.vertices.size());
+      p.vertices.push_back({origin[0] + i * step[0], origin[1] + j * step[1], origin[2] + k * step[2]});
+    }
+    return v;
+  };
+  // For each axis a and each of its two sides, the quads of that side, wound outward.
+  for (int a = 0; a < 3; ++a) {
+    const int b = (a + 1) % 3, c = (a + 2) % 3;
+    for (int side = 0; side < 2; ++side)
+      for (int u = 0; u < n[b]; ++u)
+        for (int w = 0; w < n[c]; ++w) {
+          std::array<int, 3> q[4];
+          const int du[4] = {0, 1, 1, 0}, dw[4] = {0, 0, 1, 1};
+          std::vector<int> face;
+          for (int k = 0; k < 4; ++k) {
+            q[k][a] = side * n[a];
+            q[k][b] = u + du[k];
+            q[k][c] = w + dw[k];
+            face.push_back(vertex(q[k][0], q[k][1], q[k][2]));
+          }
+          if (side == 0) std::reverse(face.begin(), face.end());
+          p.faces.push_back(face);
+        }
+  }
+  return p;
+}
+
+// p as a PLY file: vertices with extra properties (normals, colours) that a reader must skip, faces
+// as the list types given; optionally some faces split into triangles, and an unknown element between.
+std::string plyFile(const Polyhedron& p, const std::string& format, const std::string& coordinate,
+                    const std::string& count_type, const std::string& index_type, bool extra_element) {
+  PlyWriter w{format, ""};
+  std::string header = "ply\nformat " + format + " 1.0\ncomment written by test_ply\n";
+  header += "element vertex " + std::to_string(p.vertices.size()) + "\nproperty " + coordinate + " x\nproperty " +
+            coordinate + " y\nproperty " + coordinate + " z\nproperty float nx\nproperty uchar red\n";
+  if (extra_element) header += "element edge 2\nproperty int vertex1\nproperty int vertex2\nproperty list uchar int tags\n";
+  header += "element face " + std::to_string(p.faces.size()) + "\nproperty list " + count_type + " " + index_type +
+            " vertex_indices\nproperty uchar flags\nend_header\n";
+  for (const auto& v : p.vertices) {
+    for (int a = 0; a < 3; ++a) w.value(coordinate, v[a]);
+    w.value("float", 0.5);
+    w.value("uchar", 200, true);
+  }
+  if (extra_element)
+    for (int e = 0; e < 2; ++e) {
+      w.value("int", e);
+      w.value("int", e + 1);
+      w.value("uchar", 2);
+      w.value("int", 7);
+      w.value("int", 8, true);
+    }
+  for (const auto& f : p.faces) {
+    w.value(count_type, static_cast<double>(f.size()));
+    for (const int i : f) w.value(index_type, i);
+    w.value("uchar", 1, true);
+  }
+  return header + w.data;
+}
+
+}  // namespace
+
+TEST(Ply, SameTrianglesAsAssimpInEveryEncodingAndType) {
+  TempDir dir;
+  std::mt19937 rng(20261127);
+  const std::vector<std::array<std::string, 3>> types = {
+      {"float", "uchar", "int"}, {"double", "uchar", "uint"}, {"float", "int", "int"}, {"double", "ushort", "ushort"},
+      {"float", "uchar", "short"}};
+  int files = 0;
+  for (int shape = 0; shape < 6; ++shape) {
+    const Polyhedron p = gridBox(rng);
+    for (const std::string format : {"ascii", "binary_little_endian", "binary_big_endian"})
+      for (const auto& [coordinate, count, index] : types)
+        for (const bool extra : {false, true}) {
+          SCOPED_TRACE(format + " " + coordinate + " " + count + " " + index + (extra ? " with an edge element" : ""));
+          const std::string path = dir.write("box" + std::to_string(files++) + ".ply", plyFile(p, format, coordinate, count, index, extra));
+          std::vector<std::string> warnings;
+          const TriangleMesh mesh = loadMesh(path, Vec3::Ones(), &warnings);
+          EXPECT_TRUE(isClosed(mesh));
+          EXPECT_EQ(mesh.triangles.size(), 2 * p.faces.size());
+          EXPECT_TRUE(warnings.empty()) << warnings.front();
+          const std::vector<Corners> theirs = assimpTriangles(path);
+          ASSERT_EQ(theirs.size(), mesh.triangles.size()) << "assimp read " << theirs.size() << " triangles";
+          EXPECT_EQ(trianglesOf(mesh), theirs);
+        }
+  }
+  EXPECT_EQ(files, 180);
+}
+
+TEST(Ply, PolygonsAreTriangulatedInTheirPlaneAndStripsUnrolled) {
+  TempDir dir;
+  // An L of area 3 (three unit squares), not convex, in the plane x = 1 (so the plane's coordinates are
+  // y and z), written in both windings; and the same corners as a strip.
+  const std::string vertices = "1 0 0\n1 2 0\n1 2 1\n1 1 1\n1 1 2\n1 0 2\n";
+  const auto header = [](const std::string& faces, int count) {
+    return "ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\nproperty float y\nproperty float z\nelement " +
+           faces + " " + std::to_string(count) + "\nproperty list uchar int vertex_indices\nend_header\n";
+  };
+  for (const std::string face : {"6 0 1 2 3 4 5\n", "6 5 4 3 2 1 0\n"}) {
+    const std::string path = dir.write("l.ply", header("face", 1) + vertices + face);
+    std::vector<std::string> warnings;
+    const TriangleMesh mesh = loadMesh(path, Vec3::Ones(), &warnings);
+    ASSERT_EQ(mesh.triangles.size(), 4u) << face;
+    Vec3 area = Vec3::Zero();
+    for (const auto& t : mesh.triangles) {
+      const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
+      const Vec3 n = (b - a).cross(c - a) / 2;
+      area += n;
+      // Each triangle lies in the L: its centroid is not in the missing square (1..2, 1..2).
+      const Vec3 g = (a + b + c) / 3;
+      EXPECT_FALSE(g.y() > 1 && g.z() > 1) << "triangle outside the L, centroid " << g.transpose();
+      EXPECT_GT(n.x() * (face[2] == '0' ? 1 : -1), 0.0) << "a triangle turned against the face";
+    }
+    EXPECT_NEAR(std::abs(area.x()), 3.0, 1e-12);
+    EXPECT_NEAR(area.y(), 0.0, 1e-12);
+  }
+  // Faces before the vertices, a quad and a face of two corners (a line: ignored with a warning).
+  const std::string late = dir.write("late.ply", "ply\nformat ascii 1.0\nelement face 2\nproperty list uchar int vertex_index\n"
+                                                 "element vertex 4\nproperty double x\nproperty double y\nproperty double z\n"
+                                                 "end_header\n4 0 1 2 3\n2 0 2\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n");
+  std::vector<std::string> warnings;
+  EXPECT_EQ(loadMesh(late, Vec3::Ones(), &warnings).triangles.size(), 2u);
+  ASSERT_FALSE(warnings.empty());
+  EXPECT_NE(warnings.front().find("1 point and line primitives ignored"), std::string::npos) << warnings.front();
+  // A strip 0 1 2 3, a restart, then 2 3 4 5: four triangles, all turned the same way.
+  const std::string strip = dir.write("strip.ply", "ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\nproperty float y\n"
+                                                   "property float z\nelement tristrips 1\nproperty list int int vertex_indices\n"
+                                                   "end_header\n0 0 0\n0 1 0\n1 0 0\n1 1 0\n2 0 0\n2 1 0\n9 0 1 2 3 -1 2 3 4 5\n");
+  const TriangleMesh strips = loadMesh(strip, Vec3::Ones());
+  ASSERT_EQ(strips.triangles.size(), 4u);
+  for (const auto& t : strips.triangles) {
+    const Vec3 n = (strips.vertices[t[1]] - strips.vertices[t[0]]).cross(strips.vertices[t[2]] - strips.vertices[t[0]]);
+    EXPECT_LT(n.z(), 0.0);
+  }
+  // A polygon that crosses itself (a bow tie) still loads, with a warning.
+  const std::string bow = dir.write("bow.ply", header("face", 1) + "1 0 0\n1 1 1\n1 1 0\n1 0 1\n1 3 3\n1 4 4\n" + "4 0 1 2 3\n");
+  warnings.clear();
+  EXPECT_EQ(loadMesh(bow, Vec3::Ones(), &warnings).triangles.size(), 2u);
+}
+
+TEST(Ply, ReadsOnlyWhatTheHeaderDeclares) {
+  TempDir dir;
+  const std::string vertex = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
+  const std::string face = "element face 1\nproperty list uchar int vertex_indices\n";
+  const std::string body = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const auto ascii = [&](const std::string& header, const std::string& data) {
+    return "ply\nformat ascii 1.0\n" + header + "end_header\n" + data;
+  };
+  struct Case {
+    std::string name, text, element, reason;
+  };
+  const std::vector<Case> cases = {
+      // Found by fuzz_mesh_ply (CI, FUZZ_SEED=1): a face element without vertex_indices and a count with a
+      // letter after it, which assimp read from bytes its header did not account for (4.4 GB).
+      {"fuzz_oom", std::string("ply\nformat ascii 1.0\nelement vertex 3\nproperty float `\nprop 0 1ply\nformat ascii \n"
+                               "element face 5\nproperty list char int s\nend_header\n555555555:"),
+       "line 3", "element 'vertex' has no property 'x'"},
+      {"unknown_type", ascii("element vertex 3\nproperty int64 x\n", body), "line 4", "has type 'int64', which PLY does not define"},
+      {"float_count", ascii(vertex + "element face 1\nproperty list float int vertex_indices\n", body), "line 8", "not by an integer type"},
+      {"not_ply", "plx\nformat ascii 1.0\nend_header\n", "line 1", "not a PLY file"},
+      {"no_format", "ply\n" + vertex + face + "end_header\n" + body, "line 8", "no 'format' line"},
+      {"bad_format", "ply\nformat utf8 1.0\nend_header\n", "line 2", "not ascii, binary_little_endian or binary_big_endian"},
+      {"count_word", ascii("element vertex three\n", ""), "line 3", "has count 'three', not a whole number"},
+      {"no_z", ascii("element vertex 3\nproperty float x\nproperty float y\n" + face, body), "line 3", "has no property 'z'"},
+      {"letter", ascii(vertex + face, "0 0 0\n1 0 0\n0 1 zz\n3 0 1 2\n"), "line 12", "'zz' (property 'z' of vertex 2) is not a number"},
+      {"short_line", ascii(vertex + face, "0 0 0\n1 0 0\n0 1\n3 0 1 2\n"), "line 12", "vertex 2 ends before its property 'z'"},
+      {"few_lines", ascii(vertex + face, "0 0 0\n1 0 0\n"), "", "the file ends before vertex 2 (the header declares 3)"},
+      {"index_range", ascii(vertex + "element face 1\nproperty list uchar uchar vertex_indices\n", "0 0 0\n1 0 0\n0 1 0\n3 0 1 300\n"),
+       "line 13", "'300' (property 'vertex_indices' of face 0) is not a number of its type"},
+      {"negative_index", ascii(vertex + face, "0 0 0\n1 0 0\n0 1 0\n3 0 -1 2\n"), "", "face 0 uses vertex -1, but the mesh has 3"},
+      {"fraction_index", ascii(vertex + "element face 1\nproperty list uchar float vertex_indices\n", "0 0 0\n1 0 0\n0 1 0\n3 0 1 1.5\n"),
+       "", "uses vertex 1.5"},
+      {"header_only_property", "ply\nformat ascii 1.0\nproperty float x\n" + vertex + face + "end_header\n" + body + "extra\n", "", ""},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::string path = dir.write(c.name + ".ply", c.text);
+    if (c.reason.empty()) {
+      std::vector<std::string> warnings;
+      EXPECT_EQ(loadMesh(path, Vec3::Ones(), &warnings).triangles.size(), 1u);
+      EXPECT_TRUE(std::any_of(warnings.begin(), warnings.end(), [](const std::string& w) {
+        return w.find("line 3: a property before any element; skipped") != std::string::npos;
+      }));
+      continue;
+    }
+    EXPECT_LOAD_ERROR(loadMesh(path, Vec3::Ones()), path, c.element, c.reason);
+  }
+
+  // A `comment` line that reads like an element is a comment.
+  const std::string comment = dir.write("comment.ply", ascii("comment element face 100000\n" + vertex + face, body));
+  EXPECT_EQ(loadMesh(comment, Vec3::Ones()).triangles.size(), 1u);
+  // Binary: cut anywhere inside the data, the file is refused at the byte where it ends.
+  std::string binary = "ply\nformat binary_big_endian 1.0\n" + vertex + face + "end_header\n";
+  const std::size_t header_size = binary.size();
+  PlyWriter w{"binary_big_endian", ""};
+  for (const double v : {0., 0., 0., 1., 0., 0., 0., 1., 0.}) w.value("float", v);
+  w.value("uchar", 3);
+  for (const int i : {0, 1, 2}) w.value("int", i);
+  binary += w.data;
+  EXPECT_EQ(loadMesh(dir.write("whole.ply", binary), Vec3::Ones()).triangles.size(), 1u);
+  for (std::size_t cut = header_size; cut < binary.size(); ++cut) {
+    const std::string path = dir.write("cut.ply", binary.substr(0, cut));
+    EXPECT_LOAD_ERROR(loadMesh(path, Vec3::Ones()), path, "byte", cut > header_size + 36 ? "claims" : "the file ends inside");
+  }
+}
