@@ -217,8 +217,9 @@ struct MotionChecker::Sweep {
     if (it.b >= 0) {
       const Pose& pb = pose(s, it.frame_b);
       d = ctx.pairs[k].lowerBound(pa, pb, tol, q) - it.padding;
-      // (The hulls' last GJK axis, this measurement's or an earlier one's, where the hulls cleared it.)
-      if (d > contact && ctx.pairs[k].lastRung() <= Rung::Hulls) split_item = k;
+      // (The hulls' last GJK axis, this measurement's or an earlier one's, where the hulls cleared it. Not in
+      // Hull mode: the parts hold the triangles, not all of the hull that decides there.)
+      if (d > contact && ctx.pairs[k].lastRung() <= Rung::Hulls && exact) split_item = k;
       if (d <= contact && !head) {
         report = CollisionReport{};
         report.kind = CollisionReport::Kind::Self;

@@ -75,7 +75,10 @@ bool SelfCollision::pairHits(int k, const Pose* poses, SelfCollisionContext& ctx
 Screen SelfCollision::pairScreen(int k, const Pose* poses, SelfCollisionContext& ctx, bool balls_placed) const noexcept {
   const LinkPair& p = pairs_[k];
   ++ctx.pair_tests;
-  if (balls_placed && ctx.balls.apart(p.a, p.b, pair_padding_[k], options_.tolerances)) return Screen::Apart;
+  // (Hull mode: the hulls decide, which the parts' balls need not hold.)
+  if (balls_placed &&
+      ctx.balls.apart(p.a, p.b, pair_padding_[k], options_.tolerances, options_.mode == GeometryMode::Mesh))
+    return Screen::Apart;
   const IntersectQuery q{pair_padding_[k], options_.mode};
   if (k < static_cast<int>(ctx.bodies.size())) return ctx.bodies[k].screen(poses[p.a], poses[p.b], options_.tolerances, q);
   return BodyPair(*geometry_->link(p.a), *geometry_->link(p.b)).screen(poses[p.a], poses[p.b], options_.tolerances, q);

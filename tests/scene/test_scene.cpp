@@ -644,6 +644,47 @@ TEST(Scene, TheClearanceGridKeepsHullModeVerdicts) {
   }
 }
 
+// The same plates around a block of the robot itself: in Hull mode the plates' hull holds the block, so
+// the pair collides, though every ball of the plates' parts is clear of the block's.
+TEST(Scene, HullModeSelfPairsAreDecidedByTheHulls) {
+  const test::TempDir dir;
+  const auto facet = [](const std::string& a, const std::string& b, const std::string& c) {
+    return "facet normal 0 0 0\nouter loop\nvertex " + a + "\nvertex " + b + "\nvertex " + c + "\nendloop\nendfacet\n";
+  };
+  std::string stl = "solid plates\n";
+  for (const std::string z : {"-0.5", "0.5"})
+    stl += facet("-0.1 -0.1 " + z, "0.1 -0.1 " + z, "0.1 0.1 " + z) + facet("-0.1 -0.1 " + z, "0.1 0.1 " + z, "-0.1 0.1 " + z);
+  dir.write("plates.stl", stl + "endsolid plates\n");
+  // (The base has geometry of its own, far off: through a link without any, plates and block would be
+  // adjacent, as MoveIt counts, and never checked.)
+  dir.write("plates.urdf", R"(<robot name="plates">
+  <link name="base"><collision><origin xyz="0 0 -3"/><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>
+  <link name="plates"><collision><geometry><mesh filename="plates.stl"/></geometry></collision></link>
+  <link name="block"><collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>
+  <joint name="slide" type="prismatic"><parent link="base"/><child link="plates"/><axis xyz="1 0 0"/>
+    <limit lower="-2" upper="2" effort="1" velocity="1"/></joint>
+  <joint name="hold" type="fixed"><parent link="base"/><child link="block"/></joint>
+</robot>)");
+  const std::string path = dir.write("plates.yaml", "format: 1\nname: plates\nrobot:\n  urdf: " + dir.path("plates.urdf") +
+                                                        "\n  group: [slide]\nchecks: [self]\n");
+  for (const GeometryMode mode : {GeometryMode::Mesh, GeometryMode::Hull}) {
+    SceneOptions options;
+    options.mode = mode;
+    const auto scene = Scene::load(path, options);
+    const int plates = scene->robot().linkIndex("plates");
+    ASSERT_GE(plates, 0);
+    ASSERT_GT(scene->geometry().link(plates)->parts().size(), 1u) << "the test needs a link of several parts";
+    ASSERT_EQ(scene->selfCollision().pairs().size(), 1u) << "plates and block must be a checked pair";
+    SceneContext ctx = scene->makeContext();
+    for (const double x : {0.0, 0.05, -0.12}) {
+      const std::vector<double> q = {x};
+      EXPECT_EQ(scene->isFree(q.data(), ctx), mode == GeometryMode::Mesh) << (mode == GeometryMode::Mesh ? "mesh" : "hull") << " at x = " << x;
+    }
+    const std::vector<double> away = {1.0};
+    EXPECT_TRUE(scene->isFree(away.data(), ctx));
+  }
+}
+
 TEST(Scene, TheClearanceGridChangesNoVerdict) {
   std::mt19937 rng(29);
   long long clears = 0;
