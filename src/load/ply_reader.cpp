@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -355,7 +356,11 @@ class Reader {
   void addFace(const Element& e, std::uint64_t i, const std::vector<double>& list) {
     if (list.empty()) throw LoadError(path_, "", e.name + " " + std::to_string(i) + " has no vertices");
     for (const double v : list)
-      if (v != std::floor(v)) throw LoadError(path_, "", e.name + " " + std::to_string(i) + " uses vertex " + std::to_string(v) + ", not a whole number");
+      if (v != std::floor(v)) {
+        char buf[32];
+        std::snprintf(buf, sizeof buf, "%g", v);
+        throw LoadError(path_, "", e.name + " " + std::to_string(i) + " uses vertex " + buf + ", not a whole number");
+      }
     faces_.push_back({i, corners_.size(), list.size()});
     corners_.insert(corners_.end(), list.begin(), list.end());
   }
@@ -373,12 +378,20 @@ class Reader {
       for (std::size_t k = 0; k < f.size; ++k) {
         const double v = corners_[f.first + k];
         if ((v < 0 && !(strips && v == -1)) || v >= vertex_count)
-          throw LoadError(path_, "", face_name + " " + std::to_string(f.instance) + " uses vertex " +
-                                         std::to_string(static_cast<long long>(v)) + ", but the mesh has " +
+          throw LoadError(path_, "", face_name + " " + std::to_string(f.instance) + " uses vertex " + whole(v) +
+                                         ", but the mesh has " +
                                          std::to_string(mesh_.vertices.size()) + " vertices");
       }
     for (const Face& f : faces_) strips ? unrollStrip(f) : triangulate(f);
     return std::move(mesh_);
+  }
+
+  // A whole number as written ("-1", "4000000000", "1e+30"), never cast beyond its type's range.
+  static std::string whole(double v) {
+    if (std::abs(v) < 1e15) return std::to_string(static_cast<long long>(v));
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
   }
 
   std::uint32_t corner(const Face& f, std::size_t k) const { return static_cast<std::uint32_t>(corners_[f.first + k]); }
@@ -397,7 +410,9 @@ class Reader {
     }
   }
 
-  // A polygon in its plane: a fan when convex, ear clipping otherwise (up to kMaxClipped corners).
+  // A polygon in its plane: a fan when convex, ear clipping otherwise (up to kMaxClipped corners: at most
+  // n ears, each found among n corners by n inside tests, so n³ tests a face, and a face of n corners
+  // takes at least n bytes of the file).
   void triangulate(const Face& f) {
     if (f.size < 3) {
       ++mesh_.points_and_lines;
@@ -429,7 +444,7 @@ class Reader {
     bool convex = true;
     for (std::size_t k = 0; k < f.size && convex; ++k) convex = cross(ring[k], ring[(k + 1) % f.size], ring[(k + 2) % f.size]) >= 0.0;
     if (convex) return fan();
-    constexpr std::size_t kMaxClipped = 256;  // ear clipping is cubic in the corners at worst
+    constexpr std::size_t kMaxClipped = 64;
     if (f.size > kMaxClipped)
       throw LoadError(path_, "", "face " + std::to_string(f.instance) + " has " + std::to_string(f.size) +
                                      " corners and is not convex: Clearway triangulates such faces up to " +

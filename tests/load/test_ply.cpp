@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <random>
@@ -246,6 +247,34 @@ TEST(Ply, PolygonsAreTriangulatedInTheirPlaneAndStripsUnrolled) {
     const Vec3 n = (strips.vertices[t[1]] - strips.vertices[t[0]]).cross(strips.vertices[t[2]] - strips.vertices[t[0]]);
     EXPECT_LT(n.z(), 0.0);
   }
+  // A star (not convex) of 64 corners is clipped into 62 triangles, all turned as the face and covering
+  // its area; one of 65 corners is refused (ear clipping is cubic in the corners).
+  for (const int corners : {64, 65}) {
+    std::string text = "ply\nformat ascii 1.0\nelement vertex " + std::to_string(corners) +
+                       "\nproperty double x\nproperty double y\nproperty double z\nelement face 1\n"
+                       "property list ushort int vertex_indices\nend_header\n";
+    double area = 0.0;
+    for (int k = 0; k < corners; ++k) {
+      const double angle = 2 * M_PI * k / corners, r = k % 2 ? 0.5 : 1.0;
+      text += std::to_string(r * std::cos(angle)) + " " + std::to_string(r * std::sin(angle)) + " 0\n";
+    }
+    text += std::to_string(corners);
+    for (int k = 0; k < corners; ++k) text += " " + std::to_string(k);
+    const std::string path = dir.write("star.ply", text + "\n");
+    if (corners == 65) {
+      EXPECT_LOAD_ERROR(loadMesh(path, Vec3::Ones()), path, "", "face 0 has 65 corners and is not convex");
+      continue;
+    }
+    const TriangleMesh star = loadMesh(path, Vec3::Ones(), &warnings);
+    EXPECT_EQ(star.triangles.size(), 62u);
+    for (const auto& t : star.triangles) {
+      const Vec3 n = (star.vertices[t[1]] - star.vertices[t[0]]).cross(star.vertices[t[2]] - star.vertices[t[0]]);
+      EXPECT_GT(n.z(), 0.0) << "a triangle turned against the star";
+      area += n.z() / 2;
+    }
+    // The star's area: 64 triangles of the centre and two neighbouring corners.
+    EXPECT_NEAR(area, 64 * 0.5 * 1.0 * 0.5 * std::sin(2 * M_PI / 64), 1e-4);
+  }
   // A polygon that crosses itself (a bow tie) still loads, with a warning.
   const std::string bow = dir.write("bow.ply", header("face", 1) + "1 0 0\n1 1 1\n1 1 0\n1 0 1\n1 3 3\n1 4 4\n" + "4 0 1 2 3\n");
   warnings.clear();
@@ -284,6 +313,8 @@ TEST(Ply, ReadsOnlyWhatTheHeaderDeclares) {
       {"negative_index", ascii(vertex + face, "0 0 0\n1 0 0\n0 1 0\n3 0 -1 2\n"), "", "face 0 uses vertex -1, but the mesh has 3"},
       {"fraction_index", ascii(vertex + "element face 1\nproperty list uchar float vertex_indices\n", "0 0 0\n1 0 0\n0 1 0\n3 0 1 1.5\n"),
        "", "uses vertex 1.5"},
+      {"huge_index", ascii(vertex + "element face 1\nproperty list uchar float vertex_indices\n", "0 0 0\n1 0 0\n0 1 0\n3 0 1 1e30\n"),
+       "", "face 0 uses vertex 1e+30, but the mesh has 3 vertices"},
       {"header_only_property", "ply\nformat ascii 1.0\nproperty float x\n" + vertex + face + "end_header\n" + body + "extra\n", "", ""},
   };
   for (const Case& c : cases) {
