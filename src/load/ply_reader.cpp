@@ -7,6 +7,7 @@
 #include <clearway/load/load_error.h>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -76,32 +77,41 @@ std::vector<std::string> words(std::string_view line) {
   return out;
 }
 
-// A whole token as a number of the given type; false when the token is not one (or out of its range).
+// A whole token as a number of the given kind (an integer for integer types, whatever its size: assimp
+// reads 300 for a uchar as 300); false when the token is not one. A float beyond the type's range is
+// ±∞ or ±0, as strtod gives it (a coordinate's ∞ is refused later, naming the vertex).
 bool parse(const std::string& token, Type type, double* value) {
   const char* first = token.data();
   const char* last = first + token.size();
-  if (first != last && *first == '+') ++first;
+  const bool minus = first != last && *first == '-';
+  if (last - first > 1 && *first == '+' && (std::isdigit(static_cast<unsigned char>(first[1])) || first[1] == '.')) ++first;
   if (isInteger(type)) {
     std::int64_t v = 0;
     const auto [end, ec] = std::from_chars(first, last, v);
     if (ec != std::errc() || end != last) return false;
-    static constexpr std::int64_t kLow[] = {-128, 0, -32768, 0, -2147483648LL, 0};
-    static constexpr std::int64_t kHigh[] = {127, 255, 32767, 65535, 2147483647LL, 4294967295LL};
-    const auto k = static_cast<int>(type);
-    if (v < kLow[k] || v > kHigh[k]) return false;
     *value = static_cast<double>(v);
     return true;
   }
+  const auto outOfRange = [&] {
+    const bool tiny = token.find("e-") != std::string::npos || token.find("E-") != std::string::npos;
+    *value = (minus ? -1.0 : 1.0) * (tiny ? 0.0 : std::numeric_limits<double>::infinity());
+    return true;
+  };
   if (type == Type::Float32) {  // rounded once, to the float the file declares
     float v = 0.0f;
     const auto [end, ec] = std::from_chars(first, last, v);
-    if (ec != std::errc() || end != last) return false;
+    if (end != last || (ec != std::errc() && ec != std::errc::result_out_of_range)) return false;
+    if (ec == std::errc::result_out_of_range) return outOfRange();
     *value = v;
     return true;
   }
   const auto [end, ec] = std::from_chars(first, last, *value);
-  return ec == std::errc() && end == last;
+  if (end != last || (ec != std::errc() && ec != std::errc::result_out_of_range)) return false;
+  return ec == std::errc::result_out_of_range ? outOfRange() : true;
 }
+
+// A name as messages show it (and as it is kept: no name PLY or Clearway looks for is longer).
+std::string shown(const std::string& name) { return name.substr(0, 40); }
 
 const char* kTypeList = "char, uchar, short, ushort, int, uint, float, double, int8, uint8, int16, uint16, int32, "
                         "uint32, float32 or float64";
@@ -142,13 +152,17 @@ class Reader {
       at_ = end + 1;
       line_ = number + 1;
       if (number == 1) {
-        if (w.size() != 1 || w[0] != "ply") throw LoadError(path_, lineName(1), "not a PLY file: the first line is not 'ply'");
+        std::string first = w.size() == 1 ? w[0] : "";
+        for (char& c : first) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        if (first != "ply") throw LoadError(path_, lineName(1), "not a PLY file: the first line is not 'ply'");
         continue;
       }
       if (w.empty() || w[0] == "comment" || w[0] == "obj_info") continue;
       const std::string where = lineName(number);
       if (w[0] == "end_header") {
         if (!have_format) throw LoadError(path_, where, "the PLY header has no 'format' line");
+        if (unknown_lines_ > kWarnedLines)
+          warn("", std::to_string(unknown_lines_ - kWarnedLines) + " more header lines that are not PLY skipped");
         return;
       }
       if (w[0] == "format") {
@@ -161,7 +175,7 @@ class Reader {
       } else if (w[0] == "property") {
         readPropertyLine(w, where);
       } else {
-        warn(where, "header line '" + w[0].substr(0, 40) + "' is not PLY; skipped");
+        if (++unknown_lines_ <= kWarnedLines) warn(where, "header line '" + shown(w[0]) + "' is not PLY; skipped");
       }
     }
   }
@@ -173,10 +187,10 @@ class Reader {
     std::uint64_t n = 0;
     const bool digits = std::all_of(count.begin(), count.end(), [](char c) { return c >= '0' && c <= '9'; });
     for (std::size_t i = 0; digits && i < count.size() && n <= bytes_.size(); ++i) n = 10 * n + static_cast<std::uint64_t>(count[i] - '0');
-    if (!digits) throw LoadError(path_, where, "element '" + w[1] + "' has count '" + count.substr(0, 40) + "', not a whole number");
+    if (!digits) throw LoadError(path_, where, "element '" + shown(w[1]) + "' has count '" + shown(count) + "', not a whole number");
     // Every instance takes at least one byte (see readElement): a larger count cannot be the file's.
     if (n > bytes_.size())
-      throw LoadError(path_, where, "element '" + w[1] + "' has " + count.substr(0, 40) +
+      throw LoadError(path_, where, "element '" + shown(w[1]) + "' has " + shown(count) +
                                         " instances, more than the file has bytes (" + std::to_string(bytes_.size()) + ")");
     const bool faces = w[1] == "face" || w[1] == "tristrips";
     if (n > 0 && (w[1] == "vertex" || faces)) {
@@ -192,12 +206,12 @@ class Reader {
       first = number;
       (w[1] == "vertex" ? vertex_element_ : face_element_) = elements_.size();
     }
-    elements_.push_back({w[1], n, {}, number});
+    elements_.push_back({shown(w[1]), n, {}, number});
   }
 
   void readPropertyLine(const std::vector<std::string>& w, const std::string& where) {
     if (elements_.empty()) {
-      warn(where, "a property before any element; skipped");
+      if (++unknown_lines_ <= kWarnedLines) warn(where, "a property before any element; skipped");
       return;
     }
     Property p;
@@ -206,15 +220,15 @@ class Reader {
     if (w.size() < need)
       throw LoadError(path_, where, p.list ? "'property list' needs a count type, an item type and a name"
                                            : "'property' needs a type and a name");
-    p.name = w[need - 1];
+    p.name = shown(w[need - 1]);
     const std::size_t first_type = p.list ? 2 : 1;
     for (std::size_t k = first_type; k < need - 1; ++k) {
       const Type t = typeNamed(w[k]);
       if (t == Type::None)
-        throw LoadError(path_, where, "property '" + p.name.substr(0, 40) + "' has type '" + w[k].substr(0, 40) +
+        throw LoadError(path_, where, "property '" + p.name + "' has type '" + shown(w[k]) +
                                           "', which PLY does not define (" + kTypeList + ")");
       if (p.list && k == first_type && !isInteger(t))
-        throw LoadError(path_, where, "list '" + p.name.substr(0, 40) + "' is counted by a " + w[k] +
+        throw LoadError(path_, where, "list '" + p.name + "' is counted by a " + shown(w[k]) +
                                           ", not by an integer type");
       (p.list && k == first_type ? p.count : p.item) = t;
     }
@@ -236,16 +250,18 @@ class Reader {
 
   std::string instanceName(const Element& e, std::uint64_t i) const { return e.name + " " + std::to_string(i); }
 
-  // One value of the given type at the cursor.
-  double value(Type type, const Element& e, std::uint64_t i, const Property& p) {
+  // One value of the given type at the cursor. Values nothing reads (`used` false) need only be there:
+  // assimp skips what it does not know, whatever it holds.
+  double value(Type type, const Element& e, std::uint64_t i, const Property& p, bool used = true) {
     if (format_ == Format::Ascii) {
       if (next_token_ >= tokens_.size())
         throw LoadError(path_, lineName(token_line_), instanceName(e, i) + " ends before its property '" + p.name + "'");
       const std::string& token = tokens_[next_token_++];
       double v = 0.0;
-      if (!parse(token, type, &v))
-        throw LoadError(path_, lineName(token_line_), "'" + token.substr(0, 40) + "' (property '" + p.name + "' of " +
-                                                          instanceName(e, i) + ") is not a number of its type");
+      if (used && !parse(token, type, &v))
+        throw LoadError(path_, lineName(token_line_), "'" + shown(token) + "' (property '" + p.name + "' of " +
+                                                          instanceName(e, i) + ") is not " +
+                                                          (isInteger(type) ? "an integer" : "a number"));
       return v;
     }
     const std::size_t n = sizeOf(type);
@@ -279,36 +295,34 @@ class Reader {
     }
   }
 
-  // A list's length, refused when negative or longer than the data left for it.
+  // A list's length, refused when negative or longer than the data left for it (its line's tokens, or the
+  // file's bytes).
   std::uint64_t listLength(const Element& e, std::uint64_t i, const Property& p) {
     const std::size_t count_at = at_;
-    const std::string claim = "list '" + p.name + "' of " + instanceName(e, i) + " claims ";
-    if (format_ == Format::Ascii && next_token_ < tokens_.size()) {
-      // A count beyond the line (or below 0) is named as such, whatever its type's range.
-      const std::string& token = tokens_[next_token_];
-      const std::size_t left = tokens_.size() - next_token_ - 1;
-      const std::size_t digits = token[0] == '-' || token[0] == '+' ? 1 : 0;
-      const bool whole = token.size() > digits &&
-                         std::all_of(token.begin() + static_cast<std::ptrdiff_t>(digits), token.end(), [](char c) { return c >= '0' && c <= '9'; });
-      if (whole && (token[0] == '-' || token.size() - digits > 19 || std::stoull(token.substr(digits)) > left))
-        throw LoadError(path_, lineName(token_line_), claim + token.substr(0, 40) + " values, but the line holds " +
-                                                          std::to_string(left) + " more");
-    }
+    const std::string token = format_ == Format::Ascii && next_token_ < tokens_.size() ? shown(tokens_[next_token_]) : "";
     const double n = value(p.count, e, i, p);
-    if (format_ != Format::Ascii) {
+    const auto claims = [&](const std::string& count, const std::string& where, const std::string& left) {
+      return LoadError(path_, where, "list '" + p.name + "' of " + instanceName(e, i) + " claims " + count +
+                                         " values, but " + left);
+    };
+    if (format_ == Format::Ascii) {
+      const std::size_t left = tokens_.size() - next_token_;
+      if (!(n >= 0.0 && n <= static_cast<double>(left)))
+        throw claims(token, lineName(token_line_), "the line holds " + std::to_string(left) + " more");
+    } else {
       const std::size_t left = (bytes_.size() - std::min(bytes_.size(), at_)) / sizeOf(p.item);
-      if (n < 0 || n > static_cast<double>(left))
-        throw LoadError(path_, "byte " + std::to_string(count_at),
-                        claim + (n < 0 ? std::string("a negative number of") : std::to_string(static_cast<std::uint64_t>(n))) +
-                            " values, but the file holds " + std::to_string(left) + " more");
+      if (!(n >= 0.0 && n <= static_cast<double>(left)))
+        throw claims(n < 0 ? "a negative number of" : std::to_string(static_cast<std::uint64_t>(n)),
+                     "byte " + std::to_string(count_at), "the file holds " + std::to_string(left) + " more");
     }
     return static_cast<std::uint64_t>(n);
   }
 
+  // Where the instance being read starts: "line N" (ASCII) or "byte N" (binary).
+  std::string here(std::uint64_t at) const { return (format_ == Format::Ascii ? "line " : "byte ") + std::to_string(at); }
+
   void readElement(std::size_t index) {
     const Element& e = elements_[index];
-    // An instance without properties takes no data (none in binary; assimp neither reads lines for it).
-    if (e.properties.empty()) return;
     const bool vertices = index == vertex_element_, faces = index == face_element_;
     int xyz[3] = {-1, -1, -1};
     int corners = -1;
@@ -324,51 +338,57 @@ class Reader {
           throw LoadError(path_, lineName(e.line), "element 'vertex' has no property '" + std::string(1, static_cast<char>('x' + a)) + "'");
     if (faces && corners < 0)
       throw LoadError(path_, lineName(e.line), "element '" + e.name + "' has no list 'vertex_indices' (or 'vertex_index')");
+    // An instance without properties holds no values: no bytes, and in ASCII an empty line at most, which
+    // reading skips as it skips every blank line.
+    if (e.properties.empty()) return;
 
     std::vector<double> list;
     for (std::uint64_t i = 0; i < e.count; ++i) {
       if (format_ == Format::Ascii && !nextLine())
         throw LoadError(path_, "", "the file ends before " + instanceName(e, i) + " (the header declares " +
                                        std::to_string(e.count) + ")");
+      const std::uint64_t start = format_ == Format::Ascii ? static_cast<std::uint64_t>(token_line_) : at_;
       Vec3 point = Vec3::Zero();
       for (std::size_t k = 0; k < e.properties.size(); ++k) {
         const Property& p = e.properties[k];
+        const bool coordinate = vertices && (xyz[0] == static_cast<int>(k) || xyz[1] == static_cast<int>(k) ||
+                                             xyz[2] == static_cast<int>(k));
         if (!p.list) {
-          const double v = value(p.item, e, i, p);
+          const double v = value(p.item, e, i, p, coordinate);
           for (int a = 0; a < 3; ++a)
-            if (vertices && xyz[a] == static_cast<int>(k)) point[a] = v;
+            if (coordinate && xyz[a] == static_cast<int>(k)) point[a] = v;
           continue;
         }
         const std::uint64_t n = listLength(e, i, p);
         const bool keep = faces && corners == static_cast<int>(k);
         list.clear();
         for (std::uint64_t j = 0; j < n; ++j) {
-          const double v = value(p.item, e, i, p);
+          const double v = value(p.item, e, i, p, keep);
           if (keep) list.push_back(v);
         }
-        if (keep) addFace(e, i, list);
+        if (keep) addFace(e, i, start, list);
       }
       if (vertices) mesh_.vertices.push_back(point);
     }
   }
 
+  struct Face {
+    std::uint64_t instance, at;  // its number and where it starts (here())
+    std::size_t first, size;     // its corners in corners_
+  };
+
   // A face's corners (or a strip's indices), checked when every vertex is known (finish).
-  void addFace(const Element& e, std::uint64_t i, const std::vector<double>& list) {
-    if (list.empty()) throw LoadError(path_, "", e.name + " " + std::to_string(i) + " has no vertices");
+  void addFace(const Element& e, std::uint64_t i, std::uint64_t at, const std::vector<double>& list) {
+    const bool strip = e.name == "tristrips";
+    if (list.empty() && !strip) throw LoadError(path_, here(at), e.name + " " + std::to_string(i) + " has no vertices");
     for (const double v : list)
-      if (v != std::floor(v)) {
-        char buf[32];
-        std::snprintf(buf, sizeof buf, "%g", v);
-        throw LoadError(path_, "", e.name + " " + std::to_string(i) + " uses vertex " + buf + ", not a whole number");
-      }
-    faces_.push_back({i, corners_.size(), list.size()});
+      if (v != std::floor(v)) throw LoadError(path_, here(at), e.name + " " + std::to_string(i) + " uses vertex " + written(v) + ", not a whole number");
+    faces_.push_back({i, at, corners_.size(), list.size()});
     corners_.insert(corners_.end(), list.begin(), list.end());
   }
 
-  struct Face {
-    std::uint64_t instance;
-    std::size_t first, size;
-  };
+  // A strip's restart: -1, or its unsigned 32-bit form (assimp reads every index as an int).
+  static bool restart(double v) { return v == -1.0 || v == 4294967295.0; }
 
   PlyMesh finish() {
     const bool strips = face_element_ < elements_.size() && elements_[face_element_].name == "tristrips";
@@ -377,18 +397,18 @@ class Reader {
     for (const Face& f : faces_)
       for (std::size_t k = 0; k < f.size; ++k) {
         const double v = corners_[f.first + k];
-        if ((v < 0 && !(strips && v == -1)) || v >= vertex_count)
-          throw LoadError(path_, "", face_name + " " + std::to_string(f.instance) + " uses vertex " + whole(v) +
-                                         ", but the mesh has " +
-                                         std::to_string(mesh_.vertices.size()) + " vertices");
+        if (strips && restart(v)) continue;
+        if (!(v >= 0.0 && v < vertex_count))
+          throw LoadError(path_, here(f.at), face_name + " " + std::to_string(f.instance) + " uses vertex " + written(v) +
+                                                 ", but the mesh has " + std::to_string(mesh_.vertices.size()) + " vertices");
       }
     for (const Face& f : faces_) strips ? unrollStrip(f) : triangulate(f);
     return std::move(mesh_);
   }
 
-  // A whole number as written ("-1", "4000000000", "1e+30"), never cast beyond its type's range.
-  static std::string whole(double v) {
-    if (std::abs(v) < 1e15) return std::to_string(static_cast<long long>(v));
+  // An index as written ("-1", "4000000000", "1.5", "1e+30"), never cast beyond a type's range.
+  static std::string written(double v) {
+    if (std::abs(v) < 1e15 && v == std::floor(v)) return std::to_string(static_cast<long long>(v));
     char buf[32];
     std::snprintf(buf, sizeof buf, "%g", v);
     return buf;
@@ -400,7 +420,7 @@ class Reader {
   void unrollStrip(const Face& f) {
     std::size_t run = 0;
     for (std::size_t k = 0; k < f.size; ++k) {
-      if (corners_[f.first + k] < 0) {
+      if (restart(corners_[f.first + k])) {
         run = 0;
         continue;
       }
@@ -410,9 +430,9 @@ class Reader {
     }
   }
 
-  // A polygon in its plane: a fan when convex, ear clipping otherwise (up to kMaxClipped corners: at most
-  // n ears, each found among n corners by n inside tests, so n³ tests a face, and a face of n corners
-  // takes at least n bytes of the file).
+  // A polygon in its plane: a fan when convex (up to rounding), ear clipping otherwise. Clipping costs up
+  // to n² inside tests per ear; the file's budget of them (kClipWork per byte) ends any loop through
+  // crafted polygons with an error instead of minutes of work.
   void triangulate(const Face& f) {
     if (f.size < 3) {
       ++mesh_.points_and_lines;
@@ -441,37 +461,47 @@ class Reader {
       const Vec3 &p = mesh_.vertices[a], &q = mesh_.vertices[b], &r = mesh_.vertices[c];
       return turn * ((q[u] - p[u]) * (r[v] - p[v]) - (q[v] - p[v]) * (r[u] - p[u]));
     };
+    // Convex up to rounding: a turn below 1e-12 of its edges' product is straight (corners along a
+    // slanted edge, written in floats).
     bool convex = true;
-    for (std::size_t k = 0; k < f.size && convex; ++k) convex = cross(ring[k], ring[(k + 1) % f.size], ring[(k + 2) % f.size]) >= 0.0;
+    for (std::size_t k = 0; k < f.size && convex; ++k) {
+      const std::uint32_t a = ring[k], b = ring[(k + 1) % f.size], c = ring[(k + 2) % f.size];
+      const Vec3 &p = mesh_.vertices[a], &q = mesh_.vertices[b], &r = mesh_.vertices[c];
+      convex = cross(a, b, c) >= -1e-12 * (q - p).norm() * (r - q).norm();
+    }
     if (convex) return fan();
-    constexpr std::size_t kMaxClipped = 64;
-    if (f.size > kMaxClipped)
-      throw LoadError(path_, "", "face " + std::to_string(f.instance) + " has " + std::to_string(f.size) +
-                                     " corners and is not convex: Clearway triangulates such faces up to " +
-                                     std::to_string(kMaxClipped) + " corners");
     const auto inside = [&](std::uint32_t p, std::uint32_t a, std::uint32_t b, std::uint32_t c) {
       return cross(a, b, p) >= 0.0 && cross(b, c, p) >= 0.0 && cross(c, a, p) >= 0.0;
     };
+    const double budget = kClipWork * static_cast<double>(bytes_.size()) + 1e6;
+    std::size_t k = 0;  // where the search for the next ear starts: next to the last one
     while (ring.size() > 3) {
       bool clipped = false;
-      for (std::size_t k = 0; k < ring.size() && !clipped; ++k) {
+      for (std::size_t tried = 0; tried < ring.size() && !clipped; ++tried, k = (k + 1) % ring.size()) {
         const std::uint32_t a = ring[(k + ring.size() - 1) % ring.size()], b = ring[k], c = ring[(k + 1) % ring.size()];
         if (!(cross(a, b, c) > 0.0)) continue;
-        bool empty = true;
-        for (const std::uint32_t p : ring)
-          if (p != a && p != b && p != c && inside(p, a, b, c)) empty = false;
-        if (!empty) continue;
+        clip_work_ += static_cast<double>(ring.size());
+        if (clip_work_ > budget)
+          throw LoadError(path_, here(f.at), "face " + std::to_string(f.instance) + " (" + std::to_string(f.size) +
+                                                 " corners, not convex) takes more work to triangulate than the file's "
+                                                 "size allows");
+        if (std::any_of(ring.begin(), ring.end(), [&](std::uint32_t p) { return p != a && p != b && p != c && inside(p, a, b, c); }))
+          continue;
         mesh_.triangles.push_back({a, b, c});
         ring.erase(ring.begin() + static_cast<std::ptrdiff_t>(k));
+        k = (k + ring.size() - 2) % ring.size();  // (the loop's step then starts at the clipped corner's neighbour)
         clipped = true;
       }
       if (!clipped) {  // the polygon crosses itself: no ear is free of other corners
-        warn("", "face " + std::to_string(f.instance) + " crosses itself; the rest of it is triangulated as a fan");
+        warn(here(f.at), "face " + std::to_string(f.instance) + " crosses itself; the rest of it is triangulated as a fan");
         break;
       }
     }
-    for (std::size_t k = 1; k + 1 < ring.size(); ++k) mesh_.triangles.push_back({ring[0], ring[k], ring[k + 1]});
+    for (std::size_t j = 1; j + 1 < ring.size(); ++j) mesh_.triangles.push_back({ring[0], ring[j], ring[j + 1]});
   }
+
+  static constexpr double kClipWork = 1000.0;  // inside tests per byte of the file
+  static constexpr int kWarnedLines = 3;        // header lines warned of one by one
 
   std::string path_;
   std::vector<std::string>* warnings_;
@@ -483,11 +513,13 @@ class Reader {
   std::size_t vertex_element_ = std::numeric_limits<std::size_t>::max();
   std::size_t face_element_ = std::numeric_limits<std::size_t>::max();
   long vertex_line_ = 0, face_line_ = 0;
+  int unknown_lines_ = 0;
   std::vector<std::string> tokens_;
   std::size_t next_token_ = 0;
   long token_line_ = 0;
   std::vector<double> corners_;
   std::vector<Face> faces_;
+  double clip_work_ = 0.0;
   PlyMesh mesh_;
 };
 

@@ -247,9 +247,9 @@ TEST(Ply, PolygonsAreTriangulatedInTheirPlaneAndStripsUnrolled) {
     const Vec3 n = (strips.vertices[t[1]] - strips.vertices[t[0]]).cross(strips.vertices[t[2]] - strips.vertices[t[0]]);
     EXPECT_LT(n.z(), 0.0);
   }
-  // A star (not convex) of 64 corners is clipped into 62 triangles, all turned as the face and covering
-  // its area; one of 65 corners is refused (ear clipping is cubic in the corners).
-  for (const int corners : {64, 65}) {
+  // Stars (not convex) of 64 and 200 corners are clipped into n - 2 triangles, all turned as the face and
+  // covering its area.
+  for (const int corners : {64, 200}) {
     std::string text = "ply\nformat ascii 1.0\nelement vertex " + std::to_string(corners) +
                        "\nproperty double x\nproperty double y\nproperty double z\nelement face 1\n"
                        "property list ushort int vertex_indices\nend_header\n";
@@ -261,20 +261,22 @@ TEST(Ply, PolygonsAreTriangulatedInTheirPlaneAndStripsUnrolled) {
     text += std::to_string(corners);
     for (int k = 0; k < corners; ++k) text += " " + std::to_string(k);
     const std::string path = dir.write("star.ply", text + "\n");
-    if (corners == 65) {
-      EXPECT_LOAD_ERROR(loadMesh(path, Vec3::Ones()), path, "", "face 0 has 65 corners and is not convex");
-      continue;
-    }
     const TriangleMesh star = loadMesh(path, Vec3::Ones(), &warnings);
-    EXPECT_EQ(star.triangles.size(), 62u);
+    EXPECT_EQ(star.triangles.size(), static_cast<std::size_t>(corners - 2));
     for (const auto& t : star.triangles) {
       const Vec3 n = (star.vertices[t[1]] - star.vertices[t[0]]).cross(star.vertices[t[2]] - star.vertices[t[0]]);
       EXPECT_GT(n.z(), 0.0) << "a triangle turned against the star";
       area += n.z() / 2;
     }
-    // The star's area: 64 triangles of the centre and two neighbouring corners.
-    EXPECT_NEAR(area, 64 * 0.5 * 1.0 * 0.5 * std::sin(2 * M_PI / 64), 1e-4);
+    // The star's area: triangles of the centre and two neighbouring corners.
+    EXPECT_NEAR(area, corners * 0.5 * 1.0 * 0.5 * std::sin(2 * M_PI / corners), 1e-4);
   }
+  // Restarts written as uint (4294967295, which assimp reads as -1) and an empty strip.
+  const std::string unsigned_strip = dir.write("ustrip.ply", "ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\nproperty float y\n"
+                                                             "property float z\nelement tristrips 2\nproperty list int uint vertex_indices\n"
+                                                             "end_header\n0 0 0\n0 1 0\n1 0 0\n1 1 0\n2 0 0\n2 1 0\n"
+                                                             "9 0 1 2 3 4294967295 2 3 4 5\n0\n");
+  EXPECT_EQ(trianglesOf(loadMesh(unsigned_strip, Vec3::Ones())), trianglesOf(strips));
   // A polygon that crosses itself (a bow tie) still loads, with a warning.
   const std::string bow = dir.write("bow.ply", header("face", 1) + "1 0 0\n1 1 1\n1 1 0\n1 0 1\n1 3 3\n1 4 4\n" + "4 0 1 2 3\n");
   warnings.clear();
@@ -309,7 +311,12 @@ TEST(Ply, ReadsOnlyWhatTheHeaderDeclares) {
       {"short_line", ascii(vertex + face, "0 0 0\n1 0 0\n0 1\n3 0 1 2\n"), "line 12", "vertex 2 ends before its property 'z'"},
       {"few_lines", ascii(vertex + face, "0 0 0\n1 0 0\n"), "", "the file ends before vertex 2 (the header declares 3)"},
       {"index_range", ascii(vertex + "element face 1\nproperty list uchar uchar vertex_indices\n", "0 0 0\n1 0 0\n0 1 0\n3 0 1 300\n"),
-       "line 13", "'300' (property 'vertex_indices' of face 0) is not a number of its type"},
+       "line 13", "face 0 uses vertex 300, but the mesh has 3 vertices"},
+      // Found by review: "+-1" read as -1 once the '+' was dropped, then cast to an unsigned count.
+      {"plus_minus", ascii(vertex + "element face 1\nproperty list char int vertex_indices\n", "0 0 0\n1 0 0\n0 1 0\n+-1 0 1 2\n"),
+       "line 13", "'+-1' (property 'vertex_indices' of face 0) is not an integer"},
+      {"negative_count", ascii(vertex + "element face 1\nproperty list char int vertex_indices\n", "0 0 0\n1 0 0\n0 1 0\n-3 0 1 2\n"),
+       "line 13", "claims -3 values, but the line holds 3 more"},
       {"negative_index", ascii(vertex + face, "0 0 0\n1 0 0\n0 1 0\n3 0 -1 2\n"), "", "face 0 uses vertex -1, but the mesh has 3"},
       {"fraction_index", ascii(vertex + "element face 1\nproperty list uchar float vertex_indices\n", "0 0 0\n1 0 0\n0 1 0\n3 0 1 1.5\n"),
        "", "uses vertex 1.5"},
@@ -331,6 +338,22 @@ TEST(Ply, ReadsOnlyWhatTheHeaderDeclares) {
     EXPECT_LOAD_ERROR(loadMesh(path, Vec3::Ones()), path, c.element, c.reason);
   }
 
+  // What assimp (and so MoveIt) reads, read alike: an upper-case first line; values nothing uses, whatever
+  // they hold (a colour of 300, a normal of "1.0e"); floats beyond float's range (0 below it, infinity
+  // above, which a coordinate may not be); a warning for each of the first three header lines that are not
+  // PLY, then one for the rest.
+  std::vector<std::string> warnings;
+  const std::string lenient = dir.write("lenient.ply", "PLY\nformat ascii 1.0\nfoo\nbar\nbaz\nqux\nquux\n" +
+                                                          std::string("element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                                                                      "property uchar red\nproperty float nx\n") + face +
+                                                          "end_header\n0 0 1e-50 0 0\n1 0 0 300 1.0e\n0 1 0 0 0\n3 0 1 2\n");
+  const TriangleMesh read = loadMesh(lenient, Vec3::Ones(), &warnings);
+  ASSERT_EQ(read.triangles.size(), 1u);
+  EXPECT_EQ(read.vertices[read.triangles[0][0]].z(), 0.0);
+  ASSERT_GE(warnings.size(), 4u);
+  EXPECT_NE(warnings[3].find("2 more header lines that are not PLY skipped"), std::string::npos) << warnings[3];
+  const std::string beyond = dir.write("beyond.ply", ascii(vertex + face, "0 0 0\n1 0 1e39\n0 1 0\n3 0 1 2\n"));
+  EXPECT_LOAD_ERROR(loadMesh(beyond, Vec3::Ones()), beyond, "", "vertex 1 has a non-finite coordinate");
   // A `comment` line that reads like an element is a comment.
   const std::string comment = dir.write("comment.ply", ascii("comment element face 100000\n" + vertex + face, body));
   EXPECT_EQ(loadMesh(comment, Vec3::Ones()).triangles.size(), 1u);
