@@ -332,7 +332,8 @@ struct MotionChecker::Sweep {
     r.report = report;
   }
 
-  // Covers [a, b] ∩ [0, limit] for item k (all of [0, a) is covered already).
+  // Covers [a, b] ∩ [0, limit] for item k (all of [0, a) is covered already, except for a verdict, which
+  // needs no order: any contact settles it).
   void cover(int k, double a, double b, double witness) {
     const Item& it = mc.items_[k];
     const std::size_t base = ctx.intervals.size();
@@ -365,8 +366,12 @@ struct MotionChecker::Sweep {
         continue;
       }
       const double rad = reach(k, d, std::max(m - iv.a, hi - m));
+      // Left first (popped first), so that advancement starts clear of everything before it; a verdict
+      // takes the right first: the probe has found its states free, and planners' colliding segments
+      // mostly clip an obstacle shortly before a free end.
+      if (verdict_only && m - rad > iv.a) ctx.intervals.push_back({iv.a, m - rad, iv.witness});
       if (m + rad < hi) ctx.intervals.push_back({m + rad, hi, m});
-      if (m - rad > iv.a) ctx.intervals.push_back({iv.a, m - rad, iv.witness});
+      if (!verdict_only && m - rad > iv.a) ctx.intervals.push_back({iv.a, m - rad, iv.witness});
     }
     ctx.intervals.resize(base);
   }
@@ -504,8 +509,9 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
       cover(k, 0.0, 1.0, -1.0);  // within contact in the middle: from the start, exactly
     } else {  // what the ball in the middle leaves, left first
       const double rad = ctx.first_reach[k];
+      if (sweep.verdict_only && mid + rad < sweep.limit) cover(k, mid + rad, 1.0, mid);  // (see Sweep::cover)
       if (mid - rad > 0.0) cover(k, 0.0, mid - rad, -1.0);
-      if (mid + rad < sweep.limit) cover(k, mid + rad, 1.0, mid);
+      if (!sweep.verdict_only && mid + rad < sweep.limit) cover(k, mid + rad, 1.0, mid);
     }
   }
   if (sweep.capped) {
