@@ -607,10 +607,9 @@ void expectGridKeepsVerdicts(const std::shared_ptr<const Scene>& with, const std
   clears += a.counters.environment.grid_clears;
 }
 
-// A link of two open plates, 1 m apart, around a small box: the meshes are clear of it, the hull (Hull
-// mode's geometry) holds it, and so the parts' balls, which hold each plate, must not clear the link there.
-TEST(Scene, TheClearanceGridKeepsHullModeVerdicts) {
-  const test::TempDir dir;
+// Two open plates (0.2 m squares at z = ±0.5) as dir/plates.stl: one link of two parts whose hull is a
+// box their parts' balls do not fill.
+void writePlates(const test::TempDir& dir) {
   const auto facet = [](const std::string& a, const std::string& b, const std::string& c) {
     return "facet normal 0 0 0\nouter loop\nvertex " + a + "\nvertex " + b + "\nvertex " + c + "\nendloop\nendfacet\n";
   };
@@ -618,6 +617,13 @@ TEST(Scene, TheClearanceGridKeepsHullModeVerdicts) {
   for (const std::string z : {"-0.5", "0.5"})
     stl += facet("-0.1 -0.1 " + z, "0.1 -0.1 " + z, "0.1 0.1 " + z) + facet("-0.1 -0.1 " + z, "0.1 0.1 " + z, "-0.1 0.1 " + z);
   dir.write("plates.stl", stl + "endsolid plates\n");
+}
+
+// A link of two open plates, 1 m apart, around a small box: the meshes are clear of it, the hull (Hull
+// mode's geometry) holds it, and so the parts' balls, which hold each plate, must not clear the link there.
+TEST(Scene, TheClearanceGridKeepsHullModeVerdicts) {
+  const test::TempDir dir;
+  writePlates(dir);
   dir.write("plates.urdf", R"(<robot name="plates">
   <link name="base"/>
   <link name="plates"><collision><geometry><mesh filename="plates.stl"/></geometry></collision></link>
@@ -648,13 +654,7 @@ TEST(Scene, TheClearanceGridKeepsHullModeVerdicts) {
 // the pair collides, though every ball of the plates' parts is clear of the block's.
 TEST(Scene, HullModeSelfPairsAreDecidedByTheHulls) {
   const test::TempDir dir;
-  const auto facet = [](const std::string& a, const std::string& b, const std::string& c) {
-    return "facet normal 0 0 0\nouter loop\nvertex " + a + "\nvertex " + b + "\nvertex " + c + "\nendloop\nendfacet\n";
-  };
-  std::string stl = "solid plates\n";
-  for (const std::string z : {"-0.5", "0.5"})
-    stl += facet("-0.1 -0.1 " + z, "0.1 -0.1 " + z, "0.1 0.1 " + z) + facet("-0.1 -0.1 " + z, "0.1 0.1 " + z, "-0.1 0.1 " + z);
-  dir.write("plates.stl", stl + "endsolid plates\n");
+  writePlates(dir);
   // (The base has geometry of its own, far off: through a link without any, plates and block would be
   // adjacent, as MoveIt counts, and never checked.)
   dir.write("plates.urdf", R"(<robot name="plates">
