@@ -5,11 +5,15 @@
 #include <clearway/scene/scene.h>
 
 #include <Eigen/Core>
+#include <array>
 #include <vector>
 
 namespace clearway::motion_detail {
 
 // What one thread's checks of one MotionChecker keep between and within segments (MotionContext holds it).
+// How many states the probe checks.
+constexpr int kProbes = 4;
+
 struct Scratch {
   SceneContext scene;
   std::vector<double> q, dq;
@@ -49,14 +53,14 @@ struct Scratch {
   // it ran on), and the segments since it last ran.
   double probe_rate = 1.0;
   int probe_skipped = 0;
+  // Per probe state: how often it was the first to collide lately (a decaying count); the states are
+  // checked in the order of these counts.
+  std::array<double, kProbes> probe_hits{};
   std::vector<double> probe_states;  // the probe's states, one after another (kProbes·dimension)
 };
 
-// How many states the probe checks.
-constexpr int kProbes = 4;
-
-// A verdict-only check's first look (probe.cpp): the states at s = 1, 1/2, 1/4 and 3/4, checked as the
-// validity checker checks states (all their obstacles before any of their self pairs: Scene::anyCollides).
+// A verdict-only check's first look (probe.cpp): the states at s = 1, 1/2, 1/4 and 3/4 (those that collided
+// first most often lately before the others), checked as the validity checker checks states (all their obstacles before any of their self pairs: Scene::anyCollides).
 // True, with r filled (a contact at that s, the state's report), when one collides: the segment is then not
 // free whatever the items would measure. Only where it has lately paid for itself (planners' segments
 // often collide; a path's or a benchmark's seldom do).

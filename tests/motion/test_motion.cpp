@@ -1170,6 +1170,40 @@ std::shared_ptr<const Scene> movingWallScene(const TempDir& dir, double x0, doub
                                                   "checks: [environment, continuous, moving]\nstart: [0, 0]\ngoal: [0, 0]\n"));
 }
 
+// The probe checks first the state that collided first most often lately. The slider between a post in
+// the middle of its travel and one at its end: segment a meets both (at s = 1/2 and at its end), b only
+// the middle one. A fresh probe finds a's end; after segments like b, a's middle.
+TEST(MotionCertified, TheProbeLearnsWhichStateCollidesFirst) {
+  TempDir dir;
+  const std::string urdf = dir.write("slider.urdf", kSliderUrdf);
+  const auto scene = Scene::load(dir.write(
+      "posts.yaml", "format: 1\nname: posts\nrobot:\n  urdf: " + urdf +
+                        "\n  group: [slide, turn]\nenvironment:\n  obstacles:\n"
+                        "    - {name: middle, box: {size: [0.02, 0.5, 0.5]}, pose: {position: [0, 0, 0]}}\n"
+                        "    - {name: end, box: {size: [0.02, 0.5, 0.5]}, pose: {position: [1, 0, 0]}}\n"
+                        "checks: [environment]\nstart: [-1, 0]\ngoal: [-1, 0]\n"));
+  const MotionChecker checker(scene);
+  MotionContext ctx = checker.makeContext();
+  const double a0[2] = {-1, 0}, a1[2] = {1, 0}, b0[2] = {-0.5, 0}, b1[2] = {0.5, 0};
+  MotionResult r = checker.check(a0, a1, ctx, false);
+  ASSERT_FALSE(r.free);
+  EXPECT_EQ(r.first_contact, 1.0) << "a fresh probe checks the end first";
+  EXPECT_EQ(r.distance_queries, 0) << "settled by the probe";
+  for (int k = 0; k < 10; ++k) {
+    r = checker.check(b0, b1, ctx, false);
+    ASSERT_FALSE(r.free);
+    EXPECT_EQ(r.first_contact, 0.5);
+    EXPECT_EQ(r.distance_queries, 0) << "settled by the probe";
+  }
+  r = checker.check(a0, a1, ctx, false);
+  ASSERT_FALSE(r.free);
+  EXPECT_EQ(r.first_contact, 0.5) << "the middle, which collided first lately, goes first";
+  // Locating the first contact does not probe: the same verdict, at the middle post's face.
+  r = checker.check(a0, a1, ctx);
+  ASSERT_FALSE(r.free);
+  EXPECT_NEAR(r.first_contact, (1.0 - 0.06) / 2.0, 2e-3);
+}
+
 TEST(MotionCertified, MovingWallIsNeverTunnelled) {
   // The block (0.1 m) holds still at x = 0 from t = 0 to t = 2 while the wall sweeps from x = −1 to x = 1:
   // both ends are free, so sampling the (zero-length) segment sees nothing; the certified check finds the
