@@ -12,11 +12,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <limits>
-#include <sstream>
 #include <string_view>
 #include <system_error>
 
@@ -298,8 +296,7 @@ class Reader {
   // A list's length, refused when negative or longer than the data left for it (its line's tokens, or the
   // file's bytes).
   std::uint64_t listLength(const Element& e, std::uint64_t i, const Property& p) {
-    const std::size_t count_at = at_;
-    const std::string token = format_ == Format::Ascii && next_token_ < tokens_.size() ? shown(tokens_[next_token_]) : "";
+    const std::size_t count_at = at_, count_token = next_token_;
     const double n = value(p.count, e, i, p);
     const auto claims = [&](const std::string& count, const std::string& where, const std::string& left) {
       return LoadError(path_, where, "list '" + p.name + "' of " + instanceName(e, i) + " claims " + count +
@@ -308,7 +305,7 @@ class Reader {
     if (format_ == Format::Ascii) {
       const std::size_t left = tokens_.size() - next_token_;
       if (!(n >= 0.0 && n <= static_cast<double>(left)))
-        throw claims(token, lineName(token_line_), "the line holds " + std::to_string(left) + " more");
+        throw claims(shown(tokens_[count_token]), lineName(token_line_), "the line holds " + std::to_string(left) + " more");
     } else {
       const std::size_t left = (bytes_.size() - std::min(bytes_.size(), at_)) / sizeOf(p.item);
       if (!(n >= 0.0 && n <= static_cast<double>(left)))

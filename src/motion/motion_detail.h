@@ -10,10 +10,10 @@
 
 namespace clearway::motion_detail {
 
-// What one thread's checks of one MotionChecker keep between and within segments (MotionContext holds it).
 // How many states the probe checks.
 constexpr int kProbes = 4;
 
+// What one thread's checks of one MotionChecker keep between and within segments (MotionContext holds it).
 struct Scratch {
   SceneContext scene;
   std::vector<double> q, dq;

@@ -6,10 +6,11 @@
 namespace clearway::motion_detail {
 
 namespace {
-// The parameters, in the order a fresh context checks them: the end first, then coarse to fine. RRTConnect checks the state it extends to only on its
-// goal tree, so on its start tree the end often collides itself (on the shared problems, putting the end
-// before 0.5, 0.25 and 0.75 took 1 to 16% off the motion checks of the same runs; dropping 0.25 then
-// was no better within the noise, and worse for segments whose ends are both free).
+// The parameters, in the order a fresh context checks them: the end first, then coarse to fine. RRTConnect
+// checks the state it extends to only on its goal tree, so on its start tree the end often collides itself
+// (on the shared problems, putting the end before 0.5, 0.25 and 0.75 took 1 to 16% off the motion checks of
+// the same runs; dropping 0.25 then was no better within the noise, and worse for segments whose ends are
+// both free).
 constexpr double kAt[kProbes] = {1.0, 0.5, 0.25, 0.75};
 // The probe runs while it finds a collision on at least this share of the segments it looks at: below it,
 // the state checks cost free segments more than they save colliding ones (measured on the shared
