@@ -10,7 +10,9 @@
 #include "narrowphase_shapes.h"
 #endif
 
+#include <clearway/kinematics/kinematic_lanes.h>
 #include <clearway/ompl/collision_checking.h>
+#include <hwy/targets.h>
 
 #ifdef CLEARWAY_HAVE_FCL
 #include <fcl/narrowphase/detail/gjk_solver_indep.h>
@@ -223,6 +225,67 @@ void statesCase(const SuiteCase& c, const SuiteConfig& config, std::vector<Suite
   FclScene fcl(*mesh);
   row("fcl", "obbrss", bestNs(count, [&](std::size_t i) { verdict[i] = !fcl.isFree(&states[i * n]); }));
 #endif
+}
+
+// ---- verdicts: every path to a state's verdict, state by state, against FCL -------------------------------
+
+// The same states through each way Clearway decides one: one per call with the clearance grid (built
+// first), one per call through the trees alone (an environment that never has a grid), and 64 to a call
+// (Scene::areFree) with the lanes forced to every SIMD target this CPU runs. Each row is judged against
+// FCL's verdicts (without FCL: the trees'); and since a faster path may never change a verdict, a state
+// where any row differs from the first fails the case, naming it.
+void verdictsCase(const SuiteCase& c, const SuiteConfig& config, std::vector<SuiteRow>& rows) {
+  const SceneDescription d = parseSceneFile(c.file);
+  const auto scene = robots().scene(d);
+  scene->environment().prepareClearanceGrid();
+  const Scene trees(d, scene->geometryPtr(),
+                    std::make_shared<const Environment>(scene->environment().withoutClearanceGrid()), scene->options());
+  Rng rng(caseSeed(config, c));
+  const int n = scene->dimension();
+  const std::size_t count = config.count;
+  std::vector<double> states(count * n);
+  for (std::size_t i = 0; i < count; ++i) randomState(*scene, rng, &states[i * n]);
+
+  std::vector<std::pair<std::string, std::vector<char>>> found;  // (mode, colliding per state)
+  std::vector<double> ns;
+  const auto measure = [&](std::string mode, auto&& verdict_of) {
+    std::vector<char> colliding(count);
+    ns.push_back(timedNs(count, [&](std::size_t i) { verdict_of(i, colliding); }));
+    found.emplace_back(std::move(mode), std::move(colliding));
+  };
+  SceneContext ctx = scene->makeContext(), trees_ctx = trees.makeContext();
+  measure("one-by-one", [&](std::size_t i, std::vector<char>& v) { v[i] = !scene->isFree(&states[i * n], ctx); });
+  measure("trees", [&](std::size_t i, std::vector<char>& v) { v[i] = !trees.isFree(&states[i * n], trees_ctx); });
+  constexpr std::size_t kBatch = 64;
+  std::unique_ptr<bool[]> batch_free(new bool[kBatch]);
+  for (const std::int64_t target : KinematicLanes::targets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    measure(std::string("batch-") + hwy::TargetName(target), [&](std::size_t i, std::vector<char>& v) {
+      if (i % kBatch != 0) return;
+      const std::size_t k = std::min(kBatch, count - i);
+      scene->areFree(&states[i * n], static_cast<int>(k), ctx, batch_free.get());
+      for (std::size_t j = 0; j < k; ++j) v[i + j] = !batch_free[j];
+    });
+    hwy::SetSupportedTargetsForTest(0);  // (the CPU's own targets again)
+  }
+  std::vector<char> truth = found[1].second;
+#ifdef CLEARWAY_HAVE_FCL
+  FclScene fcl(*scene);
+  for (std::size_t i = 0; i < count; ++i) truth[i] = !fcl.isFree(&states[i * n]);
+#endif
+  for (std::size_t r = 0; r < found.size(); ++r) {
+    for (std::size_t i = 0; i < count; ++i)
+      if (found[r].second[i] != found[0].second[i])
+        throw std::runtime_error(c.subject + ": state " + std::to_string(i) + " is " +
+                                 (found[r].second[i] ? "colliding" : "free") + " by " + found[r].first + " but " +
+                                 (found[0].second[i] ? "colliding" : "free") + " one by one");
+    SuiteRow row;
+    row.suite = "verdicts", row.subject = c.subject, row.engine = "clearway", row.mode = found[r].first;
+    row.ns_per_item = ns[r];
+    row.work_per_item = 1;
+    judge(row, found[r].second, truth);
+    rows.push_back(row);
+  }
 }
 
 // OMPL's validity checker over Clearway ("clearway") or over FCL ("fcl", only when built with it).
@@ -493,7 +556,7 @@ const char* const kShapeFamilies[] = {"hull16", "box-capsule", "cylinder-cone"};
 }  // namespace
 
 const std::vector<std::string>& suiteNames() {
-  static const std::vector<std::string> names = {"narrowphase", "states", "motions", "plan"};
+  static const std::vector<std::string> names = {"narrowphase", "states", "verdicts", "motions", "plan"};
   return names;
 }
 
@@ -512,10 +575,12 @@ std::vector<SuiteCase> enumerateCases(const SuiteConfig& config) {
     const std::string scenes = config.shared + "/scenes";
     if (!std::filesystem::is_directory(scenes)) throw std::runtime_error(need + ", and " + scenes + " is not a folder");
     for (const std::string& family : sceneFamilies(scenes))
-      for (int k = 1; k <= config.problems; ++k) {
-        const std::string file = problemFile(scenes, family, k);
-        if (!file.empty()) cases.push_back({suite, std::filesystem::path(file).stem().string(), file});
-      }
+      for (int k = 1; k <= config.problems; ++k)
+        for (const bool octomap : {false, true}) {  // (the verdicts suite takes both forms of a problem)
+          if (octomap && suite != "verdicts") continue;
+          const std::string file = problemFile(scenes, family, k, octomap);
+          if (!file.empty()) cases.push_back({suite, std::filesystem::path(file).stem().string(), file});
+        }
   }
   if (!config.subjects.empty())
     cases.erase(std::remove_if(cases.begin(), cases.end(),
@@ -527,7 +592,7 @@ std::vector<SuiteCase> enumerateCases(const SuiteConfig& config) {
                 cases.end());
   for (const std::string& suite : config.suites)
     if (std::find(suiteNames().begin(), suiteNames().end(), suite) == suiteNames().end())
-      throw std::runtime_error("unknown suite '" + suite + "' (known: narrowphase, states, motions, plan)");
+      throw std::runtime_error("unknown suite '" + suite + "' (known: narrowphase, states, verdicts, motions, plan)");
   return cases;
 }
 
@@ -535,7 +600,9 @@ const std::vector<std::string>& missingComparisons() {
   static const std::vector<std::string> missing =
       kFcl ? std::vector<std::string>{}
            : std::vector<std::string>{"narrowphase: the whole suite (Clearway's GJK against FCL's two solvers)",
-                                      "states: fcl obbrss", "motions: fcl sampled (OMPL's sampling over FCL)",
+                                      "states: fcl obbrss",
+                                      "verdicts: FCL as the reference (the trees' verdicts stand in)",
+                                      "motions: fcl sampled (OMPL's sampling over FCL)",
                                       "plan: fcl sampled (RRTConnect over FCL)"};
   return missing;
 }
@@ -549,6 +616,7 @@ void runCase(const SuiteCase& c, const SuiteConfig& config, std::vector<SuiteRow
     throw std::runtime_error("the narrowphase suite needs FCL (libfcl-dev) at build time");
 #endif
   } else if (c.suite == "states") statesCase(c, config, rows);
+  else if (c.suite == "verdicts") verdictsCase(c, config, rows);
   else if (c.suite == "motions") motionsCase(c, config, rows);
   else if (c.suite == "plan") planCase(c, config, rows);
   else throw std::runtime_error("unknown suite '" + c.suite + "'");

@@ -35,7 +35,10 @@ namespace fs = std::filesystem;
 
 const char* const kBenchHelp =
     "SUITE: narrowphase (GJK distance by tolerance, Clearway and FCL's two solvers), states (one state:\n"
-    "exact meshes, convex hulls, FCL OBBRSS; mesh-batch: 64 states per call), motions (certified by contact distance, OMPL's sampling by\n"
+    "exact meshes, convex hulls, FCL OBBRSS; mesh-batch: 64 states per call), verdicts (the same states through\n"
+    "every path to a verdict, both forms of each problem: one per call with and without the clearance grid,\n"
+    "64 per call with the lanes forced to each SIMD target, judged against FCL; a state where they differ fails\n"
+    "the case), motions (certified by contact distance, OMPL's sampling by\n"
     "resolution over Clearway and over FCL, against a dense reference), plan (RRTConnect with each\n"
     "checker: one OMPL benchmark log per problem in DIR/plan, the checkers as planners side by side for\n"
     "Planner Arena), or all. Default: narrowphase states motions.\n"
@@ -234,13 +237,13 @@ std::string fmt(const char* f, double x) {
 std::string table(const std::vector<Summary>& all) {
   std::ostringstream t;
   char line[256];
-  std::snprintf(line, sizeof line, "%-12s %-11s %-10s %9s %7s %12s %9s %6s %6s %6s %11s %11s %8s\n", "suite", "engine",
+  std::snprintf(line, sizeof line, "%-12s %-11s %-12s %9s %7s %12s %9s %6s %6s %6s %11s %11s %8s\n", "suite", "engine",
                 "mode", "tolerance", "items", "ns/item", "work", "refpos", "missed", "extra", "error", "max_error",
                 "FCL/x");
   t << line;
   for (const Summary& s : all) {
     const double peer = s.engine.rfind("fcl", 0) == 0 ? 0.0 : fclPeerNs(s, all);
-    std::snprintf(line, sizeof line, "%-12s %-11s %-10s %9.3g %7.0f %12.1f %9.2f %6.0f %6.0f %6.0f %11.3g %11.3g %8s\n",
+    std::snprintf(line, sizeof line, "%-12s %-11s %-12s %9.3g %7.0f %12.1f %9.2f %6.0f %6.0f %6.0f %11.3g %11.3g %8s\n",
                   s.suite.c_str(), s.engine.c_str(), s.mode.c_str(), s.tolerance, s.items, s.ns(), s.work(), s.positives,
                   s.misses, s.false_alarms, s.error(), s.max_error, peer > 0 && s.ns() > 0 ? fmt("%.2f", peer / s.ns()).c_str() : "-");
     t << line;
@@ -533,7 +536,7 @@ Subcommand addBenchCommand(CLI::App& root) {
   s->config.out = "bench-results";
   CLI::App* app = root.add_subcommand(
       "bench", "accuracy against time per suite, mode and tolerance, FCL side by side: CSV, table, plots; shards");
-  app->add_option("SUITE", s->config.suites, "narrowphase, states, motions, plan or all")
+  app->add_option("SUITE", s->config.suites, "narrowphase, states, verdicts, motions, plan or all")
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   app->add_option("--out", s->config.out, "the output folder")->type_name("DIR")->capture_default_str();
   app->add_option("--shard", s->shard, "run the cases whose index is I modulo N (results.csv only)")

@@ -1,9 +1,11 @@
 // `clearway bench`: shards merge into exactly the unsharded result (every field but the measured time),
 // its CSV and OMPL logs parse back, accuracy moves the right way with the tolerance, and bad input
 // (a shard out of range, a missing or repeated shard, a truncated file, mixed configurations) is a
-// clear error.
+// clear error; the verdicts suite takes every path to a verdict.
 #include "cli/tool_run.h"
 #include "shared_data.h"
+
+#include <clearway/kinematics/kinematic_lanes.h>
 
 #include <gtest/gtest.h>
 
@@ -12,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -247,6 +250,35 @@ TEST(BenchTool, PlanningWritesOneOmplExperimentPerProblem) {
     }
   }
   EXPECT_EQ(plan_rows, 3);
+  fs::remove_all(dir);
+}
+
+// The verdicts suite: both forms of a problem, every path to a state's verdict (with and without the
+// clearance grid, batched on every SIMD target the CPU runs) on the same states, none missing a collision
+// FCL finds, and each judged on every state.
+TEST(BenchTool, VerdictsTakeEveryPathOnBothFormsOfAProblem) {
+  CLEARWAY_REQUIRE_SHARED("scenes");
+  const std::string dir = tempDir("verdicts");
+  const ToolRun r = runTool("bench verdicts --subjects box_panda --count 150" + sharedArg() + " --out '" + dir + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::map<std::string, std::set<std::string>> modes;  // subject -> modes
+  std::ifstream in(dir + "/results.csv");
+  for (std::string line; std::getline(in, line);) {
+    const std::vector<std::string> f = fields(line);
+    if (f.size() != 14 || f[0] != "verdicts") continue;
+    modes[f[2]].insert(f[4]);
+    EXPECT_EQ(f[3], "clearway") << line;
+    EXPECT_EQ(f[6], "150") << line;
+    EXPECT_GT(std::stol(f[9]), 15) << "few colliding states: " << line;
+    EXPECT_LT(std::stol(f[9]), 135) << "few free states: " << line;
+    EXPECT_EQ(f[10], "0") << "a collision missed: " << line;
+  }
+  ASSERT_EQ(modes.size(), 2u) << "box_panda_0001 and its OctoMap form";
+  for (const auto& [subject, m] : modes) {
+    EXPECT_TRUE(m.count("one-by-one") && m.count("trees")) << subject;
+    EXPECT_EQ(m.size(), 2 + clearway::KinematicLanes::targets().size()) << subject << ": one batch row per SIMD target";
+    EXPECT_TRUE(m.count(std::string("batch-") + clearway::KinematicLanes::targetName())) << subject;
+  }
   fs::remove_all(dir);
 }
 

@@ -17,8 +17,8 @@ namespace {
 
 TEST(BenchWithoutFcl, NamesTheComparisonsItCannotMake) {
   const std::vector<std::string>& missing = bench::missingComparisons();
-  ASSERT_EQ(missing.size(), 4u);
-  for (const char* suite : {"narrowphase", "states: fcl", "motions: fcl", "plan: fcl"})
+  ASSERT_EQ(missing.size(), 5u);
+  for (const char* suite : {"narrowphase", "states: fcl", "verdicts: FCL", "motions: fcl", "plan: fcl"})
     EXPECT_TRUE(std::any_of(missing.begin(), missing.end(), [&](const std::string& m) { return m.find(suite) == 0; }))
         << suite;
   bench::SuiteConfig config;
@@ -33,15 +33,15 @@ TEST(BenchWithoutFcl, NamesTheComparisonsItCannotMake) {
   }
 }
 
-TEST(BenchWithoutFcl, StatesAndMotionsMeasureClearwayAlone) {
+TEST(BenchWithoutFcl, StatesVerdictsAndMotionsMeasureClearwayAlone) {
   CLEARWAY_SHARED_OR_SKIP(scenes, "scenes");
   bench::SuiteConfig config;
-  config.suites = {"states", "motions"};
+  config.suites = {"states", "verdicts", "motions"};
   config.shared = test::sharedDir();
   config.subjects = {"box_panda"};
   config.count = 10;
   const std::vector<bench::SuiteCase> cases = bench::enumerateCases(config);
-  ASSERT_EQ(cases.size(), 2u);
+  ASSERT_EQ(cases.size(), 4u);  // (verdicts: both forms of the problem)
   for (const bench::SuiteCase& c : cases) {
     std::vector<bench::SuiteRow> rows;
     bench::runCase(c, config, rows);
