@@ -1,4 +1,5 @@
-// The enclosing layer: at random configurations of our arms and the shared robots, a pair it calls apart
+// The enclosing layer: every point of every link lies in its balls as placed (real robots, and random links
+// at random poses); at random configurations of our arms and the shared robots, a pair it calls apart
 // is farther apart than the padding by the exact meshes, and it clears pairs the bounding balls alone do
 // not (a layer that never fires would pass the first check).
 #include <clearway/body/enclosing.h>
@@ -10,6 +11,7 @@
 #include <hwy/targets.h>
 
 #include "forced_target.h"
+#include "mesh_reference.h"
 
 #include <cmath>
 #include <cstdint>
@@ -161,6 +163,136 @@ TEST(EnclosingBalls, BoundsApartInLanesIsApartsFirstTest) {
     }
     EXPECT_GT(apart, 0) << urdf;
   }
+}
+
+// Points of a link in its own frame: every triangle's corners, and points on each primitive's surface in
+// 26 directions and 40 random ones (round primitives are their cores grown by their radius).
+std::vector<Vec3> linkPoints(const LinkGeometry& g, std::mt19937_64& rng) {
+  std::vector<Vec3> out;
+  for (const Triangle& t : g.triangles()) out.insert(out.end(), std::begin(t.v), std::end(t.v));
+  std::vector<Vec3> dirs;
+  for (int x = -1; x <= 1; ++x)
+    for (int y = -1; y <= 1; ++y)
+      for (int z = -1; z <= 1; ++z)
+        if (x || y || z) dirs.push_back(Vec3(x, y, z).normalized());
+  std::normal_distribution<double> normal;
+  for (int k = 0; k < 40; ++k) dirs.push_back(Vec3(normal(rng), normal(rng), normal(rng)).normalized());
+  for (const LinkGeometry::Primitive& p : g.primitives())
+    for (const Vec3& d : dirs)
+      std::visit([&](const auto& shape) {
+        const Vec3 local = p.pose.R.transpose() * d;
+        out.push_back(p.pose * (shape.support(local) + shape.radius() * local));
+      }, p.shape);
+  return out;
+}
+
+// Every point of link i (world, placed by `pose`) lies in its bounding ball as placed, and in one of its
+// parts' balls when it has them. Returns the number of points checked.
+long expectEnclosed(EnclosingBalls& balls, int i, const LinkGeometry& g, const Pose& pose, const std::vector<Vec3>& points,
+                    const std::string& what) {
+  const int n = balls.ballCount(i);
+  EXPECT_GE(n, 1) << what;
+  if (n < 1) return 0;
+  const EnclosingBalls::Placed bound = balls.placed(i, 0);
+  long checked = 0;
+  for (const Vec3& v : points) {
+    const Vec3 p = pose * v;
+    ++checked;
+    EXPECT_LE((p - bound.center).norm(), bound.radius) << what << ": a point outside the bounding ball";
+    if (n == 1) continue;
+    bool in_part = false;
+    for (int k = 1; k < n && !in_part; ++k) {
+      const EnclosingBalls::Placed part = balls.placed(i, k);
+      in_part = (p - part.center).norm() <= part.radius;
+    }
+    EXPECT_TRUE(in_part) << what << ": a point in none of the parts' balls (" << g.parts().size() << " parts)";
+  }
+  return checked;
+}
+
+// The enclosing layer encloses: at random configurations of our robots and the shared ones, every
+// triangle corner and primitive surface point of every link lies in the link's bounding ball and in one of
+// its parts' balls, as placed.
+TEST(EnclosingBalls, EveryPointOfEveryLinkLiesInItsBalls) {
+  CLEARWAY_REQUIRE_SHARED_ARMS();
+  std::vector<std::string> urdfs = test::allArms();
+  for (const char* ours : {"/robots/flyer/flyer.urdf", "/robots/rover/rover.urdf", "/robots/planar_arm/planar_arm.urdf"})
+    urdfs.push_back(std::string(CLEARWAY_SOURCE_DIR) + ours);
+  std::mt19937_64 rng(23);
+  for (const std::string& urdf : urdfs) {
+    Arm arm(urdf);
+    const RobotModel& model = *arm.model;
+    std::vector<Pose> poses(model.linkCount());
+    std::vector<std::vector<Vec3>> points(model.linkCount());
+    for (int i : arm.geometry.geometricLinks()) points[i] = linkPoints(*arm.geometry.link(i), rng);
+    long checked = 0;
+    for (int s = 0; s < 6; ++s) {
+      const std::vector<double> q = randomState(model, rng);
+      computeLinkPoses(model, q.data(), poses.data());
+      arm.balls.place(poses.data());
+      for (int i : arm.geometry.geometricLinks())
+        checked += expectEnclosed(arm.balls, i, *arm.geometry.link(i), poses[i], points[i], urdf + " link " + model.link(i).name);
+      if (testing::Test::HasFailure()) return;
+    }
+    EXPECT_GT(checked, 0) << urdf;
+  }
+}
+
+// The same as a property of random links: triangle soups, closed meshes and primitives in random frames,
+// joined in one link, at random poses up to a kilometre from the origin (where the placement rounds most).
+TEST(EnclosingBalls, RandomLinksAtRandomPosesLieInTheirBalls) {
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const auto randomPose = [&](double reach) {
+    Pose p;
+    p.R = tree_ref::randomRotation(rng);
+    p.t = Vec3(unit(rng), unit(rng), unit(rng)) * reach;
+    return p;
+  };
+  const std::vector<std::pair<std::string, TriangleMesh>> closed = tree_ref::closedSamples();
+  int with_parts = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    std::vector<Link> links(2);
+    links[0].name = "world";
+    links[1].name = "body";
+    links[1].parent_joint = 0;
+    std::vector<TriangleMesh> meshes;
+    // A triangle soup (points in a random box), sometimes a closed mesh beside it.
+    TriangleMesh soup;
+    const Vec3 size(std::exp(2.0 * unit(rng)), std::exp(2.0 * unit(rng)), std::exp(2.0 * unit(rng)));
+    for (int k = 0; k < 3 * (4 + trial * 7); ++k) soup.vertices.push_back(size.cwiseProduct(Vec3(unit(rng), unit(rng), unit(rng))));
+    for (int k = 0; k + 2 < static_cast<int>(soup.vertices.size()); k += 3) soup.triangles.push_back({k, k + 1, k + 2});
+    meshes.push_back(soup);
+    links[1].collisions.push_back({randomPose(1.0), std::nullopt, 0});
+    if (trial % 2) {
+      meshes.push_back(closed[trial % closed.size()].second);
+      links[1].collisions.push_back({randomPose(2.0), std::nullopt, 1});
+    }
+    const Shape primitives[] = {Box(Vec3(0.3, 0.1, 0.2)), Sphere(0.25), Capsule(0.1, 0.4), Cylinder(0.2, 0.05)};
+    for (int k = 0; k < trial % 4; ++k) links[1].collisions.push_back({randomPose(1.5), primitives[(trial + k) % 4], -1});
+    Joint j;
+    j.name = "float";
+    j.type = JointType::Floating;
+    j.parent_link = 0;
+    j.child_link = 1;
+    auto model = std::make_shared<const RobotModel>("random", links, std::vector<Joint>{j}, meshes);
+    const RobotGeometry geometry(model);
+    EnclosingBalls balls(geometry);
+    const LinkGeometry& g = *geometry.link(1);
+    with_parts += balls.ballCount(1) > 1;
+    const std::vector<Vec3> points = linkPoints(g, rng);
+    std::vector<Pose> poses(2);
+    for (int s = 0; s < 5; ++s) {
+      const Pose at = randomPose(s == 0 ? 0.0 : std::pow(10.0, s - 1));  // 0 to 1000 m
+      const Eigen::Quaterniond r(at.R);
+      const double q[7] = {at.t.x(), at.t.y(), at.t.z(), r.x(), r.y(), r.z(), r.w()};
+      computeLinkPoses(*model, q, poses.data());
+      balls.place(poses.data());
+      expectEnclosed(balls, 1, g, poses[1], points, "trial " + std::to_string(trial) + " pose " + std::to_string(s));
+      if (testing::Test::HasFailure()) return;
+    }
+  }
+  EXPECT_GT(with_parts, 10) << "too few random links had parts' balls to check";
 }
 
 TEST(EnclosingBalls, MadeOnlyForItsRobot) {
