@@ -1160,6 +1160,50 @@ TEST(MotionCertified, BranchingPaddedRobotNeverMissesWhatDenseSamplingFinds) {
   EXPECT_LE(c.first_contact, d.first_contact + 1e-9);
 }
 
+// Our mobile two-armed robot of URDF primitives (robots/dual_arm: 27 joints, all 528 non-adjacent pairs
+// checked) before a table and a shelf: segments between free states, certified against dense sampling
+// (2 mm in the joint vector). A collision sampling finds must be found, no later; self-collisions are among
+// them.
+TEST(MotionCertified, ManyPairRobotNeverMissesWhatDenseSamplingFinds) {
+  const auto scene = Scene::load(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/dual_arm_shelf.yaml");
+  ASSERT_GT(scene->selfCollision().pairs().size(), 500u);
+  const MotionChecker certified(scene);
+  MotionContext ctx = certified.makeContext();
+  const MotionChecker fine(scene, sampled(2e-3));
+  MotionContext fc = fine.makeContext();
+  std::mt19937 rng(43);
+  const int n = scene->dimension();
+  int segments = 0, collide = 0, self = 0, misses = 0;
+  std::vector<double> q0(n), q1(n), dq(n);
+  for (int trial = 0; trial < 20000 && segments < 120; ++trial) {
+    // Half the segments between random states, half short steps (free more often).
+    if (trial % 2) {
+      randomStep(*scene, rng, q0, q1, dq);
+    } else {
+      q0 = randomState(*scene, rng);
+      q1 = randomState(*scene, rng);
+    }
+    if (!scene->isFree(q0) || !scene->isFree(q1)) continue;
+    ++segments;
+    const MotionResult c = certified.check(q0.data(), q1.data(), ctx);
+    const MotionResult d = fine.check(q0.data(), q1.data(), fc);
+    EXPECT_FALSE(c.capped);
+    collide += !c.free;
+    if (d.free) continue;
+    misses += c.free;
+    self += d.report.kind == CollisionReport::Kind::Self;
+    EXPECT_FALSE(c.free) << "trial " << trial << ": certified missed " << scene->describe(d.report);
+    EXPECT_LE(c.first_contact, d.first_contact + 1e-9) << "trial " << trial;
+  }
+  std::printf("dual_arm: %d segments, %d collide (certified), %d first between links, %d missed\n", segments, collide,
+              self, misses);
+  EXPECT_EQ(segments, 120);
+  EXPECT_EQ(misses, 0);
+  EXPECT_GT(collide, 10);
+  EXPECT_LT(collide, segments - 10);
+  EXPECT_GT(self, 0) << "no segment met the robot itself first";
+}
+
 // The slider with a wall (1 mm thick unless given) that starts at x = x0 and moves along +x at 1 m/s (checks: moving).
 std::shared_ptr<const Scene> movingWallScene(const TempDir& dir, double x0, double thickness = 0.001) {
   const std::string urdf = dir.write("slider.urdf", kSliderUrdf);
@@ -1313,7 +1357,7 @@ TEST(MotionBound, PathsGiveThePairBoundExactly) {
         }
     }
   };
-  for (const char* f : {"arm6_wall", "twin_arm_table", "rover_gap", "flyer_post"})
+  for (const char* f : {"arm6_wall", "twin_arm_table", "rover_gap", "flyer_post", "dual_arm_shelf"})
     check(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/" + f + ".yaml");
   EXPECT_GT(compared, 5000);
   CLEARWAY_REQUIRE_SHARED("robots/panda/panda.urdf");

@@ -1,5 +1,5 @@
 // Scene::areFree and Scene::anyCollides against Scene::isFree, verdict by verdict: every shared family in both its primitive and
-// its OctoMap form, our robots' scenes (floating and planar joints among them), batches of every length
+// its OctoMap form, our robots' scenes (floating and planar joints among them, and 528 pairs of primitives), batches of every length
 // around the lane width, invalid states inside a batch, scenes that check nothing or can never be free,
 // a context of another robot, and the lanes forced to every SIMD target this machine offers.
 #include <clearway/kinematics/kinematic_lanes.h>
@@ -136,7 +136,7 @@ TEST(SceneBatch, EverySharedFamilyInBothForms) {
 }
 
 TEST(SceneBatch, OurScenesWithEveryJointType) {
-  for (const char* name : {"arm6_wall.yaml", "flyer_post.yaml", "rover_gap.yaml", "twin_arm_table.yaml"}) {
+  for (const char* name : {"arm6_wall.yaml", "flyer_post.yaml", "rover_gap.yaml", "twin_arm_table.yaml", "dual_arm_shelf.yaml"}) {
     const Scene scene(parseSceneFile(bundledScene(name)));
     const std::vector<double> q = randomStates(scene, 300, 3);
     const int colliding = expectBatchEqualsOneByOne(scene, q, name);

@@ -216,7 +216,8 @@ long expectEnclosed(EnclosingBalls& balls, int i, const LinkGeometry& g, const P
 TEST(EnclosingBalls, EveryPointOfEveryLinkLiesInItsBalls) {
   CLEARWAY_REQUIRE_SHARED_ARMS();
   std::vector<std::string> urdfs = test::allArms();
-  for (const char* ours : {"/robots/flyer/flyer.urdf", "/robots/rover/rover.urdf", "/robots/planar_arm/planar_arm.urdf"})
+  for (const char* ours : {"/robots/flyer/flyer.urdf", "/robots/rover/rover.urdf", "/robots/planar_arm/planar_arm.urdf",
+                           "/robots/dual_arm/dual_arm.urdf"})
     urdfs.push_back(std::string(CLEARWAY_SOURCE_DIR) + ours);
   std::mt19937_64 rng(23);
   for (const std::string& urdf : urdfs) {
