@@ -1107,6 +1107,39 @@ TEST(MotionBound, VelocityFieldHoldsOnTheSharedRobots) {
   expectTwistHoldsOn(scenes, 19);
 }
 
+// Segments between free states of the scene (half between random states, half short random steps), up to
+// `trials` tries or `most` segments, each checked certified and by dense sampling (2 mm in the joint
+// vector): a collision sampling finds must be found, no later. `met` sees each collision sampling finds.
+struct DenseRun {
+  int segments = 0, collide = 0, misses = 0;
+};
+template <class Met>
+DenseRun compareWithDenseSampling(const std::shared_ptr<const Scene>& scene, unsigned seed, int trials, int most, Met&& met) {
+  const MotionChecker certified(scene);
+  MotionContext ctx = certified.makeContext();
+  const MotionChecker fine(scene, sampled(2e-3));
+  MotionContext fc = fine.makeContext();
+  std::mt19937 rng(seed);
+  const int n = scene->dimension();
+  DenseRun run;
+  for (int trial = 0; trial < trials && run.segments < most; ++trial) {
+    std::vector<double> q0 = randomState(*scene, rng), q1 = randomState(*scene, rng), dq(n);
+    if (trial % 2) randomStep(*scene, rng, q0, q1, dq);
+    if (!scene->isFree(q0) || !scene->isFree(q1)) continue;
+    ++run.segments;
+    const MotionResult c = certified.check(q0.data(), q1.data(), ctx);
+    const MotionResult d = fine.check(q0.data(), q1.data(), fc);
+    EXPECT_FALSE(c.capped);
+    run.collide += !c.free;
+    if (d.free) continue;
+    run.misses += c.free;
+    EXPECT_FALSE(c.free) << "trial " << trial << ": certified missed " << scene->describe(d.report);
+    EXPECT_LE(c.first_contact, d.first_contact + 1e-9) << "trial " << trial;
+    met(d);
+  }
+  return run;
+}
+
 TEST(MotionCertified, BranchingPaddedRobotNeverMissesWhatDenseSamplingFinds) {
   // The two arms over a table, by a thin post and under a thin bar, with 1 cm of padding: random steps
   // between free states, checked by the certified loop and by dense sampling (2 mm in the joint vector).
@@ -1118,27 +1151,14 @@ TEST(MotionCertified, BranchingPaddedRobotNeverMissesWhatDenseSamplingFinds) {
   MotionContext ctx = certified.makeContext();
   const MotionChecker fine(scene, sampled(2e-3));
   MotionContext fc = fine.makeContext();
-  std::mt19937 rng(14);
   const int n = scene->dimension();
-  int collide = 0, free = 0, misses = 0, across = 0;
-  for (int trial = 0; trial < 6000; ++trial) {
-    // Half the segments between random states, half short steps (free more often).
-    std::vector<double> q0 = randomState(*scene, rng), q1 = randomState(*scene, rng), dq(n);
-    if (trial % 2) randomStep(*scene, rng, q0, q1, dq);
-    if (!scene->isFree(q0) || !scene->isFree(q1)) continue;
-    const MotionResult c = certified.check(q0.data(), q1.data(), ctx);
-    const MotionResult d = fine.check(q0.data(), q1.data(), fc);
-    EXPECT_FALSE(c.capped);
-    (c.free ? free : collide)++;
-    if (!d.free) {
-      misses += c.free;
-      EXPECT_FALSE(c.free) << "trial " << trial << ": certified missed a collision sampling found";
-      EXPECT_LE(c.first_contact, d.first_contact + 1e-9) << "trial " << trial;
-      if (d.report.kind != CollisionReport::Kind::Self) continue;
-      const std::string a = scene->robot().link(d.report.link).name, b = scene->robot().link(d.report.other_link).name;
-      across += (a.rfind("left_", 0) == 0 && b.rfind("right_", 0) == 0) || (a.rfind("right_", 0) == 0 && b.rfind("left_", 0) == 0);
-    }
-  }
+  int across = 0;
+  const DenseRun run = compareWithDenseSampling(scene, 14, 6000, 1 << 30, [&](const MotionResult& d) {
+    if (d.report.kind != CollisionReport::Kind::Self) return;
+    const std::string a = scene->robot().link(d.report.link).name, b = scene->robot().link(d.report.other_link).name;
+    across += (a.rfind("left_", 0) == 0 && b.rfind("right_", 0) == 0) || (a.rfind("right_", 0) == 0 && b.rfind("left_", 0) == 0);
+  });
+  const int collide = run.collide, free = run.segments - run.collide, misses = run.misses;
   std::printf("twin_arm: %d segments free, %d collide (%d first between the arms), %d missed\n", free, collide, across,
               misses);
   EXPECT_EQ(misses, 0);
@@ -1162,46 +1182,33 @@ TEST(MotionCertified, BranchingPaddedRobotNeverMissesWhatDenseSamplingFinds) {
 
 // Our mobile two-armed robot of URDF primitives (robots/dual_arm: 27 joints, all 528 non-adjacent pairs
 // checked) before a table and a shelf: segments between free states, certified against dense sampling
-// (2 mm in the joint vector). A collision sampling finds must be found, no later; self-collisions are among
-// them.
+// (2 mm in the joint vector). A collision sampling finds must be found, no later; a self-collision too.
 TEST(MotionCertified, ManyPairRobotNeverMissesWhatDenseSamplingFinds) {
   const auto scene = Scene::load(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/dual_arm_shelf.yaml");
   ASSERT_GT(scene->selfCollision().pairs().size(), 500u);
-  const MotionChecker certified(scene);
-  MotionContext ctx = certified.makeContext();
-  const MotionChecker fine(scene, sampled(2e-3));
-  MotionContext fc = fine.makeContext();
-  std::mt19937 rng(43);
-  const int n = scene->dimension();
-  int segments = 0, collide = 0, self = 0, misses = 0;
-  std::vector<double> q0(n), q1(n), dq(n);
-  for (int trial = 0; trial < 20000 && segments < 120; ++trial) {
-    // Half the segments between random states, half short steps (free more often).
-    if (trial % 2) {
-      randomStep(*scene, rng, q0, q1, dq);
-    } else {
-      q0 = randomState(*scene, rng);
-      q1 = randomState(*scene, rng);
-    }
-    if (!scene->isFree(q0) || !scene->isFree(q1)) continue;
-    ++segments;
-    const MotionResult c = certified.check(q0.data(), q1.data(), ctx);
-    const MotionResult d = fine.check(q0.data(), q1.data(), fc);
-    EXPECT_FALSE(c.capped);
-    collide += !c.free;
-    if (d.free) continue;
-    misses += c.free;
-    self += d.report.kind == CollisionReport::Kind::Self;
-    EXPECT_FALSE(c.free) << "trial " << trial << ": certified missed " << scene->describe(d.report);
-    EXPECT_LE(c.first_contact, d.first_contact + 1e-9) << "trial " << trial;
-  }
-  std::printf("dual_arm: %d segments, %d collide (certified), %d first between links, %d missed\n", segments, collide,
-              self, misses);
-  EXPECT_EQ(segments, 120);
-  EXPECT_EQ(misses, 0);
-  EXPECT_GT(collide, 10);
-  EXPECT_LT(collide, segments - 10);
-  EXPECT_GT(self, 0) << "no segment met the robot itself first";
+  const DenseRun run = compareWithDenseSampling(scene, 43, 20000, 200, [](const MotionResult&) {});
+  std::printf("dual_arm: %d segments, %d collide (certified), %d missed\n", run.segments, run.collide, run.misses);
+  EXPECT_EQ(run.segments, 200);
+  EXPECT_EQ(run.misses, 0);
+  EXPECT_GT(run.collide, 10);
+  EXPECT_LT(run.collide, run.segments - 10);
+  // Random segments meet the table, the shelf and the torso first; this one (found by a search) closes
+  // the right hand's fingers on each other on the way: both checks find the fingertips, the certified one
+  // no later.
+  const std::vector<double> q0 = {0.231, 0.899, 1.225, 0.087, 0.680, -2.148, -1.827, 0.389, -0.840, 1.400, -0.959,
+                                  0.154, 0.222, -0.427, -0.314, 0.143, -1.302, 1.686, -0.987, 1.616, -0.788, 0.418,
+                                  1.930, -0.416, 0.267, 0.392, -0.379};
+  const std::vector<double> q1 = {0.094, 0.625, -0.558, -1.668, 0.243, -0.467, -0.082, 1.234, -0.072, -1.066, -0.796,
+                                  0.348, 0.165, 0.438, 0.123, -1.252, -0.531, 2.557, 0.187, -2.350, -0.559, -1.096,
+                                  0.487, -0.478, -0.427, -0.027, 0.011};
+  ASSERT_TRUE(scene->isFree(q0) && scene->isFree(q1));
+  const MotionChecker certified(scene), fine(scene, sampled(2e-3));
+  MotionContext ctx = certified.makeContext(), fc = fine.makeContext();
+  const MotionResult c = certified.check(q0.data(), q1.data(), ctx), d = fine.check(q0.data(), q1.data(), fc);
+  ASSERT_FALSE(d.free);
+  EXPECT_EQ(d.report.kind, CollisionReport::Kind::Self) << scene->describe(d.report);
+  EXPECT_FALSE(c.free);
+  EXPECT_LE(c.first_contact, d.first_contact + 1e-9);
 }
 
 // The slider with a wall (1 mm thick unless given) that starts at x = x0 and moves along +x at 1 m/s (checks: moving).
