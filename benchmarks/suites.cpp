@@ -259,14 +259,17 @@ void verdictsCase(const SuiteCase& c, const SuiteConfig& config, std::vector<Sui
   constexpr std::size_t kBatch = 64;
   std::unique_ptr<bool[]> batch_free(new bool[kBatch]);
   for (const std::int64_t target : KinematicLanes::targets()) {
-    hwy::SetSupportedTargetsForTest(target);
+    // Highway's dispatch forced to one target for the scope, however it ends (the CPU's own targets after).
+    struct Forced {
+      explicit Forced(std::int64_t t) { hwy::SetSupportedTargetsForTest(t); }
+      ~Forced() { hwy::SetSupportedTargetsForTest(0); }
+    } forced(target);
     measure(std::string("batch-") + hwy::TargetName(target), [&](std::size_t i, std::vector<char>& v) {
       if (i % kBatch != 0) return;
       const std::size_t k = std::min(kBatch, count - i);
       scene->areFree(&states[i * n], static_cast<int>(k), ctx, batch_free.get());
       for (std::size_t j = 0; j < k; ++j) v[i + j] = !batch_free[j];
     });
-    hwy::SetSupportedTargetsForTest(0);  // (the CPU's own targets again)
   }
   std::vector<char> truth = found[1].second;
 #ifdef CLEARWAY_HAVE_FCL
