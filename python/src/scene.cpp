@@ -155,9 +155,13 @@ void bindScene(py::module_& m) {
         return out;
       }, "(dof, 2) array of each entry's lower and upper limit (+-inf when unbounded).")
       .def_property_readonly("effects", [](const PyScene& s) { return s.scene->effects(); }, "What the scene checks.")
-      .def_property_readonly("warnings", [](const PyScene& s) { return s.scene->robot().loadWarnings(); },
-                             "What loading the robot found worth telling (clearway check prints them), as "
-                             "'FILE: ELEMENT: REASON'.")
+      .def_property_readonly("warnings", [](const PyScene& s) {
+        std::vector<std::string> all = s.scene->description().warnings;
+        const std::vector<std::string>& robot = s.scene->robot().loadWarnings();
+        all.insert(all.end(), robot.begin(), robot.end());
+        return all;
+      }, "What loading the scene file and the robot found worth telling (clearway check prints them), as "
+         "'FILE: ELEMENT: REASON'.")
       .def_property_readonly("link_names", [](const PyScene& s) {
         std::vector<std::string> names;
         for (const Link& l : s.scene->robot().links()) names.push_back(l.name);

@@ -282,6 +282,16 @@ void mergeThroughAssimp(const std::string& path, const std::string& ext, const M
   merger->addNode(*scene, *scene->mRootNode, root);
 }
 
+// The closed axis-aligned cube of half extent `half` about `centre`, outward triangles.
+TriangleMesh tinyBoxMesh(const Vec3& centre, double half) {
+  TriangleMesh box;
+  for (int i = 0; i < 8; ++i)
+    box.vertices.push_back(centre + half * Vec3(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1));
+  box.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                   {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  return box;
+}
+
 }  // namespace
 
 bool isClosed(const TriangleMesh& mesh) {
@@ -335,21 +345,26 @@ TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<st
   }
   mesh.vertices = std::move(used);
 
-  std::size_t open = 0, non_manifold = 0;
-  countBadEdges(mesh, &open, &non_manifold);
-  if (open > 0 || non_manifold > 0)
-    warn("not closed (" + std::to_string(open) + " edges with one triangle, " + std::to_string(non_manifold) +
-         " with more than two): a piece with an edge of one triangle is a surface, not a solid (a body wholly inside it does not collide)");
-
   Vec3 lo = mesh.vertices[0], hi = mesh.vertices[0];
   for (const Vec3& v : mesh.vertices) {
     lo = lo.cwiseMin(v);
     hi = hi.cwiseMax(v);
   }
   const double extent = (hi - lo).maxCoeff();
-  if (!(extent >= kMinInputLength))
-    throw LoadError(path, "", "the mesh spans " + number(extent) + " m after scale, below the smallest length an "
-                              "input may give (1e-9 m)");
+  if (extent < kMinInputLength) {
+    // Below this the hull arithmetic has no digits left. The box of half kMinInputLength about the centre
+    // holds every vertex (each lies within extent / 2 of it, rounding included): a conservative solid.
+    warn("the mesh spans " + number(extent) + " m after scale, below the smallest size Clearway computes with "
+         "(1e-9 m): checked as a closed box 2e-9 m wide around it");
+    return tinyBoxMesh(0.5 * (lo + hi), kMinInputLength);
+  }
+
+  std::size_t open = 0, non_manifold = 0;
+  countBadEdges(mesh, &open, &non_manifold);
+  if (open > 0 || non_manifold > 0)
+    warn("not closed (" + std::to_string(open) + " edges with one triangle, " + std::to_string(non_manifold) +
+         " with more than two): a piece with an edge of one triangle is a surface, not a solid (a body wholly inside it does not collide)");
+
   if (extent > kMillimetreExtent)
     warn("largest extent is " + number(extent) + " m after scale: probably millimetres (scale=\"0.001 0.001 0.001\"?)");
   return mesh;

@@ -21,6 +21,7 @@
 #include <stdexcept>
 #include <tuple>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace clearway {
 namespace {
@@ -115,6 +116,7 @@ class Loader {
 
 RobotModel Loader::load(const std::string& srdf) {
   outline_ = detail::readUrdfOutline(urdf_);
+  for (const auto& w : outline_.warnings) warn(w.element, w.reason);
   const urdf::ModelInterfaceSharedPtr model = parseWithUrdfdom(outline_.text_for_urdfdom, urdf_, &warnings_);
   buildLinks(*model);
   buildJoints(*model);
@@ -288,7 +290,8 @@ std::vector<DisabledCollision> Loader::readSrdf(const std::string& srdf) {
   // Pairs naming a link the URDF lacks are skipped as MoveIt skips them (SRDFs shipped with robots often
   // name links of another variant); one warning for all of them, not one per pair.
   std::size_t unknown_pairs = 0;
-  std::vector<std::string> unknown_links;
+  std::vector<std::string> unknown_links;  // in order of first mention, for the warning
+  std::unordered_set<std::string> unknown_seen;  // the same, to look up: SRDFs can name tens of thousands
   for (const XMLElement* e = robot->FirstChildElement(); e != nullptr; e = e->NextSiblingElement()) {
     const std::string tag = e->Name();
     const std::string element = "<" + tag + "> (line " + std::to_string(e->GetLineNum()) + ")";
@@ -306,8 +309,7 @@ std::vector<DisabledCollision> Loader::readSrdf(const std::string& srdf) {
       const auto it = link_index_.find(value);
       if (it == link_index_.end()) {
         known = false;
-        if (std::find(unknown_links.begin(), unknown_links.end(), value) == unknown_links.end())
-          unknown_links.emplace_back(value);
+        if (unknown_seen.insert(value).second) unknown_links.emplace_back(value);
         continue;
       }
       link[k] = it->second;

@@ -9,8 +9,10 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <iomanip>
 #include <sstream>
 #include <unordered_map>
 
@@ -59,11 +61,15 @@ class Reader {
     numbers(e, name, 1, &x);
     return x;
   }
-  // Lengths in metres within the input limits: |x| ≤ kMaxInputLength, and x ≥ kMinInputLength when
-  // `positive` (else x = 0 or |x| ≥ kMinInputLength).
-  void checkLengths(const XMLElement* e, const char* name, const double* x, int n, bool positive) const;
+  // Lengths in metres no longer than the input limit: |x| ≤ kMaxInputLength. A shorter one of any size,
+  // down to 1e-300 (CAD exporters' residues), is a length like any other.
+  void checkLengths(const XMLElement* e, const char* name, const double* x, int n) const;
+  // Sizes in (0, kMinInputLength) are grown to kMinInputLength, with a warning, and written back to the
+  // attribute that urdfdom reads: below it the hull arithmetic has no digits left, and the grown solid
+  // holds the one given, so no contact is lost.
+  void growTinySizes(const XMLElement* e, const char* name, double* x, int n);
   void checkOrigin(const XMLElement* owner, Pose* pose = nullptr) const;
-  UrdfOutline::Collision readCollision(const XMLElement* c) const;
+  UrdfOutline::Collision readCollision(const XMLElement* c);
   void readLink(const XMLElement* e);
   void readJoint(const XMLElement* e);
   void orderTree();
@@ -83,9 +89,14 @@ bool Reader::numbers(const XMLElement* e, const char* name, int n, double* out) 
     while (p < end && std::isspace(static_cast<unsigned char>(*p))) ++p;
     if (p < end && *p == '+') ++p;
     double x = 0.0;
-    const auto [next, ec] = std::from_chars(p, end, x);
-    if (ec == std::errc::result_out_of_range)
-      fail(e, std::string(name) + "=\"" + text + "\" has a value out of the range of double");
+    auto [next, ec] = std::from_chars(p, end, x);
+    if (ec == std::errc::result_out_of_range) {
+      // Below the smallest double (1e-330) is a residue that rounds to 0 or a subnormal, as strtod and
+      // urdfdom read it; beyond the largest is no number at all.
+      x = std::strtod(std::string(p, next).c_str(), nullptr);
+      if (!(std::abs(x) < 1.0)) fail(e, std::string(name) + "=\"" + text + "\" has a value out of the range of double");
+      ec = std::errc();
+    }
     if (ec != std::errc() || next == p || (next < end && !std::isspace(static_cast<unsigned char>(*next))))
       fail(e, std::string(name) + "=\"" + text + "\": expected " + std::to_string(n) + " number" + (n > 1 ? "s" : ""));
     if (!std::isfinite(x)) fail(e, std::string(name) + "=\"" + text + "\" has a non-finite value (NaN or infinity)");
@@ -97,24 +108,43 @@ bool Reader::numbers(const XMLElement* e, const char* name, int n, double* out) 
   return true;
 }
 
-void Reader::checkLengths(const XMLElement* e, const char* name, const double* x, int n, bool positive) const {
+void Reader::checkLengths(const XMLElement* e, const char* name, const double* x, int n) const {
   for (int i = 0; i < n; ++i) {
-    const double a = std::abs(x[i]);
+    if (std::abs(x[i]) <= kMaxInputLength) continue;
     std::ostringstream value;
-    value << x[i];
-    const std::string quoted = std::string(name) + "=\"" + attribute(e, name) + "\"";
-    if (a > kMaxInputLength)
-      fail(e, quoted + ": " + value.str() + " m is beyond the largest length an input may give (1e6 m)");
-    if ((positive || a > 0.0) && a < kMinInputLength)
-      fail(e, quoted + ": " + value.str() + " m is below the smallest length an input may give (1e-9 m)");
+    value << std::setprecision(17) << x[i];
+    fail(e, std::string(name) + "=\"" + attribute(e, name) + "\": " + value.str() +
+                " m is beyond the largest length an input may give (1e6 m)");
   }
+}
+
+void Reader::growTinySizes(const XMLElement* e, const char* name, double* x, int n) {
+  bool grown = false;
+  for (int i = 0; i < n; ++i) {
+    if (x[i] > 0.0 && x[i] < kMinInputLength) {
+      x[i] = kMinInputLength;
+      grown = true;
+    }
+  }
+  if (!grown) return;
+  std::string text;
+  for (int i = 0; i < n; ++i) {
+    char buffer[32];
+    const auto end = std::to_chars(buffer, buffer + sizeof buffer, x[i]).ptr;  // reads back as x[i]
+    text += (i ? " " : "") + std::string(buffer, end);
+  }
+  out_.warnings.push_back({describe(e), std::string(name) + "=\"" + attribute(e, name) +
+                                            "\" is below the smallest size Clearway computes with (1e-9 m): "
+                                            "checked as " + name + "=\"" + text + "\""});
+  // The document is this reader's own copy, and urdfdom reads the size from it.
+  const_cast<XMLElement*>(e)->SetAttribute(name, text.c_str());
 }
 
 void Reader::checkOrigin(const XMLElement* owner, Pose* pose) const {
   const XMLElement* o = owner->FirstChildElement("origin");
   if (o == nullptr) return;
   double xyz[3] = {0, 0, 0}, rpy[3] = {0, 0, 0};
-  if (numbers(o, "xyz", 3, xyz)) checkLengths(o, "xyz", xyz, 3, false);
+  if (numbers(o, "xyz", 3, xyz)) checkLengths(o, "xyz", xyz, 3);
   numbers(o, "rpy", 3, rpy);
   if (pose) {
     pose->t = Vec3(xyz[0], xyz[1], xyz[2]);
@@ -122,7 +152,7 @@ void Reader::checkOrigin(const XMLElement* owner, Pose* pose) const {
   }
 }
 
-UrdfOutline::Collision Reader::readCollision(const XMLElement* c) const {
+UrdfOutline::Collision Reader::readCollision(const XMLElement* c) {
   UrdfOutline::Collision out;
   out.element = describe(c);
   checkOrigin(c, &out.origin);
@@ -135,13 +165,18 @@ UrdfOutline::Collision Reader::readCollision(const XMLElement* c) const {
   if (shape == "box") {
     if (!numbers(g, "size", 3, v)) fail(g, "box without size");
     if (v[0] < 0 || v[1] < 0 || v[2] < 0) fail(g, "box size must not be negative");
-    checkLengths(g, "size", v, 3, false);
+    checkLengths(g, "size", v, 3);
+    growTinySizes(g, "size", v, 3);
   } else if (shape == "sphere" || shape == "cylinder" || shape == "capsule") {
     if (!numbers(g, "radius", 1, &v[0]) || !(v[0] > 0)) fail(g, shape + " needs a radius > 0");
-    checkLengths(g, "radius", &v[0], 1, true);
+    checkLengths(g, "radius", &v[0], 1);
+    growTinySizes(g, "radius", &v[0], 1);
     if (shape != "sphere" && (!numbers(g, "length", 1, &v[1]) || v[1] < 0))
       fail(g, shape + " needs a length >= 0");
-    if (shape != "sphere") checkLengths(g, "length", &v[1], 1, false);
+    if (shape != "sphere") {
+      checkLengths(g, "length", &v[1], 1);
+      growTinySizes(g, "length", &v[1], 1);
+    }
     if (shape == "capsule") {
       out.capsule = true;
       out.radius = v[0];
@@ -168,9 +203,8 @@ void Reader::readLink(const XMLElement* e) {
     const std::string tag = c->Name();
     if (tag == "collision") {
       link.collisions.push_back(readCollision(c));
-    } else if (tag == "visual" || tag == "inertial") {
-      checkOrigin(c);
-      if (tag == "visual") ++link.visuals;
+    } else if (tag == "visual") {
+      ++link.visuals;  // never read otherwise, as in urdfdom and MoveIt: nothing in it can refuse the robot
     }
   }
   out_.links.push_back(std::move(link));

@@ -34,12 +34,17 @@ struct UrdfOutline {
   std::vector<int> link_order;   // links depth first from the root, children in joint document order
   std::vector<int> joint_order;  // joint_order[k - 1] is the parent joint of links[link_order[k]]
   std::string text_for_urdfdom;  // the document without capsule collisions, <visual> and <inertial>
+  struct Warning {
+    std::string element, reason;
+  };
+  std::vector<Warning> warnings;  // sizes grown to the smallest one computed with
 };
 
 /// Reads and checks the URDF at path; throws LoadError naming the file, element and line for malformed
-/// XML, a missing or unknown joint type, an unknown link name, a non-finite or malformed number in an
-/// origin, axis, limit, mimic or geometry, an unsupported geometry, inverted limits, a loop in the
-/// kinematic tree or several root links.
+/// XML, a missing or unknown joint type, an unknown link name, a non-finite or malformed number in a
+/// joint or collision origin, axis, limit, mimic or geometry, a length beyond kMaxInputLength, an
+/// unsupported geometry, inverted limits, a loop in the kinematic tree or several root links. <visual>
+/// and <inertial> are not read. Sizes below kMinInputLength are grown to it, with a warning.
 UrdfOutline readUrdfOutline(const std::string& path);
 
 /// The URDF rotation from roll, pitch, yaw: Rz(yaw)·Ry(pitch)·Rx(roll).

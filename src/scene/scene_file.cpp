@@ -62,20 +62,39 @@ class Parser {
       if (!allowed.count(k)) fail(key.empty() ? k : key + "." + k, "unknown key" + where(n[k]));
   }
 
-  // A length in metres within the input limits: |x| ≤ kMaxInputLength, and, unless zero is allowed,
-  // |x| ≥ kMinInputLength (a radius of 1e-310 has no hull, a position of 1e308 no box centre).
-  double length(const YAML::Node& n, const std::string& key, bool zero_allowed) const {
+  // A length in metres within the input limit |x| ≤ kMaxInputLength (a position of 1e308 has no box
+  // centre); any shorter one, down to CAD exporters' 1e-16 residues, is a length like any other.
+  double length(const YAML::Node& n, const std::string& key) const {
     const double v = number(n, key);
     if (std::abs(v) > kMaxInputLength)
       fail(key, "'" + n.Scalar() + "' m is beyond the largest length an input may give (1e6 m)" + where(n));
-    if (std::abs(v) < kMinInputLength && !(zero_allowed && v == 0.0))
-      fail(key, "'" + n.Scalar() + "' m is below the smallest length an input may give (1e-9 m)" + where(n));
     return v;
   }
-  Vec3 lengths(const YAML::Node& n, const std::string& key, bool zero_allowed) const {
+  // A size in metres: a length ≥ 0 (> 0 unless zero is allowed). One in (0, kMinInputLength), below
+  // which the hull arithmetic has no digits left (a radius of 1e-310), is grown to kMinInputLength with
+  // a warning: the grown solid holds the one given, so no contact is lost.
+  double size(const YAML::Node& n, const std::string& key, bool zero_allowed) const {
+    const double v = length(n, key);
+    if (v < 0.0 || (v == 0.0 && !zero_allowed))
+      fail(key, "'" + n.Scalar() + "' m: a size must be " + (zero_allowed ? ">= 0" : "> 0") + where(n));
+    if (v > 0.0 && v < kMinInputLength) {
+      warnings_.push_back(LoadError::format(file_, "key '" + key + "'",
+                                            "'" + n.Scalar() + "' m is below the smallest size Clearway computes "
+                                            "with (1e-9 m): checked as 1e-9 m" + where(n)));
+      return kMinInputLength;
+    }
+    return v;
+  }
+  Vec3 sizes(const YAML::Node& n, const std::string& key, bool zero_allowed) const {
     if (!n.IsSequence() || n.size() != 3) vec3(n, key);  // the error for a wrong type or length
     Vec3 v;
-    for (int i = 0; i < 3; ++i) v[i] = length(n[i], key + "[" + std::to_string(i) + "]", zero_allowed);
+    for (int i = 0; i < 3; ++i) v[i] = size(n[i], key + "[" + std::to_string(i) + "]", zero_allowed);
+    return v;
+  }
+  Vec3 lengths(const YAML::Node& n, const std::string& key) const {
+    if (!n.IsSequence() || n.size() != 3) vec3(n, key);  // the error for a wrong type or length
+    Vec3 v;
+    for (int i = 0; i < 3; ++i) v[i] = length(n[i], key + "[" + std::to_string(i) + "]");
     return v;
   }
 
@@ -123,7 +142,7 @@ class Parser {
   Pose pose(const YAML::Node& n, const std::string& key) const {
     requireMap(n, key, {"position", "orientation"});
     Vec3 t = Vec3::Zero();
-    if (n["position"]) t = lengths(n["position"], key + ".position", true);
+    if (n["position"]) t = lengths(n["position"], key + ".position");
     if (!n["orientation"]) return Pose::translation(t);
     const std::vector<double> q = numbers(n["orientation"], key + ".orientation", 4);
     const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
@@ -148,13 +167,13 @@ class Parser {
         ++kinds;
         requireMap(b, key + ".box", {"size"});
         if (!b["size"]) fail(key + ".box.size", "missing");
-        o.shape = Box(0.5 * lengths(b["size"], key + ".box.size", true));
+        o.shape = Box(0.5 * sizes(b["size"], key + ".box.size", true));
       }
       if (const YAML::Node s = n["sphere"]) {
         ++kinds;
         requireMap(s, key + ".sphere", {"radius"});
         if (!s["radius"]) fail(key + ".sphere.radius", "missing");
-        o.shape = Sphere(length(s["radius"], key + ".sphere.radius", false));
+        o.shape = Sphere(size(s["radius"], key + ".sphere.radius", false));
       }
       for (const char* kind : {"cylinder", "capsule"}) {
         const YAML::Node c = n[kind];
@@ -164,7 +183,7 @@ class Parser {
         requireMap(c, k, {"radius", "length"});
         if (!c["radius"]) fail(k + ".radius", "missing");
         if (!c["length"]) fail(k + ".length", "missing");
-        const double r = length(c["radius"], k + ".radius", false), h = 0.5 * length(c["length"], k + ".length", true);
+        const double r = size(c["radius"], k + ".radius", false), h = 0.5 * size(c["length"], k + ".length", true);
         if (std::string(kind) == "cylinder") o.shape = Cylinder(r, h);
         else o.shape = Capsule(r, h);
       }
@@ -188,7 +207,7 @@ class Parser {
 
   void obstacle(const YAML::Node& n, const std::string& key, SceneDescription& d) const {
     SceneDescription::ObstacleSpec o = body(n, key, {"velocity"});
-    if (n["velocity"]) o.velocity = lengths(n["velocity"], key + ".velocity", true);  // m/s
+    if (n["velocity"]) o.velocity = lengths(n["velocity"], key + ".velocity");  // m/s
     d.obstacles.push_back(std::move(o));
   }
 
@@ -302,6 +321,7 @@ class Parser {
     // floating one 7): the file alone does not say.
     if (root["start"]) d.start = numbers(root["start"], "start");
     if (root["goal"]) d.goal = numbers(root["goal"], "goal");
+    d.warnings = warnings_;
     return d;
   }
 
@@ -309,6 +329,7 @@ class Parser {
   std::string file_;
   fs::path base_;
   const std::string* text_ = nullptr;
+  mutable std::vector<std::string> warnings_;  // sizes grown; the readers are const as they only read
 };
 
 }  // namespace

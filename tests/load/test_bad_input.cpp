@@ -268,14 +268,17 @@ TEST_F(BadInput, SuspiciousMeshesAreWarnings) {
 // ---- Inputs that once crashed, hung or exhausted memory (../shared/bad-inputs), written out here.
 
 TEST_F(BadInput, SizesAndCoordinatesBeyondTheInputLimits) {
-  // A sphere of radius 1e-310 crashed the hull builder; a coordinate of 1e308 the tree builder.
+  // A sphere of radius 1e-310 crashed the hull builder; a coordinate of 1e308 the tree builder. Sizes
+  // below 1e-9 m are grown to it (Scene.TinySolidsAreGrownNeverSkipped), lengths beyond 1e6 m refused.
   const std::string tiny = dir.write("tiny.urdf", twoLinks("revolute", "", "<collision><geometry><sphere radius=\"1e-310\"/></geometry></collision>"));
-  EXPECT_LOAD_ERROR(loadRobot(tiny), tiny, "link 'b' <collision> <geometry> <sphere> (line 3)",
-                    "radius=\"1e-310\": 1e-310 m is below the smallest length an input may give (1e-9 m)");
+  const RobotModel tiny_model = loadRobot(tiny);
+  ASSERT_EQ(tiny_model.loadWarnings().size(), 1u);
+  EXPECT_EQ(tiny_model.loadWarnings()[0], tiny + ": link 'b' <collision> <geometry> <sphere> (line 3): radius=\"1e-310\" is "
+                                           "below the smallest size Clearway computes with (1e-9 m): checked as radius=\"1e-09\"");
   const std::string thin = dir.write("thin.urdf", twoLinks("revolute", "", "<collision><geometry><cylinder radius=\"0.1\" length=\"1e-320\"/></geometry></collision>"));
-  EXPECT_LOAD_ERROR(loadRobot(thin), thin, "<cylinder>", "length=\"1e-320\"");
+  EXPECT_EQ(RobotGeometry(std::make_shared<const RobotModel>(loadRobot(thin))).link(1)->primitives().size(), 1u);
   const std::string flat = dir.write("flat.urdf", twoLinks("revolute", "", "<collision><geometry><box size=\"0.1 0 1e-12\"/></geometry></collision>"));
-  EXPECT_LOAD_ERROR(loadRobot(flat), flat, "<box>", "below the smallest length");
+  EXPECT_EQ(loadRobot(flat).loadWarnings().size(), 1u);
   const std::string far = dir.write("far.urdf", twoLinks("revolute", "", "<collision><origin xyz=\"0 1e308 0\"/><geometry><sphere radius=\"1\"/></geometry></collision>"));
   EXPECT_LOAD_ERROR(loadRobot(far), far, "<origin>", "beyond the largest length an input may give (1e6 m)");
   const std::string slide = dir.write("slide.urdf", R"(<robot name="r"><link name="a"/><link name="b"/>
@@ -302,8 +305,16 @@ TEST_F(BadInput, SizesAndCoordinatesBeyondTheInputLimits) {
   dir.write("tet.stl", test::tetrahedronStl());
   const std::string huge = dir.write("huge.urdf", twoLinks("revolute", "", "<collision><geometry><mesh filename=\"tet.stl\" scale=\"1e270 1 1\"/></geometry></collision>"));
   EXPECT_LOAD_ERROR(loadRobot(huge), huge, "link 'b' <collision>", "1e+270 m from the origin after scale, beyond the largest length");
-  const std::string speck = dir.write("speck.urdf", twoLinks("revolute", "", "<collision><geometry><mesh filename=\"tet.stl\" scale=\"1e-12 1e-12 1e-12\"/></geometry></collision>"));
-  EXPECT_LOAD_ERROR(loadRobot(speck), speck, "link 'b' <collision>", "the mesh spans 1e-12 m after scale, below the smallest length");
+  // A mesh scaled below 1e-9 m becomes the closed box 2e-9 m wide around it, with a warning.
+  const std::string speck = dir.write("speck.urdf", twoLinks("revolute", "", "<collision><origin xyz=\"1e-16 0 0\"/><geometry><mesh filename=\"tet.stl\" scale=\"1e-12 1e-12 1e-12\"/></geometry></collision>"));
+  const RobotModel speck_model = loadRobot(speck);
+  ASSERT_EQ(speck_model.loadWarnings().size(), 1u);
+  EXPECT_NE(speck_model.loadWarnings()[0].find("the mesh spans 1e-12 m after scale, below the smallest size Clearway "
+                                               "computes with (1e-9 m): checked as a closed box 2e-9 m wide around it"),
+            std::string::npos) << speck_model.loadWarnings()[0];
+  const TriangleMesh box = loadMesh(dir.path("tet.stl"), Vec3::Constant(1e-12));
+  EXPECT_EQ(box.triangles.size(), 12u);
+  EXPECT_TRUE(isClosed(box));
 }
 
 TEST_F(BadInput, MeshFormatsAndPlyIndices) {

@@ -11,8 +11,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <random>
+#include <regex>
+#include <sstream>
 #include <set>
 #include <thread>
 
@@ -98,7 +101,8 @@ TEST(SceneFile, BadInputNamesFileAndKey) {
       {replaced("goal: [-1.5, 0]", "goal: [-1.5, zero]"), "key 'goal[1]'", "not a number"},
       {replaced("[self, environment]", "[self, gravity]"), "key 'checks'", "unknown check 'gravity'"},
       {replaced("size: [0.1, 2, 1]", "size: [0.1, 2]"), "key 'environment.obstacles[0].box.size'", "expected 3 numbers"},
-      {replaced("size: [0.1, 2, 1]", "size: [0.1, -2, 1]"), "key 'environment.obstacles[0]'", "half extent"},
+      {replaced("size: [0.1, 2, 1]", "size: [0.1, -2, 1]"), "key 'environment.obstacles[0].box.size[1]'",
+       "'-2' m: a size must be >= 0"},
       {replaced("box: {size: [0.1, 2, 1]}", "cone: {radius: 1}"), "key 'environment.obstacles[0].cone'", "unknown key"},
       {replaced("position: [1.2, 0, 0]}", "position: [1.2, 0, 0], orientation: [0, 0, 0, 2]}"),
        "key 'environment.obstacles[0].pose.orientation'", "norm"},
@@ -125,10 +129,10 @@ TEST(SceneFile, BadInputNamesFileAndKey) {
       // radius the hull builder.
       {replaced("position: [1.2, 0, 0]", "position: [1e308, 0, 0]"), "key 'environment.obstacles[0].pose.position[0]'",
        "'1e308' m is beyond the largest length an input may give"},
-      {replaced("size: [0.1, 2, 1]", "size: [0.1, 2, 1e-310]"), "key 'environment.obstacles[0].box.size[2]'",
-       "below the smallest length"},
-      {replaced("box: {size: [0.1, 2, 1]}", "sphere: {radius: 1e-310}"), "key 'environment.obstacles[0].sphere.radius'",
-       "below the smallest length"},
+      {replaced("size: [0.1, 2, 1]", "size: [0.1, 2, -1e-310]"), "key 'environment.obstacles[0].box.size[2]'",
+       "'-1e-310' m: a size must be >= 0"},
+      {replaced("box: {size: [0.1, 2, 1]}", "sphere: {radius: 0}"), "key 'environment.obstacles[0].sphere.radius'",
+       "'0' m: a size must be > 0"},
       {replaced("box: {size: [0.1, 2, 1]}", "capsule: {radius: 0.1, length: 2e6}"),
        "key 'environment.obstacles[0].capsule.length'", "beyond the largest length"},
   };
@@ -306,6 +310,119 @@ TEST(Scene, InvalidStatesAreNeverFree) {
   const double bad[2] = {0.5, 2.6};
   EXPECT_FALSE(scene->validState(bad, &why));
   EXPECT_NE(why.find("elbow"), std::string::npos) << why;
+}
+
+std::string readText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// The URDF text with each zero in an origin's xyz and rpy replaced by a residue of the kind CAD exporters
+// write (the stock Fetch's bellows_link has -1.67219873481315E-16), relative mesh paths made absolute (from
+// `folder`), and an <inertial> and a <visual> with such origins added to each link.
+std::string withResidues(const std::string& urdf, const std::string& folder) {
+  static const char* const kResidues[] = {"1e-16", "-1.67219873481315E-16", "1e-300", "-1e-310", "1e-330", "1e-17"};
+  std::size_t k = 0;
+  std::string out;
+  std::string rest = urdf;
+  for (const char* attribute : {"xyz", "rpy"}) {
+    const std::regex origin(std::string(R"((<origin[^>]*?\b)") + attribute + R"(=")([^"]*)("))");
+    out.clear();
+    std::size_t last = 0;
+    for (auto it = std::sregex_iterator(rest.begin(), rest.end(), origin); it != std::sregex_iterator(); ++it) {
+      const std::smatch& m = *it;
+      out += rest.substr(last, m.position(0) - last) + m[1].str();
+      std::istringstream values(m[2].str());
+      std::string v, replaced;
+      while (values >> v)
+        replaced += (replaced.empty() ? "" : " ") + (std::strtod(v.c_str(), nullptr) == 0.0 ? kResidues[k++ % 6] : v);
+      out += replaced + m[3].str();
+      last = m.position(0) + m.length(0);
+    }
+    out += rest.substr(last);
+    rest = out;
+  }
+  out = std::regex_replace(out, std::regex(R"(filename="(?!package:|/))"), "filename=\"" + folder + "/");
+  return std::regex_replace(
+      out, std::regex(R"((<link name="[^"]*">))"),
+      "$1<inertial><origin xyz=\"0.0191 -1.67219873481315E-16 -0.1348\" rpy=\"1e-300 0 -1e-16\"/><mass value=\"1\"/>"
+      "<inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial>"
+      "<visual><origin xyz=\"1e-17 0 -1e-310\"/><geometry><sphere radius=\"1e-310\"/></geometry></visual>");
+}
+
+// The scene's robot with residues in every origin kind loads, with no more warnings, and gives the
+// verdicts of the robot with zeros on `count` states uniform in the limits.
+void expectResiduesChangeNoVerdict(const std::string& scene_file, int count) {
+  TempDir dir;
+  const auto plain = Scene::load(scene_file);
+  SceneDescription d = plain->description();
+  const std::string text = withResidues(readText(d.urdf), std::filesystem::path(d.urdf).parent_path().string());
+  ASSERT_NE(text.find("-1.67219873481315E-16"), std::string::npos);
+  d.urdf = dir.write("residues.urdf", text);
+  const Scene residues(d);
+  EXPECT_EQ(residues.robot().loadWarnings().size(), plain->robot().loadWarnings().size());
+  std::mt19937 rng(7);
+  std::vector<double> q(plain->dimension());
+  int colliding = 0;
+  for (int i = 0; i < count; ++i) {
+    for (int j = 0; j < plain->dimension(); ++j)
+      q[j] = std::uniform_real_distribution<double>(plain->lower(j), plain->upper(j))(rng);
+    const bool free = plain->isFree(q);
+    ASSERT_EQ(residues.isFree(q), free) << "state " << i;
+    colliding += free ? 0 : 1;
+  }
+  EXPECT_GT(colliding, 0);
+  EXPECT_LT(colliding, count);
+}
+
+TEST(Scene, ResiduesInOriginsChangeNoVerdict) {
+  expectResiduesChangeNoVerdict(test::sourceRobot("scenes/dual_arm_shelf.yaml"), 2000);
+}
+
+TEST(Scene, ResiduesInTheSharedPandasOriginsChangeNoVerdict) {
+  CLEARWAY_SHARED_OR_SKIP(scene, "scenes/box_panda/box_panda_0001.yaml");
+  expectResiduesChangeNoVerdict(scene, 2000);
+}
+
+// A body below the smallest size computed with is grown to it, with a warning naming the element:
+// loaded, never skipped (a speck inside an obstacle collides), in a URDF and in a scene file alike.
+TEST(Scene, TinySolidsAreGrownNeverSkipped) {
+  TempDir dir;
+  const std::string urdf = dir.write("speck.urdf", R"(<robot name="speck">
+  <link name="a"/>
+  <link name="b"><collision><origin xyz="0.5 0 0"/><geometry><sphere radius="1e-310"/></geometry></collision>
+    <collision><origin xyz="0.5 0.2 0"/><geometry><box size="1e-12 0 3e-300"/></geometry></collision>
+    <collision><origin xyz="0.5 -0.2 0"/><geometry><capsule radius="1e-320" length="1e-12"/></geometry></collision></link>
+  <joint name="j" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>
+    <limit lower="-3.2" upper="3.2" velocity="1" effort="1"/></joint>
+</robot>)");
+  const auto scene = Scene::load(dir.write("speck.yaml", "format: 1\nname: speck\nrobot:\n  urdf: " + urdf +
+      "\n  group: [j]\nenvironment:\n  obstacles:\n"
+      "    - {name: grain, box: {size: [1e-12, 1e-300, 0]}, pose: {position: [0, 0.5, 0]}}\n"
+      "    - {name: dust, sphere: {radius: 1e-310}, pose: {position: [0, -0.5, 0]}}\n"
+      "    - {name: block, box: {size: [0.1, 0.1, 0.1]}, pose: {position: [-0.5, 0, 0]}}\n"
+      "checks: [environment]\n"));
+  const std::vector<std::string>& robot = scene->robot().loadWarnings();
+  ASSERT_EQ(robot.size(), 4u);
+  EXPECT_NE(robot[0].find("link 'b' <collision> <geometry> <sphere> (line 3): radius=\"1e-310\" is below the "
+                          "smallest size Clearway computes with (1e-9 m): checked as radius=\"1e-09\""),
+            std::string::npos) << robot[0];
+  EXPECT_NE(robot[1].find("checked as size=\"1e-09 0 1e-09\""), std::string::npos) << robot[1];
+  EXPECT_NE(robot[2].find("<capsule> (line 5): radius=\"1e-320\""), std::string::npos) << robot[2];
+  EXPECT_NE(robot[3].find("<capsule> (line 5): length=\"1e-12\""), std::string::npos) << robot[3];
+  const std::vector<std::string>& file = scene->description().warnings;
+  ASSERT_EQ(file.size(), 3u);
+  EXPECT_NE(file[0].find("key 'environment.obstacles[0].box.size[0]': '1e-12' m is below the smallest size"),
+            std::string::npos) << file[0];
+  EXPECT_NE(file[2].find("key 'environment.obstacles[1].sphere.radius'"), std::string::npos) << file[2];
+  // The speck at (0.5, 0) meets the block at q = pi; each grown obstacle meets the speck at its angle.
+  EXPECT_FALSE(scene->isFree({M_PI}));
+  EXPECT_FALSE(scene->isFree({M_PI / 2}));
+  EXPECT_FALSE(scene->isFree({-M_PI / 2}));
+  EXPECT_TRUE(scene->isFree({M_PI / 4}));
+  EXPECT_TRUE(scene->isFree({M_PI / 2 + 0.01}));
 }
 
 // What a scene does not declare, it does not compute: counted, per effect.

@@ -1,13 +1,14 @@
 #pragma once
-// What a robot, mesh, scene or map file may ask for. Inputs beyond these limits are refused at load
-// time with the file, element and reason: past them, sums and squares of coordinates overflow or lose
-// every digit (a box at 1e308 has an infinite centre; a sphere of radius 1e-310 has no hull), and no
-// robot or workcell comes near them.
+// What a robot, mesh, scene or map file may ask for. Lengths beyond kMaxInputLength are refused at load
+// time with the file, element and reason: past it, sums and squares of coordinates overflow (a box at
+// 1e308 has an infinite centre), and no robot or workcell comes near it. A body smaller than
+// kMinInputLength (a sphere of radius 1e-310 has no hull) is grown to it, with a warning: the grown
+// solid holds the one given, so no contact is lost; an octree cell that small is refused.
 namespace clearway {
 
 /// The largest coordinate, length or size (m) an input may give: 1000 km.
 constexpr double kMaxInputLength = 1e6;
-/// The smallest radius, or non-zero length or size (m), an input may give: 1 nm.
+/// The smallest radius or non-zero size (m) computed with: 1 nm; smaller bodies are grown to it.
 constexpr double kMinInputLength = 1e-9;
 
 }  // namespace clearway

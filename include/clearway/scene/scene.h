@@ -99,6 +99,7 @@ struct SceneDescription {
   std::vector<AttachedSpec> attached;
   Effects effects;
   std::vector<double> start, goal;  ///< empty when the file gives none
+  std::vector<std::string> warnings;  ///< "file: key 'k': reason" for each input taken other than as given
 };
 
 /// Parses a scene file (docs/scene-format.md). Throws LoadError(file, "key 'a.b'", reason) for an
