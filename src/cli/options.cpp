@@ -158,16 +158,19 @@ CLI::Validator wholeNumber(long long lo, long long hi) {
       "in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
 }
 
-CLI::Validator numberAbove(double above) {
+CLI::Validator numberAbove(double above, double at_most) {
   std::ostringstream bound;
   bound << "> " << above;
+  if (at_most < HUGE_VAL) bound << ", <= " << at_most;
   return CLI::Validator(
-      [above](std::string& v) {
+      [above, at_most](std::string& v) {
         char* end = nullptr;
         const double x = std::strtod(v.c_str(), &end);
-        if (!v.empty() && *end == '\0' && std::isfinite(x) && x > above) return std::string();
+        if (!v.empty() && *end == '\0' && std::isfinite(x) && x > above && x <= at_most) return std::string();
         std::ostringstream why;
-        why << "needs a number > " << above << ", got '" << v << "'";
+        why << "needs a number > " << above;
+        if (at_most < HUGE_VAL) why << " and <= " << at_most;
+        why << ", got '" << v << "'";
         return why.str();
       },
       bound.str());

@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -38,8 +39,8 @@ void addLoadOptions(CLI::App& app, LoadOptions& load);
 /// Accepts a whole number in [lo, hi] and names the range when it rejects one.
 CLI::Validator wholeNumber(long long lo, long long hi);
 
-/// Accepts a finite number above `above`.
-CLI::Validator numberAbove(double above);
+/// Accepts a finite number above `above` and at most `at_most`, and names the range when it rejects one.
+CLI::Validator numberAbove(double above, double at_most = HUGE_VAL);
 
 /// Notes that a deprecated spelling was used; printDeprecations() warns once per spelling.
 void noteDeprecated(const std::string& old_spelling, const std::string& new_spelling);

@@ -127,14 +127,19 @@ int runPlan(const PlanSettings& s) {
     std::cerr << "clearway plan: " << scene_path << ": the scene needs a start and a goal\n";
     return kExitUsage;
   }
-  for (const auto* q : {&d.start, &d.goal}) {
+  std::vector<double> start_q = d.start, goal_q = d.goal;
+  for (auto* q : {&start_q, &goal_q}) {
     std::string why;
     CollisionReport r;
-    const char* which = q == &d.start ? "start" : "goal";
+    const char* which = q == &start_q ? "start" : "goal";
     if (!scene->validState(q->data(), &why)) {
       std::cerr << "clearway plan: " << scene_path << ": " << which << ": " << why << "\n";
       return kExitUsage;
     }
+    // validState allows a hair past a limit (a file's rounding); OMPL's bounds are exact and would call
+    // such a start invalid, so it is moved onto the limit and checked there.
+    for (int k = 0; k < scene->dimension() && k < static_cast<int>(q->size()); ++k)
+      (*q)[k] = std::min(std::max((*q)[k], scene->lower(k)), scene->upper(k));
     if (!scene->isFree(*q, &r)) {
       std::cerr << "clearway plan: " << scene_path << ": " << which << " is in collision: " << scene->describe(r) << "\n";
       return kExitNo;
@@ -154,8 +159,8 @@ int runPlan(const PlanSettings& s) {
   }
   const StateMap map(*scene);
   ob::ScopedState<> start(space), goal(space);
-  map.fromVector(d.start.data(), start.get());
-  map.fromVector(d.goal.data(), goal.get());
+  map.fromVector(start_q.data(), start.get());
+  map.fromVector(goal_q.data(), goal.get());
   setup.setStartAndGoalStates(start, goal);
   // A start or goal that no motion can leave would spend the whole time limit: say what holds it instead.
   // (The certified check lowers its contact distance near a free end, so this takes a touch within the
@@ -183,7 +188,7 @@ int runPlan(const PlanSettings& s) {
   const double solve_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (status != ob::PlannerStatus::EXACT_SOLUTION) {
     std::cerr << "clearway plan: " << planner_name << " found no path in " << time_limit << " s (" << status.asString()
-              << "; planned for " << std::fixed << std::setprecision(3) << solve_s << " s)\n";
+              << "; planned for " << std::fixed << std::setprecision(6) << solve_s << " s)\n";
     return kExitNo;
   }
   const auto states_before = checking.validity->counters().states.load();
@@ -208,13 +213,14 @@ int runPlan(const PlanSettings& s) {
   std::printf("path %zu\n", path.getStateCount());
   for (std::size_t i = 0; i < path.getStateCount(); ++i) {
     map.toVector(path.getState(i), q.data());
-    for (int k = 0; k < scene->dimension(); ++k) std::printf(k ? " %.9g" : "%.9g", q[k]);
+    // 17 significant digits read back as the same double: a path fed to check or motion is this path.
+    for (int k = 0; k < scene->dimension(); ++k) std::printf(k ? " %.17g" : "%.17g", q[k]);
     std::printf("\n");
   }
   const auto& vc = checking.validity->counters();
   const auto& mc = checking.motion->counters();
   std::fprintf(stderr,
-               "planner %s: solved in %.3f s, simplified in %.3f s; %zu states, length %.4f; certified: %s\n"
+               "planner %s: solved in %.6f s, simplified in %.6f s; %zu states, length %.4f; certified: %s\n"
                "checker: %llu states (%.2f us each), %llu motions (%.2f us each); during simplification: %llu "
                "states, %llu motions\n",
                planner_name.c_str(), solve_s, simplify_s, path.getStateCount(), path.length(),
@@ -237,7 +243,8 @@ Subcommand addPlanCommand(CLI::App& root) {
                   "the scene file (YAML; - for stdin, its paths then from the working directory); default: the "
                   "bundled " CLEARWAY_DEFAULT_SCENE);
   app->add_option("--planner", s->planner, "an OMPL geometric planner (listed below)")->capture_default_str();
-  app->add_option("--time", s->time, "seconds the planner may take")->check(numberAbove(0))->type_name("SECONDS")
+  // OMPL's deadline is a clock time point: beyond about 7.5e9 s it overflows and the planner stops at once.
+  app->add_option("--time", s->time, "seconds the planner may take (at most 1e6)")->check(numberAbove(0, 1e6))->type_name("SECONDS")
       ->capture_default_str();
   CLI::Option* seed = addSeedOption(*app, s->seed, "OMPL's random seed (default: from the clock)");
   app->add_flag_callback("--no-simplify", [s] { s->simplify = false; }, "print the path as the planner found it");

@@ -38,6 +38,7 @@ std::shared_ptr<const Scene> openScene(const std::string& path, const SceneOptio
 std::shared_ptr<const Scene> loadScene(const char* command, const std::string& path, const SceneOptions& options) {
   try {
     auto scene = openScene(path, options);
+    for (const std::string& w : scene->description().warnings) printWarning(w);
     for (const std::string& w : scene->robot().loadWarnings()) printWarning(w);
     return scene;
   } catch (const std::exception& e) {

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <charconv>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -18,6 +19,12 @@
 namespace clearway {
 
 namespace {
+
+// The shortest text that reads back as x: a value 1e-10 past a limit must not print as the limit.
+std::string exactText(double x) {
+  char buffer[32];
+  return std::string(buffer, std::to_chars(buffer, buffer + sizeof buffer, x).ptr);
+}
 
 // The self checker before init() makes the scene's own: without tables, which would be built twice.
 SelfCollisionOptions placeholderOptions() {
@@ -384,8 +391,8 @@ bool Scene::validState(const double* state, std::string* why) const {
     }
     if (x < lo - kJointLimitTolerance || x > hi + kJointLimitTolerance) {
       if (why)
-        *why = "state[" + std::to_string(i) + "] (" + var.name + ") = " + std::to_string(x) + " is outside [" +
-               std::to_string(lo) + ", " + std::to_string(hi) + "]";
+        *why = "state[" + std::to_string(i) + "] (" + var.name + ") = " + exactText(x) + " is outside [" +
+               exactText(lo) + ", " + exactText(hi) + "] by more than " + exactText(kJointLimitTolerance);
       return false;
     }
   }

@@ -9,7 +9,9 @@
 
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
+#include <vector>
 
 using clearway_test::runTool;
 using clearway_test::ToolRun;
@@ -163,7 +165,9 @@ TEST(Arguments, BadArgumentsNameTheOptionAndTheReason) {
     std::string args, says;
   };
   const Case cases[] = {
-      {"plan " + kScene + " --time=abc", "--time: needs a number > 0, got 'abc'"},
+      {"plan " + kScene + " --time=abc", "--time: needs a number > 0 and <= 1e+06, got 'abc'"},
+      // OMPL's deadline overflowed: no path at once.
+      {"plan " + kScene + " --time 7.5e9", "--time: needs a number > 0 and <= 1e+06, got '7.5e9'"},
       {"plan " + kScene + " --time -1", "--time"},
       {"plan " + kScene + " --planner Teleport", "--planner: unknown planner 'Teleport'"},
       {"check " + kScene + " --geometry fuzzy", "--geometry: unknown geometry 'fuzzy' (mesh or hull)"},
@@ -195,4 +199,36 @@ TEST(Arguments, OneSeedParserForEveryCommand) {
   // The largest seed is a seed.
   const ToolRun r = runTool("audit " + kUrdf + " --samples 10 --quiet --seed 18446744073709551615");
   EXPECT_EQ(r.exit_code, 0) << r.err;
+}
+
+// A path reads back as printed (17 digits): a goal on a joint limit is printed on it, not past it, and a
+// start a hair past a limit (within the tolerance check accepts) is planned from the limit, not refused.
+TEST(Arguments, PlannedPathsReadBackExactly) {
+  const std::string scene = writeTemp("limit.yaml",
+      "format: 1\nname: limit\nrobot:\n  urdf: " + std::string(CLEARWAY_SOURCE_DIR) +
+      "/robots/planar_arm/planar_arm.urdf\n  group: [shoulder, elbow]\nenvironment:\n  obstacles: []\n"
+      "checks: [self, environment]\nstart: [0.3, -2.5000000000001]\ngoal: [1.9, 2.5]\n");
+  const ToolRun r = runTool("plan '" + scene + "' --seed 1 --time 5 --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::istringstream out(r.out);
+  std::string word;
+  std::size_t n = 0;
+  out >> word >> n;
+  ASSERT_EQ(word, "path");
+  ASSERT_GE(n, 2u);
+  std::vector<std::string> lines;
+  std::string line;
+  std::getline(out, line);
+  while (std::getline(out, line)) lines.push_back(line);
+  ASSERT_EQ(lines.size(), n);
+  EXPECT_EQ(lines.front(), "0.29999999999999999 -2.5");
+  EXPECT_EQ(lines.back(), "1.8999999999999999 2.5");
+  const std::string path = writeTemp("limit_path.txt", lines.front() + "\n" + lines.back() + "\n" + lines[1] + "\n");
+  const ToolRun check = runTool("check '" + scene + "' --states '" + path + "'");
+  EXPECT_EQ(check.exit_code, 0) << check.err;
+  EXPECT_EQ(count(check.out, "free"), 3) << check.out;
+  // check names a state past the tolerance with every digit.
+  const std::string past = writeTemp("past.txt", "0 2.5000001\n");
+  const ToolRun refused = runTool("check '" + scene + "' --states '" + past + "'");
+  EXPECT_MENTIONS(refused.out + refused.err, "= 2.5000001 is outside [-2.5, 2.5]");
 }
