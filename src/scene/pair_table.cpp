@@ -134,6 +134,7 @@ struct TableCache {
   };
   std::mutex mutex;
   std::map<Key, Entry> tables;
+  std::size_t sweep_at = 64;  // the size at which entries of robots gone are next dropped
 };
 
 TableCache& tableCache() {
@@ -170,10 +171,15 @@ std::shared_ptr<const PairTable> PairTable::shared(const std::shared_ptr<const R
   std::shared_ptr<const PairTable> t =
       build(geometry->model(), a, *geometry->link(a), b, *geometry->link(b), padding, mode, tol, held, options);
   const std::lock_guard<std::mutex> lock(cache.mutex);
-  // Entries of robots gone are dropped as new ones come.
-  for (auto it = cache.tables.begin(); it != cache.tables.end();)
-    it = it->second.geometry.expired() ? cache.tables.erase(it) : std::next(it);
+  // Entries of robots gone are dropped as new ones come, in a sweep each time the cache has doubled since
+  // the last: a sweep per table made loading a robot quartic in its links (a table per pair, each sweep
+  // over every table); this way each entry is swept a constant number of times on average.
   cache.tables[std::move(key)] = {geometry, t};
+  if (cache.tables.size() >= cache.sweep_at) {
+    for (auto it = cache.tables.begin(); it != cache.tables.end();)
+      it = it->second.geometry.expired() ? cache.tables.erase(it) : std::next(it);
+    cache.sweep_at = std::max<std::size_t>(64, 2 * cache.tables.size());
+  }
   return t;
 }
 
