@@ -24,27 +24,13 @@ using tinyxml2::XMLElement;
 constexpr int kMaxNodeDepth = 256;
 constexpr std::int64_t kMaxExpandedNodes = 100000;
 
+// A reader's message (tinyxml2's) is cut to this many characters: it may quote the file.
+constexpr std::size_t kReaderChars = 80;
+
 // The separators of a list (<p>, <float_array>, ...): XML's whitespace, as assimp skips it. A form feed
 // or vertical tab (std::isspace) stops assimp's reader without consuming it: it then reads the same
 // place forever, one 0 index after another, until memory runs out.
 bool listSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
-
-// A token for a message: control and non-ASCII bytes as \xNN.
-std::string printable(const std::string& token) {
-  std::string out;
-  for (const char c : token.substr(0, 40)) {
-    const auto u = static_cast<unsigned char>(c);
-    if (u >= 0x20 && u < 0x7f) {
-      out += c;
-    } else {
-      static const char kHex[] = "0123456789ABCDEF";
-      out += "\\x";
-      out += kHex[u >> 4];
-      out += kHex[u & 15];
-    }
-  }
-  return out;
-}
 
 std::string where(const XMLElement* e) { return "<" + std::string(e->Name()) + "> (line " + std::to_string(e->GetLineNum()) + ")"; }
 
@@ -81,7 +67,7 @@ class Checker {
       const char* source = a->Attribute("source");
       if (source == nullptr || source[0] != '#') fail(a, "an accessor needs source=\"#ARRAY\"");
       const auto it = ids_.find(source + 1);
-      if (it == ids_.end()) fail(a, std::string("source '") + source + "' names no element");
+      if (it == ids_.end()) fail(a, "source '" + inputExcerpt(source) + "' names no element");
       const std::uint64_t count = wholeNumber(a, "count"), stride = std::max<std::uint64_t>(1, wholeNumber(a, "stride", 1)),
                           offset = wholeNumber(a, "offset");
       std::uint64_t params = 0;
@@ -92,7 +78,7 @@ class Checker {
       // Each of these is at most the file size (wholeNumber), so the sum cannot overflow 64 bits.
       const std::uint64_t needed = offset + (count - 1) * stride + params;
       if (count > 0 && params > 0 && needed > length)
-        fail(a, "reaches value " + std::to_string(needed) + " of '" + (source + 1) + "', which holds " +
+        fail(a, "reaches value " + std::to_string(needed) + " of '" + inputExcerpt(source + 1) + "', which holds " +
                     std::to_string(length));
     }
   }
@@ -224,14 +210,14 @@ class Checker {
     const char* p = text;
     while (std::isspace(static_cast<unsigned char>(*p))) ++p;
     if (!std::isdigit(static_cast<unsigned char>(*p)))
-      fail(e, std::string(attribute) + "=\"" + text + "\" is not a whole number");
+      fail(e, std::string(attribute) + "=\"" + inputExcerpt(text) + "\" is not a whole number");
     errno = 0;
     char* end = nullptr;
     const unsigned long long v = std::strtoull(p, &end, 10);
     while (std::isspace(static_cast<unsigned char>(*end))) ++end;
-    if (*end != '\0') fail(e, std::string(attribute) + "=\"" + text + "\" is not a whole number");
+    if (*end != '\0') fail(e, std::string(attribute) + "=\"" + inputExcerpt(text) + "\" is not a whole number");
     if (errno == ERANGE || v > file_size_)
-      fail(e, std::string(attribute) + "=\"" + text + "\" exceeds the size of the file (" + std::to_string(file_size_) +
+      fail(e, std::string(attribute) + "=\"" + inputExcerpt(text) + "\" exceeds the size of the file (" + std::to_string(file_size_) +
                   " bytes)");
     return v;
   }
@@ -257,7 +243,7 @@ class Checker {
         ok = end != token.c_str() && *end == '\0';
       }
       if (!ok)
-        fail(e, "'" + printable(token) + "' is not " + (integers ? "an integer" : "a number") +
+        fail(e, "'" + inputExcerpt(token) + "' is not " + (integers ? "an integer" : "a number") +
                     " (assimp would never finish reading this list)");
     }
   }
@@ -290,7 +276,7 @@ void checkCollada(const std::string& path) {
   const std::string text = buffer.str();
   tinyxml2::XMLDocument doc;
   if (doc.Parse(text.c_str(), text.size()) != tinyxml2::XML_SUCCESS)
-    throw LoadError(path, "line " + std::to_string(doc.ErrorLineNum()), std::string("malformed XML: ") + doc.ErrorStr());
+    throw LoadError(path, "line " + std::to_string(doc.ErrorLineNum()), "malformed XML: " + inputExcerpt(doc.ErrorStr(), kReaderChars));
   const XMLElement* root = doc.RootElement();
   if (root == nullptr || std::strcmp(root->Name(), "COLLADA") != 0)
     throw LoadError(path, "", "not a COLLADA file: the root element is not <COLLADA>");

@@ -34,6 +34,8 @@ namespace {
 constexpr double kMillimetreExtent = 10.0;
 // A triangle whose height is below this fraction of its longest edge has zero area up to rounding.
 constexpr double kDegenerateRelative = 1e-12;
+// Assimp's messages are cut to this many characters: they may quote the rest of the file.
+constexpr std::size_t kReaderChars = 80;
 
 // An affine map x ↦ A·x + b in double precision (node transforms may scale, e.g. a COLLADA <unit>).
 struct Affine {
@@ -165,7 +167,7 @@ class Merger {
   std::int32_t vertex(const std::vector<Vec3>& positions, std::uint32_t i, const std::string& name, const Affine& world) {
     if (index_[i] >= 0) return index_[i];
     Vec3 p = (world * positions[i]).cwiseProduct(scale_);
-    const std::string which = "vertex " + std::to_string(i) + (name.empty() ? "" : " of mesh '" + name + "'");
+    const std::string which = "vertex " + std::to_string(i) + (name.empty() ? "" : " of mesh '" + inputExcerpt(name) + "'");
     if (!p.allFinite()) throw LoadError(path_, "", which + " has a non-finite coordinate");
     if (!(p.cwiseAbs().maxCoeff() <= kMaxInputLength))
       throw LoadError(path_, "", which + " lies " + number(p.cwiseAbs().maxCoeff()) + " m from the origin after scale, beyond "
@@ -220,10 +222,10 @@ void checkFaceIndices(const aiScene& scene, const std::string& path) {
     for (unsigned f = 0; f < m.mNumFaces; ++f) {
       // A face without vertices (a PLY list of length 0) aborts assimp's triangulation.
       if (m.mFaces[f].mNumIndices == 0)
-        throw LoadError(path, "", "face " + std::to_string(f) + " of mesh '" + m.mName.C_Str() + "' has no vertices");
+        throw LoadError(path, "", "face " + std::to_string(f) + " of mesh '" + inputExcerpt(m.mName.C_Str()) + "' has no vertices");
       for (unsigned k = 0; k < m.mFaces[f].mNumIndices; ++k)
         if (m.mFaces[f].mIndices[k] >= m.mNumVertices)
-          throw LoadError(path, "", "face " + std::to_string(f) + " of mesh '" + m.mName.C_Str() + "' uses vertex " +
+          throw LoadError(path, "", "face " + std::to_string(f) + " of mesh '" + inputExcerpt(m.mName.C_Str()) + "' uses vertex " +
                                         std::to_string(m.mFaces[f].mIndices[k]) + ", but the mesh has " +
                                         std::to_string(m.mNumVertices) + " vertices");
     }
@@ -246,11 +248,11 @@ void mergeThroughAssimp(const std::string& path, const std::string& ext, const M
                                   aiComponent_MATERIALS);
   const aiScene* scene = importer.ReadFile(path, 0);
   if (scene == nullptr || scene->mRootNode == nullptr)
-    throw LoadError(path, "", std::string("assimp cannot read it: ") + importer.GetErrorString());
+    throw LoadError(path, "", "assimp cannot read it: " + inputExcerpt(importer.GetErrorString(), kReaderChars));
   checkFaceIndices(*scene, path);
   scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_RemoveComponent);
   if (scene == nullptr || scene->mRootNode == nullptr)
-    throw LoadError(path, "", std::string("assimp cannot read it: ") + importer.GetErrorString());
+    throw LoadError(path, "", "assimp cannot read it: " + inputExcerpt(importer.GetErrorString(), kReaderChars));
 
   Affine root = toAffine(scene->mRootNode->mTransformation);
   if (ext == "dae") {

@@ -109,7 +109,7 @@ bool parse(const std::string& token, Type type, double* value) {
 }
 
 // A name as messages show it (and as it is kept: no name PLY or Clearway looks for is longer).
-std::string shown(const std::string& name) { return name.substr(0, 40); }
+std::string shown(const std::string& name) { return inputExcerpt(name); }
 
 const char* kTypeList = "char, uchar, short, ushort, int, uint, float, double, int8, uint8, int16, uint16, int32, "
                         "uint32, float32 or float64";

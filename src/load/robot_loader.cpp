@@ -28,15 +28,18 @@ namespace {
 
 using detail::UrdfOutline;
 
+// A reader's message (urdfdom's, tinyxml2's) is cut to this many characters: it may quote the file.
+constexpr std::size_t kReaderChars = 80;
+
 // urdfdom speaks through console_bridge, whose output handler is global: collect its messages while
 // one parse runs (one parse at a time), then put back whatever handler the application had.
 class UrdfdomMessages : public console_bridge::OutputHandler {
  public:
   void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
     if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) {
-      errors.push_back(text);
+      errors.push_back(inputExcerpt(text, kReaderChars));
     } else if (level == console_bridge::CONSOLE_BRIDGE_LOG_WARN) {
-      warnings.push_back(text);
+      warnings.push_back(inputExcerpt(text, kReaderChars));
     }
   }
   std::vector<std::string> errors, warnings;
@@ -57,7 +60,7 @@ urdf::ModelInterfaceSharedPtr parseWithUrdfdom(const std::string& text, const st
     try {
       model = urdf::parseURDF(text);
     } catch (const std::exception& e) {
-      messages.errors.push_back(e.what());
+      messages.errors.push_back(inputExcerpt(e.what(), kReaderChars));
     }
   }
   for (const std::string& w : messages.warnings) warnings->push_back(LoadError::format(path, "", "urdfdom: " + w));
@@ -277,13 +280,13 @@ std::vector<DisabledCollision> Loader::readSrdf(const std::string& srdf) {
   if (status == tinyxml2::XML_ERROR_FILE_NOT_FOUND || status == tinyxml2::XML_ERROR_FILE_COULD_NOT_BE_OPENED)
     throw LoadError(srdf, "", "cannot open the file");
   if (status != tinyxml2::XML_SUCCESS)
-    throw LoadError(srdf, "line " + std::to_string(doc.ErrorLineNum()), std::string("malformed XML: ") + doc.ErrorStr());
+    throw LoadError(srdf, "line " + std::to_string(doc.ErrorLineNum()), "malformed XML: " + inputExcerpt(doc.ErrorStr(), kReaderChars));
   const XMLElement* robot = doc.RootElement();
   if (robot == nullptr || std::string(robot->Name()) != "robot") throw LoadError(srdf, "", "the root element is not <robot>");
   const char* name = robot->Attribute("name");
   if (name != nullptr && outline_.robot_name != name)
-    warnings_.push_back(LoadError::format(srdf, "<robot>", "names robot '" + std::string(name) + "', the URDF '" +
-                                                               outline_.robot_name + "'"));
+    warnings_.push_back(LoadError::format(srdf, "<robot>", "names robot '" + inputExcerpt(name) + "', the URDF '" +
+                                                               inputExcerpt(outline_.robot_name) + "'"));
 
   std::vector<DisabledCollision> pairs;
   std::set<std::pair<int, int>> seen;

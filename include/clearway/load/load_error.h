@@ -1,6 +1,7 @@
 #pragma once
 // The one exception of the load stage: bad input (a robot or mesh file) named by file, element and reason,
 // so that a user can go straight to the offending line.
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -34,5 +35,26 @@ class LoadError : public std::runtime_error {
  private:
   std::string file_, element_, reason_;
 };
+
+/// Input text as a message may quote it: control bytes as \xNN (a NUL would end the message), cut after
+/// max_chars characters with "..." (a reader quoting the rest of a file must not make a megabyte message).
+inline std::string inputExcerpt(const std::string& text, std::size_t max_chars = 40) {
+  static const char kHex[] = "0123456789ABCDEF";
+  std::string out;
+  std::size_t shown = 0;  // characters shown, an escape or a UTF-8 sequence counting as one
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const auto u = static_cast<unsigned char>(text[i]);
+    const bool continuation = (u & 0xC0) == 0x80;
+    if (!continuation && shown++ == max_chars) return out + "...";
+    if (u < 0x20 || u == 0x7F) {
+      out += "\\x";
+      out += kHex[u >> 4];
+      out += kHex[u & 15];
+    } else {
+      out += text[i];
+    }
+  }
+  return out;
+}
 
 }  // namespace clearway
