@@ -7,6 +7,7 @@
 #include <clearway/load/mesh_loader.h>
 
 #include "load/collada_check.h"
+#include "load/mesh_uri.h"
 #include "load/ply_reader.h"
 
 #include <assimp/Importer.hpp>
@@ -36,6 +37,8 @@ constexpr double kMillimetreExtent = 10.0;
 constexpr double kDegenerateRelative = 1e-12;
 // Assimp's messages are cut to this many characters: they may quote the rest of the file.
 constexpr std::size_t kReaderChars = 80;
+// A path is shown whole up to PATH_MAX, past which no path names a file.
+constexpr std::size_t kPathChars = 4096;
 
 // An affine map x ↦ A·x + b in double precision (node transforms may scale, e.g. a COLLADA <unit>).
 struct Affine {
@@ -307,6 +310,9 @@ TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<st
   auto warn = [&](const std::string& reason) {
     if (warnings) warnings->push_back(LoadError::format(path, "", reason));
   };
+  // "x.dae\0.stl" would be read as STL by its name, and the system would open x.dae.
+  if (const std::string why = detail::controlCharacterReason(path); !why.empty())
+    throw LoadError(inputExcerpt(path, kPathChars), "", why);
   if (!scale.allFinite() || (scale.array() == 0.0).any())
     throw LoadError(path, "", "scale must be finite and non-zero in every component");
 

@@ -1,5 +1,7 @@
 #include "load/mesh_uri.h"
 
+#include <clearway/load/load_error.h>
+
 #include <cctype>
 #include <cstdlib>
 #include <filesystem>
@@ -70,9 +72,21 @@ fs::path findPackage(const fs::path& root, const std::string& name, bool search_
 
 }  // namespace
 
+std::string controlCharacterReason(const std::string& path, const std::string& note) {
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    const auto u = static_cast<unsigned char>(path[i]);
+    if (u < 0x20 || u == 0x7F)
+      return "the path" + note + " holds the control character " + inputExcerpt(path.substr(i, 1)) + " (byte " +
+             std::to_string(i + 1) + "): refused, as the file opened could be another than the one named";
+  }
+  return "";
+}
+
 ResolvedUri resolveMeshUri(const std::string& uri, const std::string& urdf_dir,
                            const std::vector<std::string>& package_paths) {
   ResolvedUri r;
+  r.error = controlCharacterReason(uri);
+  if (!r.error.empty()) return r;
   if (startsWith(uri, "package://")) {
     const std::string rest = uri.substr(std::string("package://").size());
     const std::size_t slash = rest.find('/');
@@ -105,6 +119,8 @@ ResolvedUri resolveMeshUri(const std::string& uri, const std::string& urdf_dir,
       return r;
     }
     r.path = percentDecode(rest);
+    r.error = controlCharacterReason(r.path, " (its %XX escapes decoded)");
+    if (!r.error.empty()) r.path.clear();
     return r;
   }
   const std::size_t scheme = uri.find("://");

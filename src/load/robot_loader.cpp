@@ -196,7 +196,9 @@ CollisionElement Loader::convert(const urdf::Collision& c, const std::string& el
 
 int Loader::mesh(const urdf::Mesh& m, const std::string& element) {
   const detail::ResolvedUri uri = detail::resolveMeshUri(m.filename, urdf_dir_, options_.package_paths);
-  if (!uri.error.empty()) throw LoadError(urdf_, element, "mesh '" + m.filename + "': " + uri.error);
+  // As written, but without control characters (a NUL would end the message) and at most PATH_MAX long.
+  const std::string filename = inputExcerpt(m.filename, 4096);
+  if (!uri.error.empty()) throw LoadError(urdf_, element, "mesh '" + filename + "': " + uri.error);
   const auto key = std::make_tuple(uri.path, m.scale.x, m.scale.y, m.scale.z);
   const auto found = mesh_index_.find(key);
   if (found != mesh_index_.end()) return found->second;
@@ -205,11 +207,11 @@ int Loader::mesh(const urdf::Mesh& m, const std::string& element) {
   try {
     meshes_.push_back(loadMesh(uri.path, Vec3(m.scale.x, m.scale.y, m.scale.z), &mesh_warnings, options_.mesh));
   } catch (const LoadError& error) {
-    throw LoadError(urdf_, element, "mesh '" + m.filename + "': " + error.what());
+    throw LoadError(urdf_, element, "mesh '" + filename + "': " + error.what());
   }
   // Once per file: a mesh used at two scales (or through two URIs) says the same things twice.
   for (const std::string& w : mesh_warnings)
-    if (mesh_warnings_.insert(w).second) warn(element, "mesh '" + m.filename + "': " + w);
+    if (mesh_warnings_.insert(w).second) warn(element, "mesh '" + filename + "': " + w);
   const int index = static_cast<int>(meshes_.size()) - 1;
   mesh_index_.emplace(key, index);
   return index;

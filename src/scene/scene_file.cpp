@@ -4,6 +4,8 @@
 #include <clearway/load/input_limits.h>
 #include <clearway/scene/scene.h>
 
+#include "load/mesh_uri.h"
+
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -131,7 +133,10 @@ class Parser {
   }
   // A path relative to the scene file's folder.
   std::string path(const YAML::Node& n, const std::string& key, bool folder = false) const {
-    const fs::path p = text(n, key);
+    const std::string written = text(n, key);
+    if (const std::string why = detail::controlCharacterReason(written); !why.empty())
+      fail(key, "'" + inputExcerpt(written, 4096) + "': " + why + where(n));
+    const fs::path p = written;
     const fs::path full = p.is_absolute() ? p : base_ / p;
     std::error_code ec;
     if (folder && !fs::is_directory(full, ec)) fail(key, "folder not found: " + full.string() + where(n));

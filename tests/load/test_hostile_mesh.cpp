@@ -1,7 +1,11 @@
-// Mesh input made to crash, hang or exhaust Clearway, each generated here as it was found: a reader's
-// error quoting the rest of a file. Each ends in a LoadError naming the file, element and reason, or in
-// a mesh; and runs under a timeout, so that a hang fails the test instead of blocking the suite.
+// Mesh input made to crash, hang or exhaust Clearway, each generated here as it was found: a NUL or
+// other control byte in a mesh path (the format picked from the text after it, the file opened before
+// it), and a reader's error quoting the rest of a file. Each ends in a LoadError naming the file,
+// element and reason, or in a mesh; and runs under a timeout, so that a hang fails the test instead of
+// blocking the suite.
 #include <clearway/load/mesh_loader.h>
+#include <clearway/load/robot_loader.h>
+#include <clearway/scene/scene.h>
 
 #include "load/robot_files.h"
 #include "timeout_guard.h"
@@ -19,6 +23,33 @@ namespace {
 // Long enough for any of these inputs under the sanitizers, short next to a hang.
 constexpr double kSeconds = 60.0;
 
+const char* const kTetP = "0 2 1 0 1 3 0 3 2 1 2 3";
+
+// A COLLADA tetrahedron: `array` is the positions' array element, p the triangles' indices (count of
+// them given), `nodes` the library nodes and `scene` the visual scene's nodes.
+std::string collada(const std::string& scene, const std::string& nodes = "",
+                    const std::string& array = "<float_array id=\"pa\" count=\"12\">0 0 0 1 0 0 0 1 0 0 0 1</float_array>",
+                    const std::string& p = kTetP, int triangles = 4) {
+  return "<?xml version=\"1.0\"?>\n<COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">\n"
+         "<asset><unit meter=\"1\"/><up_axis>Z_UP</up_axis></asset>\n"
+         "<library_geometries><geometry id=\"g\"><mesh>\n"
+         "<source id=\"p\">" + array + "\n"
+         "<technique_common><accessor source=\"#pa\" count=\"4\" stride=\"3\"><param name=\"X\" type=\"float\"/>"
+         "<param name=\"Y\" type=\"float\"/><param name=\"Z\" type=\"float\"/></accessor></technique_common></source>\n"
+         "<vertices id=\"v\"><input semantic=\"POSITION\" source=\"#p\"/></vertices>\n"
+         "<triangles count=\"" + std::to_string(triangles) + "\"><input semantic=\"VERTEX\" source=\"#v\" offset=\"0\"/>\n<p>" +
+         p + "</p></triangles>\n</mesh></geometry></library_geometries>\n"
+         "<library_nodes>" + nodes + "</library_nodes>\n"
+         "<library_visual_scenes><visual_scene id=\"s\">" + scene + "</visual_scene></library_visual_scenes>\n"
+         "<scene><instance_visual_scene url=\"#s\"/></scene>\n</COLLADA>\n";
+}
+
+const char* const kTetScene = "<node id=\"n\"><instance_geometry url=\"#g\"/></node>";
+
+// Runs statement within kSeconds; it must throw a LoadError as EXPECT_LOAD_ERROR says.
+#define EXPECT_LOAD_ERROR_IN_TIME(statement, file, element, reason) \
+  EXPECT_LOAD_ERROR(endsWithin(kSeconds, [&] { statement; }), file, element, reason)
+
 // what() of the LoadError that statement throws ("" when none).
 template <class F>
 std::string errorOf(F&& statement) {
@@ -31,6 +62,43 @@ std::string errorOf(F&& statement) {
 }
 
 }  // namespace
+
+// A NUL in a mesh path: Clearway took the format from ".stl" after the NUL, the OS opened x.dae before
+// it, and assimp read that by its own extension, past the COLLADA pre-check.
+TEST(HostileMesh, ControlBytesInAMeshPathAreRefused) {
+  TempDir dir;
+  const std::string dae = dir.write("x.dae", collada(kTetScene));
+  ASSERT_EQ(loadMesh(dae, Vec3::Ones()).triangles.size(), 4u);  // the file itself loads
+  for (const char byte : {'\0', '\x01', '\n', '\x7f'}) {
+    const std::string path = dae + std::string(1, byte) + ".stl";
+    const std::string shown = dae + (byte == '\0' ? "\\x00" : byte == '\x01' ? "\\x01" : byte == '\n' ? "\\x0A" : "\\x7F") + ".stl";
+    SCOPED_TRACE(shown);
+    EXPECT_LOAD_ERROR_IN_TIME(loadMesh(path, Vec3::Ones()), shown, "", "control character");
+  }
+
+  // The same through a URDF's file:// URI (percent-decoded) and a package path.
+  const std::string urdf = dir.write(
+      "nul.urdf", "<robot name=\"r\"><link name=\"a\"><collision><geometry><mesh filename=\"file://" + dae +
+                      "%00.stl\"/></geometry></collision></link></robot>\n");
+  EXPECT_LOAD_ERROR_IN_TIME(loadRobot(urdf), urdf, "link 'a' <collision> (line 1)", "control character");
+  const std::string message = errorOf([&] { loadRobot(urdf); });
+  EXPECT_EQ(message.find('\0'), std::string::npos);
+  EXPECT_NE(message.find("x.dae%00.stl"), std::string::npos) << message;  // the URI as written
+  const std::string tab = dir.write(
+      "tab.urdf", "<robot name=\"r\"><link name=\"a\"><collision><geometry><mesh filename=\"x.dae&#9;.stl\"/>"
+                  "</geometry></collision></link></robot>\n");
+  EXPECT_LOAD_ERROR_IN_TIME(loadRobot(tab), tab, "link 'a' <collision>", "control character");
+  EXPECT_EQ(errorOf([&] { loadRobot(tab); }).find('\t'), std::string::npos);
+
+  // And through a scene file: "\0" in a double-quoted YAML string is a NUL.
+  const std::string scene = dir.write(
+      "nul.yaml", "format: 1\nname: nul\nrobot:\n  urdf: " + test::sourceRobot("planar_arm/planar_arm.urdf") +
+                      "\n  group: [shoulder, elbow]\nenvironment:\n  obstacles:\n"
+                      "    - {name: part, mesh: {file: \"x.dae\\0.stl\"}}\nchecks: [environment]\n");
+  EXPECT_LOAD_ERROR_IN_TIME(parseSceneFile(scene), scene, "key 'environment.obstacles[0].mesh.file'",
+                            "control character");
+  EXPECT_EQ(errorOf([&] { parseSceneFile(scene); }).find('\0'), std::string::npos);
+}
 
 // An ASCII STL with one bad number among 20,000 facets: assimp's message quoted the rest of the file.
 TEST(HostileMesh, ErrorsQuoteAFewDozenCharactersOfTheInput) {
