@@ -525,7 +525,7 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
   double exit = 1.0;
   if (end_invalid) {
     for (int i = 0; i < sc.dimension(); ++i) {
-      const double lo = sc.lower(i) - kJointLimitTolerance, hi = sc.upper(i) + kJointLimitTolerance;
+      const double lo = sc.validLower(i), hi = sc.validUpper(i);
       if (q1[i] > hi && ctx.dq[i] > 0.0) exit = std::min(exit, (hi - q0[i]) / ctx.dq[i]);
       if (q1[i] < lo && ctx.dq[i] < 0.0) exit = std::min(exit, (lo - q0[i]) / ctx.dq[i]);
     }

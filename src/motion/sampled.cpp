@@ -23,8 +23,9 @@ MotionResult MotionChecker::sampled(const double* q0, double t0, const double* q
   for (int i = 0; i < sc.dimension(); ++i) len2 += (q1[i] - q0[i]) * (q1[i] - q0[i]);
   // As OMPL's DiscreteMotionValidator: the ends, then the states in between at the resolution.
   const double len = std::sqrt(len2);
-  // The step count in double first: len / resolution may exceed every int.
-  const double steps = std::isfinite(len) ? std::max(1.0, std::ceil(len / options_.resolution)) : 1.0;
+  // The step count in double first: len / resolution may exceed every int, and a length that overflows
+  // (a change beyond 1e154) is beyond every cap, never one step from end to end.
+  const double steps = std::isfinite(len) ? std::max(1.0, std::ceil(len / options_.resolution)) : HUGE_VAL;
   if (!(steps <= options_.max_samples)) {
     r.capped = true;
     r.report.kind = CollisionReport::Kind::Invalid;

@@ -2,6 +2,7 @@
 
 #include <clearway/body/proximity.h>
 #include <clearway/kinematics/forward_kinematics.h>
+#include <clearway/load/input_limits.h>
 
 #include <tinyxml2.h>
 
@@ -28,7 +29,7 @@ std::vector<double> defaultConfiguration(const RobotModel& model) {
     const bool qw = var.name.size() > 3 && var.name.compare(var.name.size() - 3, 3, "/qw") == 0;
     double x = qw ? 1.0 : 0.0;
     if (x < var.lower || x > var.upper)
-      x = std::isfinite(var.lower) && std::isfinite(var.upper) ? 0.5 * (var.lower + var.upper)
+      x = std::isfinite(var.lower) && std::isfinite(var.upper) ? 0.5 * var.lower + 0.5 * var.upper
                                                                : (std::isfinite(var.lower) ? var.lower : var.upper);
     q[v] = x;
   }
@@ -162,7 +163,9 @@ std::vector<PairAudit> auditSelfCollision(std::shared_ptr<const RobotGeometry> g
       const JointVariable& var = model.variables()[v];
       double x = q_default[v];
       if (sampled(model, var)) {
-        const double lo = std::isfinite(var.lower) ? var.lower : -M_PI, hi = std::isfinite(var.upper) ? var.upper : M_PI;
+        // Within ±kMaxJointValue, as a state may be: limits of ±1e308 have an infinite width to sample in.
+        const double lo = std::isfinite(var.lower) ? std::max(var.lower, -kMaxJointValue) : -M_PI;
+        const double hi = std::max(lo, std::isfinite(var.upper) ? std::min(var.upper, kMaxJointValue) : M_PI);
         x = std::uniform_real_distribution<double>(lo, hi)(rng);
       }
       configurations[static_cast<std::size_t>(s) * model.variableCount() + v] = x;

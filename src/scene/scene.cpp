@@ -6,6 +6,7 @@
 
 #include <clearway/kinematics/attached_body.h>
 #include <clearway/kinematics/forward_kinematics.h>
+#include <clearway/load/input_limits.h>
 #include <clearway/load/mesh_loader.h>
 #include <clearway/load/robot_loader.h>
 
@@ -169,11 +170,17 @@ void Scene::init() {
     const std::size_t i = static_cast<std::size_t>(it - group_variables_.begin());
     const auto [lo, hi] = range;
     if (!std::isfinite(lo) || !std::isfinite(hi) || !(lo < hi)) fail(key, "expected finite [lower, upper] with lower < upper");
+    if (std::abs(lo) > kMaxJointValue || std::abs(hi) > kMaxJointValue)
+      fail(key, "[" + exactText(lo) + ", " + exactText(hi) + "] reaches beyond ±1e6, the largest joint value a state may hold");
     if (lo < lower_[i] || hi > upper_[i])
-      fail(key, "[" + std::to_string(lo) + ", " + std::to_string(hi) + "] is outside the joint's limits [" +
-                    std::to_string(lower_[i]) + ", " + std::to_string(upper_[i]) + "]");
+      fail(key, "[" + exactText(lo) + ", " + exactText(hi) + "] is outside the joint's limits [" +
+                    exactText(lower_[i]) + ", " + exactText(upper_[i]) + "]");
     lower_[i] = lo;
     upper_[i] = hi;
+  }
+  for (std::size_t i = 0; i < lower_.size(); ++i) {
+    valid_lower_.push_back(std::max(lower_[i] - kJointLimitTolerance, -kMaxJointValue));
+    valid_upper_.push_back(std::min(upper_[i] + kJointLimitTolerance, kMaxJointValue));
   }
   std::vector<std::pair<int, double>> mimic_holds;
   for (const auto& [name, value] : description_.hold) {
@@ -389,6 +396,12 @@ bool Scene::validState(const double* state, std::string* why) const {
       if (why) *why = "state[" + std::to_string(i) + "] (" + var.name + ") is not finite";
       return false;
     }
+    if (std::abs(x) > kMaxJointValue) {
+      if (why)
+        *why = "state[" + std::to_string(i) + "] (" + var.name + ") = " + exactText(x) +
+               " is beyond ±1e6, the largest joint value a state may hold";
+      return false;
+    }
     if (x < lo - kJointLimitTolerance || x > hi + kJointLimitTolerance) {
       if (why)
         *why = "state[" + std::to_string(i) + "] (" + var.name + ") = " + exactText(x) + " is outside [" +
@@ -402,7 +415,7 @@ bool Scene::validState(const double* state, std::string* why) const {
 bool Scene::withinBounds(const double* state) const noexcept {
   for (std::size_t i = 0; i < group_variables_.size(); ++i) {
     // Written so that a NaN fails.
-    if (!(state[i] >= lower_[i] - kJointLimitTolerance && state[i] <= upper_[i] + kJointLimitTolerance)) return false;
+    if (!(state[i] >= valid_lower_[i] && state[i] <= valid_upper_[i])) return false;
   }
   return true;
 }

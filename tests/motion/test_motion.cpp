@@ -109,6 +109,42 @@ TEST(MotionBound, BoundsTheMotionOfEveryPoint) {
   }
 }
 
+// A planar joint has no limits of its own: a state of x = 1e16 m, where a link's size has no digit left,
+// made a segment that starts inside a wall free (certified and cast), and a change beyond 1e154 made
+// sampling check only the ends. Every joint value lies within ±kMaxJointValue (1e6), or the state is
+// invalid, in every mode; scene bounds beyond it are refused.
+TEST(MotionCertified, JointValuesBeyondTheLargestAreNeverFree) {
+  TempDir dir;
+  const std::string head = "format: 1\nname: rover\nrobot:\n  urdf: " + test::sourceRobot("rover/rover.urdf") +
+                           "\n  group: [drive, swing]\n";
+  const std::string tail = "environment:\n  obstacles:\n"
+                           "    - {name: wall, box: {size: [0.002, 1.5, 1]}, pose: {position: [0, -1.25, 0.5]}}\n"
+                           "checks: [self, environment]\n";
+  const auto scene = Scene::load(dir.write("rover.yaml", head + tail));
+  const double inside[4] = {0, -1.25, 0, 0}, far[4] = {1e16, -1.25, 0, 0}, huge[4] = {1.3e155, -1.25, 0, 0};
+  const double edge[4] = {1e6, 5, 0, 0}, beyond[4] = {std::nextafter(1e6, 2e6), 5, 0, 0};
+  EXPECT_FALSE(scene->isFree(std::vector<double>(inside, inside + 4)));
+  EXPECT_TRUE(scene->isFree(std::vector<double>(edge, edge + 4)));
+  std::string why;
+  EXPECT_FALSE(scene->validState(beyond, &why));
+  EXPECT_NE(why.find("(drive/x) = 1000000.0000000001 is beyond ±1e6, the largest joint value a state may hold"),
+            std::string::npos) << why;
+  for (const MotionMode mode : {MotionMode::Certified, MotionMode::Cast, MotionMode::Sampled}) {
+    MotionOptions options;
+    options.mode = mode;
+    const MotionChecker checker(scene, options);
+    MotionContext ctx = checker.makeContext();
+    for (const double* end : {far, huge}) {
+      EXPECT_FALSE(checker.check(inside, end, ctx).free) << static_cast<int>(mode);
+      EXPECT_FALSE(checker.check(end, inside, ctx).free) << static_cast<int>(mode);
+    }
+    EXPECT_FALSE(checker.check(edge, beyond, ctx).free) << static_cast<int>(mode);
+  }
+  EXPECT_LOAD_ERROR(Scene::load(dir.write("wide.yaml", head + "  bounds: {drive/x: [-1e17, 1e17]}\n" + tail)),
+                    dir.path("wide.yaml"), "key 'robot.bounds.drive/x'",
+                    "[-1e+17, 1e+17] reaches beyond ±1e6, the largest joint value a state may hold");
+}
+
 TEST(MotionCertified, ThinWallIsNeverTunnelled) {
   // A 1 mm wall at x = 0: the 0.1 m block slides from x = −1 to x = 1. Sampling at 0.25 steps over it;
   // the certified check finds the contact at s = (1 − 0.0505) / 2, within contact_distance.

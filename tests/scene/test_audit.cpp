@@ -296,3 +296,31 @@ TEST(Audit, SharedPanda) {
 
 }  // namespace
 }  // namespace clearway
+
+namespace clearway {
+namespace {
+
+TEST(Audit, LimitsOfPlusMinus1e308AreSampledWithinTheLargestJointValue) {
+  // A revolute joint with limits of ±1e308 (MoveIt loads it): hi − lo overflowed, every sample was
+  // non-finite and collided, and the arm, which meets the post only at some angles, was called Always.
+  test::TempDir dir;
+  auto model = std::make_shared<const RobotModel>(loadRobot(dir.write("r.urdf", R"(<robot name="r">
+    <link name="base"><collision><origin xyz="0.7 0 0"/><geometry><cylinder radius="0.05" length="0.1"/></geometry></collision></link>
+    <link name="arm"><collision><origin xyz="-0.5 0 0"/><geometry><box size="0.6 0.05 0.05"/></geometry></collision></link>
+    <link name="pad"><collision><origin xyz="0 0 5"/><geometry><sphere radius="0.01"/></geometry></collision></link>
+    <joint name="p" type="fixed"><parent link="base"/><child link="pad"/></joint>
+    <joint name="j" type="revolute"><parent link="pad"/><child link="arm"/><axis xyz="0 0 1"/>
+      <limit lower="-1e308" upper="1e308" velocity="1" effort="1"/></joint>
+  </robot>)")));
+  AuditOptions options;
+  options.samples = 2000;
+  const auto audit = auditSelfCollision(std::make_shared<const RobotGeometry>(model), options);
+  const PairAudit& pair = find(*model, audit, "base", "arm");
+  EXPECT_EQ(pair.reason, "");
+  EXPECT_EQ(pair.samples, 2000);
+  EXPECT_GT(pair.colliding, 0);
+  EXPECT_LT(pair.colliding, 200);  // about 3.4%: the post's 0.1 m seen from 0.7 m
+}
+
+}  // namespace
+}  // namespace clearway

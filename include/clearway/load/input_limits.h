@@ -11,4 +11,9 @@ constexpr double kMaxInputLength = 1e6;
 /// The smallest radius or non-zero size (m) computed with: 1 nm; smaller bodies are grown to it.
 constexpr double kMinInputLength = 1e-9;
 
+/// The largest magnitude of a joint value (m or rad) a state may hold: a planar or floating joint, or a
+/// revolute one with limits of ±1e308, has no finite limit of its own, and a translation of 1e16 m leaves
+/// no digit of a link's size (a segment starting inside a wall was called free).
+constexpr double kMaxJointValue = 1e6;
+
 }  // namespace clearway

@@ -176,9 +176,13 @@ class Scene {
   int dimension() const noexcept { return static_cast<int>(group_variables_.size()); }
   /// Index in the robot's joint vector of each state entry.
   const std::vector<int>& groupVariables() const noexcept { return group_variables_; }
-  /// Limits of each state entry: the joint's, or the scene's robot.bounds (±infinity when unbounded).
+  /// Limits of each state entry: the joint's, or the scene's robot.bounds (±infinity when unbounded). A
+  /// state holds values within them (to kJointLimitTolerance) and within ±kMaxJointValue.
   double lower(int i) const noexcept { return lower_[i]; }
   double upper(int i) const noexcept { return upper_[i]; }
+  /// The range a valid state's entry i lies in: the limits widened by kJointLimitTolerance, within ±kMaxJointValue.
+  double validLower(int i) const noexcept { return valid_lower_[i]; }
+  double validUpper(int i) const noexcept { return valid_upper_[i]; }
   /// Links with geometry whose pose depends on the state (others never move, so self pairs among
   /// them never change; they still meet obstacles).
   const std::vector<int>& movingLinks() const noexcept { return moving_links_; }
@@ -260,6 +264,8 @@ class Scene {
   SelfCollision self_;
   std::vector<int> group_variables_;
   std::vector<double> lower_, upper_;  // per state entry
+  // What a state entry may hold: the limits widened by kJointLimitTolerance, within ±kMaxJointValue.
+  std::vector<double> valid_lower_, valid_upper_;
   std::vector<double> base_q_;  // held values and defaults; group entries overwritten per query
   std::vector<int> moving_links_, env_links_;
   std::vector<double> link_padding_;
