@@ -2,6 +2,7 @@
 // [--report FILE]`.
 #include "commands.h"
 #include "exit_codes.h"
+#include "gnuplot_text.h"
 #include "scene_commands.h"
 
 #include <clearway/load/robot_loader.h>
@@ -74,18 +75,17 @@ void progressBar(int done, int total) {
   std::fflush(stderr);
 }
 
-std::string quoted(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("''") : std::string(1, c);
-  return out + "'";
-}
-
 // The link-pair matrix as a PNG (through gnuplot, when installed): one cell per pair, coloured by the
 // colliding fraction on a log scale; Never pairs green (dark when they came within the near margin),
 // Adjacent and Default grey; each cell lettered with its verdict. Returns false (with a reason) when
 // no picture was drawn.
 bool writeHeatmap(const RobotModel& model, const std::vector<PairAudit>& audit, const std::string& png,
                   std::string& why) {
+  std::string output;
+  if (!gnuplotFileName(std::filesystem::path(png).filename().string(), output)) {
+    why = "its file name holds a control character";
+    return false;
+  }
   std::vector<int> links;
   for (const PairAudit& p : audit) links.push_back(p.a), links.push_back(p.b);
   std::sort(links.begin(), links.end());
@@ -102,14 +102,14 @@ bool writeHeatmap(const RobotModel& model, const std::vector<PairAudit>& audit, 
     else sampled << cell << " " << static_cast<double>(p.colliding) / p.samples << "\n";
     if (*letter) labels << cell << " " << letter << "\n";
   }
-  for (std::size_t i = 0; i < links.size(); ++i) tics << (i ? ", " : "") << quoted(model.link(links[i]).name) << " " << i;
+  for (std::size_t i = 0; i < links.size(); ++i) tics << (i ? ", " : "") << "'" << gnuplotSafeText(model.link(links[i]).name) << "' " << i;
   const int n = static_cast<int>(links.size());
   const int size = std::max(700, 40 * n + 300);
   std::ostringstream gp;
-  gp << "# Written by clearway audit: the link-pair matrix of " << model.name() << "\n"
+  gp << "# Written by clearway audit: the link-pair matrix of " << gnuplotSafeText(model.name()) << "\n"
      << "set terminal pngcairo noenhanced size " << size << "," << size << " font ',9'\n"
-     << "set output " << quoted(std::filesystem::path(png).filename().string()) << "\n"
-     << "set title \"Self-collision audit of " << model.name()
+     << "set output " << output << "\n"
+     << "set title \"Self-collision audit of " << gnuplotSafeText(model.name())
      << ": fraction of samples colliding\\nA adjacent, D default, Al always, N never, N* never but within 1 mm\"\n"
      << "set size ratio -1\nset xrange [-0.5:" << n - 0.5 << "]\nset yrange [-0.5:" << n - 0.5 << "]\n"
      << "set xtics (" << tics.str() << ") rotate by 60 right\nset ytics (" << tics.str() << ")\n"
@@ -155,6 +155,13 @@ int runAudit(AuditSettings& settings) {
   }
   if (report == "-") {
     std::cerr << "clearway audit: --report needs a file name (its heat map is written beside it), not -\n";
+    return kExitUsage;
+  }
+  // The heat map beside the report (report.md → report.png) is named in its gnuplot script.
+  const std::filesystem::path png = std::filesystem::path(report).replace_extension(".png");
+  if (std::string literal; !report.empty() && !gnuplotFileName(png.filename().string(), literal)) {
+    std::cerr << "clearway audit: --report: the file name holds a control character (a newline, a tab...), which "
+                 "its heat map's gnuplot script cannot name\n";
     return kExitUsage;
   }
   // With the SRDF on stdout, the report lines go to stderr.
@@ -262,8 +269,6 @@ int runAudit(AuditSettings& settings) {
     }
   }
   if (!report.empty()) {
-    // The picture beside the report: report.md → report.png.
-    const std::filesystem::path png = std::filesystem::path(report).replace_extension(".png");
     std::string why;
     const bool drawn = writeHeatmap(*model, audit, png.string(), why);
     if (!drawn) std::cerr << "clearway audit: no heat map: " << why << "\n";

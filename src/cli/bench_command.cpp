@@ -9,6 +9,7 @@
 #include "commands.h"
 #include "data_paths.h"
 #include "exit_codes.h"
+#include "gnuplot_text.h"
 #include "scene_commands.h"
 
 #include "suites.h"  // (the clearway_bench_suites library)
@@ -352,7 +353,7 @@ std::string plotCommand(const std::vector<std::string>& names) {
   std::string cmd = "plot ";
   for (std::size_t k = 0; k < names.size(); ++k) {
     const auto bar = names[k].find('|');
-    cmd += (k ? ", " : "") + names[k].substr(0, bar) + " using 1:2 with linespoints pt 7 title '" + names[k].substr(bar + 1) +
+    cmd += (k ? ", " : "") + names[k].substr(0, bar) + " using 1:2 with linespoints pt 7 title '" + gnuplotSafeText(names[k].substr(bar + 1)) +
            "', " + names[k].substr(0, bar) + " using 1:2:3 with labels offset 0.6,0.6 font ',7' notitle";
   }
   return cmd + "\n";
