@@ -23,6 +23,10 @@ using tinyxml2::XMLElement;
 // The node hierarchy assimp builds, instances expanded: its recursion depth and its size.
 constexpr int kMaxNodeDepth = 256;
 constexpr std::int64_t kMaxExpandedNodes = 100000;
+// The triangles the instances may expand to, unless the file writes out more (see collada_check.h).
+constexpr std::uint64_t kMaxExpandedTriangles = std::uint64_t{1} << 22;
+
+std::uint64_t saturatingAdd(std::uint64_t a, std::uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; }
 
 // A reader's message (tinyxml2's) is cut to this many characters: it may quote the file.
 constexpr std::size_t kReaderChars = 80;
@@ -43,6 +47,12 @@ class Checker {
   // Every element, depth first (tinyxml2 bounds the depth), with the checks that need one element.
   void visit(const XMLElement* e) {
     const std::string name = e->Name();
+    // Assimp 5.2 asserts (aborts) when it composes a node's transform from a <skew>.
+    if (name == "skew") fail(e, "<skew> is not supported (assimp aborts on it): write the node's transform as a <matrix>");
+    if (name == "input" && inMesh(e)) mesh_inputs_.push_back(e);
+    if (name == "visual_scene") visual_scenes_.push_back(e);
+    const std::uint64_t outer = triangles_;  // a <geometry> counts its own primitives' triangles
+    if (name == "geometry") triangles_ = 0;
     if (name == "p" || name == "vcount" || name == "v" || name == "h" || name == "int_array") tokens(e, true);
     if (name == "float_array") tokens(e, false);
     for (const char* attribute : {"count", "stride", "offset"}) wholeNumber(e, attribute);
@@ -57,8 +67,40 @@ class Checker {
     if (name == "triangles" || name == "polylist" || name == "polygons") primitiveCount(e);
     if (name == "polylist") polylist(e);
     if (name == "triangles" || name == "polylist" || name == "polygons" || name == "lines" || name == "linestrips" ||
-        name == "trifans" || name == "tristrips")
+        name == "trifans" || name == "tristrips") {
       vertexInput(e);
+      triangles_ = saturatingAdd(triangles_, primitiveTriangles(e));
+    }
+    if (name == "geometry") {
+      geometry_triangles_[e] = triangles_;
+      written_triangles_ = saturatingAdd(written_triangles_, triangles_);
+      triangles_ = outer;
+    }
+  }
+
+  // The inputs of a <mesh> read numbers: one whose source is an array of names (<Name_array>,
+  // <IDREF_array>) crashes assimp, which reads it as floats.
+  void checkMeshInputs() const {
+    for (const XMLElement* input : mesh_inputs_) {
+      const char* semantic = input->Attribute("semantic");
+      const char* source = input->Attribute("source");
+      if (semantic == nullptr || std::strcmp(semantic, "VERTEX") == 0 || source == nullptr || source[0] != '#') continue;
+      const XMLElement* s = byId(source + 1);
+      if (s == nullptr || std::strcmp(s->Name(), "source") != 0) continue;
+      // The arrays it holds, and the one its accessor reads (which may be anywhere in the file).
+      std::vector<const XMLElement*> arrays;
+      for (const XMLElement* a = s->FirstChildElement(); a != nullptr; a = a->NextSiblingElement()) arrays.push_back(a);
+      const XMLElement* common = s->FirstChildElement("technique_common");
+      const XMLElement* accessor = common != nullptr ? common->FirstChildElement("accessor") : nullptr;
+      const char* read = accessor != nullptr ? accessor->Attribute("source") : nullptr;
+      if (read != nullptr && read[0] == '#' && byId(read + 1) != nullptr) arrays.push_back(byId(read + 1));
+      for (const XMLElement* a : arrays)
+        if (std::strcmp(a->Name(), "Name_array") == 0 || std::strcmp(a->Name(), "IDREF_array") == 0)
+          fail(input, "its source '" + inputExcerpt(source + 1) + "' holds a <" + a->Name() + ">" +
+                          (a->Attribute("id") != nullptr ? " '" + inputExcerpt(a->Attribute("id")) + "'" : "") + " (line " +
+                          std::to_string(a->GetLineNum()) + "): names, where " + inputExcerpt(semantic) +
+                          " needs numbers (assimp crashes reading names as vertex data)");
+    }
   }
 
   // Accessors within their arrays: assimp reads offset + index·stride unchecked.
@@ -153,9 +195,18 @@ class Checker {
     fail(e, "no <input semantic=\"VERTEX\">: its primitives have no vertex positions");
   }
 
-  // No cycle through <instance_node>, and a bounded hierarchy once instances are expanded.
+  // No cycle through <instance_node>, and a bounded hierarchy once instances are expanded: its depth, its
+  // nodes, and the triangles its instances reach (each geometry's times the paths to it through the node
+  // graph), within the limit unless the file writes out more triangles than that itself.
   void checkNodes() {
+    triangle_limit_ = std::max(kMaxExpandedTriangles, written_triangles_);
     for (const XMLElement* n : nodes_) expand(n, 1);
+    for (const XMLElement* scene : visual_scenes_) {
+      std::uint64_t triangles = 0;
+      for (const XMLElement* n = scene->FirstChildElement("node"); n != nullptr; n = n->NextSiblingElement("node"))
+        triangles = saturatingAdd(triangles, expand(n, 1).triangles);
+      if (triangles > triangle_limit_) fail(scene, tooManyTriangles(triangles));
+    }
   }
 
  private:
@@ -163,7 +214,64 @@ class Checker {
     int state = 0;  // 0 unseen, 1 on the current path, 2 done
     int depth = 0;
     std::int64_t size = 0;
+    std::uint64_t triangles = 0;  // reached through the node's instances (saturating)
   };
+
+  const XMLElement* byId(const char* id) const {
+    const auto it = ids_.find(id);
+    return it != ids_.end() ? it->second : nullptr;
+  }
+
+  static bool inMesh(const XMLElement* e) {
+    const tinyxml2::XMLNode* parent = e->Parent();
+    const XMLElement* mesh = parent != nullptr && parent->Parent() != nullptr ? parent->Parent()->ToElement() : nullptr;
+    return mesh != nullptr && std::strcmp(mesh->Name(), "mesh") == 0;
+  }
+
+  // The triangles of a primitive once assimp triangulates it: count="N" of <triangles>, a fan per
+  // polygon of a <polylist>; for the others, as many as their corners (at least as many).
+  std::uint64_t primitiveTriangles(const XMLElement* e) const {
+    if (std::strcmp(e->Name(), "triangles") == 0) return wholeNumber(e, "count");
+    if (std::strcmp(e->Name(), "polylist") != 0) {
+      std::uint64_t tokens = 0;
+      for (const XMLElement* p = e->FirstChildElement(); p != nullptr; p = p->NextSiblingElement()) {
+        if (std::strcmp(p->Name(), "p") == 0) tokens += countTokens(p);
+        for (const XMLElement* h = p->FirstChildElement(); h != nullptr; h = h->NextSiblingElement()) tokens += countTokens(h);
+      }
+      return tokens / offsets(e);
+    }
+    // The corner counts are whole numbers adding up to at most the corners held (polylist()).
+    const XMLElement* vcount = e->FirstChildElement("vcount");
+    const char* p = vcount != nullptr ? vcount->GetText() : nullptr;
+    std::uint64_t triangles = 0;
+    for (std::uint64_t i = 0, count = wholeNumber(e, "count"); p != nullptr && i < count; ++i) {
+      char* end = nullptr;
+      const unsigned long long n = std::strtoull(p, &end, 10);
+      if (end == p) break;
+      triangles += n > 3 ? n - 2 : 1;
+      p = end;
+    }
+    return triangles;
+  }
+
+  // The geometry an <instance_geometry> or <instance_controller> (through its <skin> or <morph>) names.
+  const XMLElement* instancedGeometry(const XMLElement* instance) const {
+    const char* url = instance->Attribute("url");
+    const XMLElement* target = url != nullptr && url[0] == '#' ? byId(url + 1) : nullptr;
+    if (target != nullptr && std::strcmp(target->Name(), "controller") == 0) {
+      const XMLElement* skin = target->FirstChildElement("skin");
+      if (skin == nullptr) skin = target->FirstChildElement("morph");
+      const char* source = skin != nullptr ? skin->Attribute("source") : nullptr;
+      target = source != nullptr && source[0] == '#' ? byId(source + 1) : nullptr;
+    }
+    return target != nullptr && std::strcmp(target->Name(), "geometry") == 0 ? target : nullptr;
+  }
+
+  std::string tooManyTriangles(std::uint64_t triangles) const {
+    return "its instances expand to " + (triangles == UINT64_MAX ? "over " : std::string()) + std::to_string(triangles) +
+           " triangles, more than " + std::to_string(triangle_limit_) +
+           ": the most <instance_node> and <instance_geometry> may reach (unless the file writes out more itself)";
+  }
 
   // The node a url="#X" names: the one with id X, else the one named X (assimp's own fallback); null
   // when none (assimp skips it).
@@ -185,7 +293,12 @@ class Checker {
     x.state = 1;
     int depth = 0;
     std::int64_t size = 1;
+    std::uint64_t triangles = 0;
     for (const XMLElement* c = node->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) {
+      if (std::strcmp(c->Name(), "instance_geometry") == 0 || std::strcmp(c->Name(), "instance_controller") == 0) {
+        if (const XMLElement* g = instancedGeometry(c)) triangles = saturatingAdd(triangles, geometry_triangles_[g]);
+        continue;
+      }
       const XMLElement* child = std::strcmp(c->Name(), "node") == 0            ? c
                                 : std::strcmp(c->Name(), "instance_node") == 0 ? target(c)
                                                                                : nullptr;
@@ -193,13 +306,15 @@ class Checker {
       const Expanded& e = expand(child, level + 1);
       depth = std::max(depth, e.depth);
       size = std::min(kMaxExpandedNodes + 1, size + e.size);
+      triangles = saturatingAdd(triangles, e.triangles);
     }
     Expanded& done = expanded_[node];  // the map may have grown
-    done = {2, depth + 1, size};
+    done = {2, depth + 1, size, triangles};
     if (size > kMaxExpandedNodes)
       fail(node, "more than " + std::to_string(kMaxExpandedNodes) + " nodes once <instance_node> is expanded");
     if (done.depth + level - 1 > kMaxNodeDepth)
       fail(node, "nodes nested deeper than " + std::to_string(kMaxNodeDepth) + " levels (instances expanded)");
+    if (triangles > triangle_limit_) fail(node, tooManyTriangles(triangles));
     return done;
   }
 
@@ -262,8 +377,12 @@ class Checker {
   std::string path_;
   std::uint64_t file_size_;
   std::unordered_map<std::string, const XMLElement*> ids_, names_;
-  std::vector<const XMLElement*> nodes_, accessors_;
+  std::vector<const XMLElement*> nodes_, accessors_, mesh_inputs_, visual_scenes_;
   std::unordered_map<const XMLElement*, Expanded> expanded_;
+  std::unordered_map<const XMLElement*, std::uint64_t> geometry_triangles_;
+  std::uint64_t triangles_ = 0;          // of the <geometry> being visited
+  std::uint64_t written_triangles_ = 0;  // of every <geometry>, each once
+  std::uint64_t triangle_limit_ = kMaxExpandedTriangles;
 };
 
 }  // namespace
@@ -283,6 +402,7 @@ void checkCollada(const std::string& path) {
   Checker checker(path, text.size());
   checker.visit(root);
   checker.checkAccessors();
+  checker.checkMeshInputs();
   checker.checkNodes();
 }
 

@@ -1,6 +1,7 @@
 // Mesh input made to crash, hang or exhaust Clearway, each generated here as it was found: a NUL or
 // other control byte in a mesh path (the format picked from the text after it, the file opened before
-// it), and a reader's error quoting the rest of a file. Each ends in a LoadError naming the file,
+// it), COLLADA that assimp aborts or crashes on or that expands through instancing into millions of
+// triangles, and a reader's error quoting the rest of a file. Each ends in a LoadError naming the file,
 // element and reason, or in a mesh; and runs under a timeout, so that a hang fails the test instead of
 // blocking the suite.
 #include <clearway/load/mesh_loader.h>
@@ -98,6 +99,49 @@ TEST(HostileMesh, ControlBytesInAMeshPathAreRefused) {
   EXPECT_LOAD_ERROR_IN_TIME(parseSceneFile(scene), scene, "key 'environment.obstacles[0].mesh.file'",
                             "control character");
   EXPECT_EQ(errorOf([&] { parseSceneFile(scene); }).find('\0'), std::string::npos);
+}
+
+// COLLADA that assimp 5.2 aborts on (<skew>) or crashes on (names where vertex positions should be).
+TEST(HostileMesh, ColladaSkewAndNameArraysAsPositionsAreRefused) {
+  TempDir dir;
+  const std::string skew = dir.write(
+      "skew.dae", collada("<node id=\"n\">\n<skew>45 0 1 0 1 0 0</skew><instance_geometry url=\"#g\"/></node>"));
+  EXPECT_LOAD_ERROR_IN_TIME(loadMesh(skew, Vec3::Ones()), skew, "<skew> (line 13)", "not supported");
+  const std::string names = dir.write(
+      "names.dae", collada(kTetScene, "", "<Name_array id=\"pa\" count=\"12\">a b c d e f g h i j k l</Name_array>"));
+  EXPECT_LOAD_ERROR_IN_TIME(loadMesh(names, Vec3::Ones()), names, "<input> (line 7)", "<Name_array> 'pa' (line 5)");
+  const std::string idrefs = dir.write(
+      "idrefs.dae", collada(kTetScene, "", "<IDREF_array id=\"pa\" count=\"12\">g g g g g g g g g g g g</IDREF_array>"));
+  EXPECT_LOAD_ERROR_IN_TIME(loadMesh(idrefs, Vec3::Ones()), idrefs, "<input> (line 7)", "<IDREF_array> 'pa' (line 5)");
+}
+
+// A 9 KB file whose nodes instance each other two by two: 14 levels are 16,383 nodes (within the node
+// limit) but 8,192 copies of a 1,200-triangle geometry, 9.8 million triangles. The limit is on what the
+// instances expand to, counted before assimp reads the file.
+TEST(HostileMesh, ColladaInstancesExpandingToMillionsOfTrianglesAreRefused) {
+  TempDir dir;
+  std::string p;
+  for (int i = 0; i < 300; ++i) p += std::string(kTetP) + " ";
+  std::string nodes;
+  for (int i = 0; i < 13; ++i)
+    nodes += "<node id=\"d" + std::to_string(i) + "\"><instance_node url=\"#d" + std::to_string(i + 1) +
+             "\"/><instance_node url=\"#d" + std::to_string(i + 1) + "\"/></node>\n";
+  nodes += "<node id=\"d13\"><instance_geometry url=\"#g\"/></node>\n";
+  const std::string array = "<float_array id=\"pa\" count=\"12\">0 0 0 1 0 0 0 1 0 0 0 1</float_array>";
+  const std::string bomb =
+      dir.write("bomb.dae", collada("<node id=\"n\"><instance_node url=\"#d0\"/></node>", nodes, array, p, 1200));
+  EXPECT_LT(std::filesystem::file_size(bomb), 40000u);
+  // d1, the first node past the limit: 4,096 copies.
+  EXPECT_LOAD_ERROR_IN_TIME(loadMesh(bomb, Vec3::Ones()), bomb, "<node> (line 12)", "4915200 triangles");
+
+  // Within the limit the same instancing loads: 8 copies, welded into one tetrahedron's corners.
+  std::string few;
+  for (int i = 0; i < 3; ++i)
+    few += "<node id=\"d" + std::to_string(i) + "\"><instance_node url=\"#d" + std::to_string(i + 1) +
+           "\"/><instance_node url=\"#d" + std::to_string(i + 1) + "\"/></node>\n";
+  few += "<node id=\"d3\"><instance_geometry url=\"#g\"/></node>\n";
+  const std::string fine = dir.write("few.dae", collada("<node id=\"n\"><instance_node url=\"#d0\"/></node>", few));
+  EXPECT_EQ(loadMesh(fine, Vec3::Ones()).triangles.size(), 32u);
 }
 
 // An ASCII STL with one bad number among 20,000 facets: assimp's message quoted the rest of the file.
