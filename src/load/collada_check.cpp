@@ -1,4 +1,5 @@
 #include "load/collada_check.h"
+#include "load/mesh_uri.h"
 
 #include <clearway/load/load_error.h>
 
@@ -10,8 +11,6 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
-#include <sstream>
 #include <unordered_map>
 #include <vector>
 
@@ -388,11 +387,7 @@ class Checker {
 }  // namespace
 
 void checkCollada(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw LoadError(path, "", "cannot open the file");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  const std::string text = buffer.str();
+  const std::string text = readRegularFile(path);
   tinyxml2::XMLDocument doc;
   if (doc.Parse(text.c_str(), text.size()) != tinyxml2::XML_SUCCESS)
     throw LoadError(path, "line " + std::to_string(doc.ErrorLineNum()), "malformed XML: " + inputExcerpt(doc.ErrorStr(), kReaderChars));

@@ -10,10 +10,13 @@
 #include "load/mesh_uri.h"
 #include "load/ply_reader.h"
 
+#include <assimp/DefaultIOStream.h>
+#include <assimp/DefaultIOSystem.h>
 #include <assimp/Importer.hpp>
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <cctype>
@@ -217,6 +220,28 @@ void countBadEdges(const TriangleMesh& mesh, std::size_t* open, std::size_t* non
   }
 }
 
+// Assimp's file access, limited to regular files: an OBJ's mtllib naming a FIFO made it wait for a
+// writer forever; a material library that is not a regular file is missing to it, and skipped.
+class RegularFileIOSystem : public Assimp::DefaultIOSystem {
+ public:
+  bool Exists(const char* path) const override {
+    struct stat st {};
+    return ::stat(path, &st) == 0 && S_ISREG(st.st_mode);
+  }
+  Assimp::IOStream* Open(const char* path, const char* mode) override {
+    if (std::strchr(mode, 'w') != nullptr || std::strchr(mode, 'a') != nullptr) return nullptr;  // assimp only reads here
+    std::string reason;
+    std::FILE* file = detail::openRegularFile(path, &reason);
+    return file != nullptr ? new Stream(file, path) : nullptr;
+  }
+
+ private:
+  // DefaultIOStream's constructor from an open file is protected.
+  struct Stream : Assimp::DefaultIOStream {
+    Stream(std::FILE* file, const std::string& path) : DefaultIOStream(file, path) {}
+  };
+};
+
 // Assimp's PLY reader passes faces on unchecked, and its post-processing (triangulation) reads through
 // their indices and aborts on an empty one: check them in the scene as read, before any step runs.
 void checkFaceIndices(const aiScene& scene, const std::string& path) {
@@ -239,6 +264,7 @@ void checkFaceIndices(const aiScene& scene, const std::string& path) {
 void mergeThroughAssimp(const std::string& path, const std::string& ext, const MeshOptions& options,
                         const std::function<void(const std::string&)>& warn, Merger* merger) {
   Assimp::Importer importer;
+  importer.SetIOHandler(new RegularFileIOSystem);  // the importer owns it
   if (ext == "dae") detail::checkCollada(path);
 
   // Only positions matter. Vertices are joined below by exact position, not by assimp's
@@ -317,7 +343,10 @@ TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<st
     throw LoadError(path, "", "scale must be finite and non-zero in every component");
 
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw LoadError(path, "", "mesh file not found");
+  if (!std::filesystem::exists(path, ec)) throw LoadError(path, "", "mesh file not found");
+  std::string not_regular;
+  if (std::FILE* file = detail::openRegularFile(path, &not_regular)) std::fclose(file);
+  else throw LoadError(path, "", not_regular);
   if (std::filesystem::file_size(path, ec) == 0) throw LoadError(path, "", "empty mesh: the file is empty");
 
   const std::string ext = lowerExtension(path);

@@ -2,8 +2,14 @@
 
 #include <clearway/load/load_error.h>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cctype>
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <system_error>
 
@@ -131,6 +137,47 @@ ResolvedUri resolveMeshUri(const std::string& uri, const std::string& urdf_dir,
   const fs::path p(uri);
   r.path = (p.is_absolute() ? p : fs::path(urdf_dir) / p).lexically_normal().string();
   return r;
+}
+
+std::FILE* openRegularFile(const std::string& path, std::string* reason) {
+  // Non-blocking, so that opening a FIFO returns at once (a blocking open waits for a writer); what was
+  // opened is examined before anything is read from it.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
+    *reason = std::string("cannot open the file: ") + std::strerror(errno);
+    return nullptr;
+  }
+  struct stat st {};
+  const char* kind = nullptr;
+  if (::fstat(fd, &st) != 0) kind = "it cannot be examined";
+  else if (S_ISFIFO(st.st_mode)) kind = "a FIFO";
+  else if (S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode)) kind = "a device";
+  else if (S_ISDIR(st.st_mode)) kind = "a folder";
+  else if (S_ISSOCK(st.st_mode)) kind = "a socket";
+  else if (!S_ISREG(st.st_mode)) kind = "of an unknown kind";
+  const int flags = kind == nullptr ? ::fcntl(fd, F_GETFL) : -1;
+  std::FILE* file = flags >= 0 && ::fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) == 0 ? ::fdopen(fd, "rb") : nullptr;
+  if (file == nullptr) {
+    const int error = errno;
+    ::close(fd);
+    *reason = kind != nullptr ? std::string("not a regular file (") + kind +
+                                    "): only regular files are read, as a FIFO or a device may block or never end"
+                              : std::string("cannot open the file: ") + std::strerror(error);
+  }
+  return file;
+}
+
+std::string readRegularFile(const std::string& path) {
+  std::string reason;
+  std::FILE* file = openRegularFile(path, &reason);
+  if (file == nullptr) throw LoadError(path, "", reason);
+  std::string bytes;
+  char buffer[1 << 16];
+  for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, file)) > 0;) bytes.append(buffer, n);
+  const bool failed = std::ferror(file) != 0;
+  std::fclose(file);
+  if (failed) throw LoadError(path, "", "cannot read the file");
+  return bytes;
 }
 
 }  // namespace clearway::detail

@@ -1,6 +1,8 @@
 #pragma once
 // Where a URDF <mesh filename="..."> points: a path relative to the URDF, an absolute path, a file://
-// URI, or package://NAME/PATH found through explicit search paths, ROS_PACKAGE_PATH and AMENT_PREFIX_PATH.
+// URI, or package://NAME/PATH found through explicit search paths, ROS_PACKAGE_PATH and AMENT_PREFIX_PATH;
+// and opening what a mesh path names, only when it is a regular file.
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -22,5 +24,13 @@ ResolvedUri resolveMeshUri(const std::string& uri, const std::string& urdf_dir,
 /// Why path names no file, "" when it does: a NUL or other control character in it (the system reads a
 /// path up to its first NUL, so "x.dae\0.stl" would open x.dae). note follows "the path" in the reason.
 std::string controlCharacterReason(const std::string& path, const std::string& note = "");
+
+/// Opens path for reading, without blocking, when it is a regular file (after symbolic links); else
+/// returns null and says why in *reason. A FIFO would block its reader until a writer comes, and a
+/// device (/dev/zero) may never end.
+std::FILE* openRegularFile(const std::string& path, std::string* reason);
+
+/// The bytes of path; throws LoadError(path, "", reason) when it is not a regular file or cannot be read.
+std::string readRegularFile(const std::string& path);
 
 }  // namespace clearway::detail

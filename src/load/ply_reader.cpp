@@ -3,6 +3,7 @@
 // binary: the declared sizes, in the declared byte order). Every loop over an element's instances or a
 // list's values consumes at least one byte or one token per step, or throws: it ends with the file.
 #include "load/ply_reader.h"
+#include "load/mesh_uri.h"
 
 #include <clearway/load/load_error.h>
 
@@ -12,7 +13,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <iterator>
 #include <limits>
 #include <string_view>
@@ -119,11 +119,7 @@ class Reader {
   Reader(std::string path, std::vector<std::string>* warnings) : path_(std::move(path)), warnings_(warnings) {}
 
   PlyMesh read() {
-    {
-      std::ifstream in(path_, std::ios::binary);
-      if (!in) throw LoadError(path_, "", "cannot open the file");
-      bytes_.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    }
+    bytes_ = readRegularFile(path_);
     readHeader();
     for (std::size_t e = 0; e < elements_.size(); ++e) readElement(e);
     return finish();

@@ -1,9 +1,9 @@
 // Mesh input made to crash, hang or exhaust Clearway, each generated here as it was found: a NUL or
 // other control byte in a mesh path (the format picked from the text after it, the file opened before
 // it), COLLADA that assimp aborts or crashes on or that expands through instancing into millions of
-// triangles, and a reader's error quoting the rest of a file. Each ends in a LoadError naming the file,
-// element and reason, or in a mesh; and runs under a timeout, so that a hang fails the test instead of
-// blocking the suite.
+// triangles, FIFOs where a mesh or an OBJ's material library should be, and a reader's error quoting
+// the rest of a file. Each ends in a LoadError naming the file, element and reason, or in a mesh; and
+// runs under a timeout, so that a hang fails the test instead of blocking the suite.
 #include <clearway/load/mesh_loader.h>
 #include <clearway/load/robot_loader.h>
 #include <clearway/scene/scene.h>
@@ -12,6 +12,10 @@
 #include "timeout_guard.h"
 
 #include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <string>
 
@@ -142,6 +146,31 @@ TEST(HostileMesh, ColladaInstancesExpandingToMillionsOfTrianglesAreRefused) {
   few += "<node id=\"d3\"><instance_geometry url=\"#g\"/></node>\n";
   const std::string fine = dir.write("few.dae", collada("<node id=\"n\"><instance_node url=\"#d0\"/></node>", few));
   EXPECT_EQ(loadMesh(fine, Vec3::Ones()).triangles.size(), 32u);
+}
+
+// An OBJ whose material library is a FIFO: assimp opened it and waited for a writer forever. A FIFO
+// given as the mesh itself is refused as not a regular file.
+TEST(HostileMesh, FifosAreNeverOpened) {
+  TempDir dir;
+  const std::string fifo = dir.path("materials.mtl");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string obj = dir.write("tet.obj", "mtllib materials.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+                                               "usemtl steel\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+  // Should the load block, opening the FIFO's other end lets it go on.
+  const auto unblock = [&] {
+    const int fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+    if (fd >= 0) ::close(fd);
+  };
+  std::size_t triangles = 0;
+  endsWithin(kSeconds, [&] { triangles = loadMesh(obj, Vec3::Ones()).triangles.size(); }, unblock);
+  EXPECT_EQ(triangles, 4u);
+
+  const std::string fifo_mesh = dir.path("part.stl");
+  ASSERT_EQ(::mkfifo(fifo_mesh.c_str(), 0600), 0);
+  EXPECT_LOAD_ERROR_IN_TIME(loadMesh(fifo_mesh, Vec3::Ones()), fifo_mesh, "", "not a regular file");
+  const std::string device = dir.path("zero.stl");
+  ASSERT_EQ(::symlink("/dev/zero", device.c_str()), 0);
+  EXPECT_LOAD_ERROR_IN_TIME(loadMesh(device, Vec3::Ones()), device, "", "not a regular file");
 }
 
 // An ASCII STL with one bad number among 20,000 facets: assimp's message quoted the rest of the file.
