@@ -106,7 +106,8 @@ std::vector<double> batchTimes(const py::object& times, py::ssize_t n, py::ssize
   if (a.shape(0) != n) throw py::value_error("times must have a row per state, got " + shapeText(a));
   for (py::ssize_t i = 0; i < n * cols; ++i) {
     t[i] = a.data()[i];
-    if (!std::isfinite(t[i])) throw py::value_error("times[" + std::to_string(i / cols) + "] is not finite");
+    if (!(std::abs(t[i]) <= kMaxTime))
+      throw py::value_error("times[" + std::to_string(i / cols) + "] is not finite or beyond ±1e6 s, the largest a query may give");
   }
   return t;
 }

@@ -56,7 +56,8 @@ int runCheck(const CheckSettings& s) {
   int status = kExitOk;
   std::string line, why;
   std::vector<double> q;
-  for (int line_no = 1; std::getline(*input, line); ++line_no) {
+  std::string read_error;
+  for (int line_no = 1; readInputLine(*input, line, read_error); ++line_no) {
     if (!parseNumbers(line, q, why)) {
       std::cout << "error line " << line_no << ": " << why << "\n";
       status = kExitNo;
@@ -72,6 +73,11 @@ int runCheck(const CheckSettings& s) {
     const std::string v = verdict(*scene, q, ctx);
     if (v.compare(0, 5, "error") == 0) status = kExitNo;
     std::cout << v << "\n";
+  }
+  if (!read_error.empty()) {
+    std::cout.flush();
+    std::cerr << "clearway check: " << (s.states == "-" ? "<stdin>" : s.states) << ": " << read_error << "\n";
+    return kExitUsage;
   }
   std::cout.flush();
   return std::cout ? status : kExitUsage;

@@ -82,7 +82,8 @@ int runMotion(const MotionSettings& s) {
   int status = kExitOk;
   std::string line, why;
   std::vector<double> q;
-  for (int line_no = 1; std::getline(*input, line); ++line_no) {
+  std::string read_error;
+  for (int line_no = 1; readInputLine(*input, line, read_error); ++line_no) {
     if (!parseNumbers(line, q, why)) {
       std::cout << "error line " << line_no << ": " << why << "\n";
       status = kExitNo;
@@ -105,12 +106,17 @@ int runMotion(const MotionSettings& s) {
       status = kExitNo;
       continue;
     }
-    if (!std::isfinite(t0) || !std::isfinite(t1)) {
-      std::cout << "error line " << line_no << ": a time is not finite\n";
+    if (!(std::abs(t0) <= kMaxTime && std::abs(t1) <= kMaxTime)) {
+      std::cout << "error line " << line_no << ": a time is not finite or beyond ±1e6 s, the largest a query may give\n";
       status = kExitNo;
       continue;
     }
     std::cout << verdict(*checker, q0, q1, ctx, t0, t1) << "\n";
+  }
+  if (!read_error.empty()) {
+    std::cout.flush();
+    std::cerr << "clearway motion: " << (motions_path == "-" ? "<stdin>" : motions_path) << ": " << read_error << "\n";
+    return kExitUsage;
   }
   std::cout.flush();
   return std::cout ? status : kExitUsage;

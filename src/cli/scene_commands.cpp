@@ -47,6 +47,33 @@ std::shared_ptr<const Scene> loadScene(const char* command, const std::string& p
   }
 }
 
+bool readInputLine(std::istream& in, std::string& line, std::string& error, std::size_t max_bytes) {
+  line.clear();
+  errno = 0;  // what a failed read leaves: the stream buffer reports it as an end of input
+  std::streambuf* buffer = in.rdbuf();
+  for (;;) {
+    int c = std::char_traits<char>::eof();
+    try {
+      c = buffer->sbumpc();
+    } catch (const std::exception& e) {  // a stream set to throw, or a filebuf that does
+      error = std::string("cannot read the input: ") + e.what();
+      return false;
+    }
+    if (c == std::char_traits<char>::eof()) {
+      // The end of the input, or a read error that the stream buffer reports only as an end.
+      if (errno == EIO || errno == ENOMEM || errno == EISDIR) error = std::string("cannot read the input: ") + std::strerror(errno);
+      in.setstate(std::ios::eofbit);
+      return !line.empty() && error.empty();
+    }
+    if (c == '\n') return true;
+    if (line.size() >= max_bytes) {
+      error = "a line longer than " + std::to_string(max_bytes) + " bytes (no end of line): not a list of states";
+      return false;
+    }
+    line.push_back(static_cast<char>(c));
+  }
+}
+
 std::istream* openInput(const char* command, const std::string& path, std::ifstream& file) {
   if (path == "-") return &std::cin;
   std::error_code ec;

@@ -36,6 +36,11 @@ std::shared_ptr<const Scene> loadScene(const char* command, const std::string& p
 /// or is a folder.
 std::istream* openInput(const char* command, const std::string& path, std::ifstream& file);
 
+/// Reads the next line of `in` into `line` (without its newline); false at the end of the input, or with
+/// `error` set when the input cannot be read or a line exceeds max_bytes (/dev/zero has no end of line):
+/// a command then says so and fails instead of stopping early as if every line had run.
+bool readInputLine(std::istream& in, std::string& line, std::string& error, std::size_t max_bytes = std::size_t{1} << 24);
+
 /// Parses a line of numbers separated by spaces, tabs or commas; false (and `why`) on anything else.
 bool parseNumbers(const std::string& line, std::vector<double>& out, std::string& why);
 

@@ -327,6 +327,11 @@ MotionResult MotionChecker::check(const double* q0, double t0, const double* q1,
     return r;
   }
   motion_detail::Scratch& ctx = *context.scratch_;
+  if (!(std::abs(t0) <= kMaxTime && std::abs(t1) <= kMaxTime)) {  // (NaN fails)
+    MotionResult r;
+    r.report.kind = CollisionReport::Kind::Invalid;
+    return r;
+  }
   // A context made by a checker of another robot (a World before an attach, say), or of another group of
   // this one (its state buffers sized for another dimension), does not fit: refused.
   const std::size_t dim = static_cast<std::size_t>(scene_->dimension());

@@ -426,7 +426,7 @@ bool Scene::isFree(const double* state, SceneContext& ctx, CollisionReport* repo
   CollisionReport& r = report ? *report : local;
   r = CollisionReport{};
   // (A context of another scene's robot, such as a World's before an attach, does not fit: refused.)
-  if (!withinBounds(state) || ctx.poses.size() != static_cast<std::size_t>(robot().linkCount())) {
+  if (!withinBounds(state) || !withinTime(t) || ctx.poses.size() != static_cast<std::size_t>(robot().linkCount())) {
     ++ctx.counters.invalid_states;
     r.kind = CollisionReport::Kind::Invalid;
     return false;
@@ -558,7 +558,7 @@ int Scene::anyCollides(const double* states, int count, SceneContext& ctx, Colli
     for (int l = 0; l < n; ++l) {
       const double* x = state(first + l);
       ++ctx.counters.states;
-      if (!withinBounds(x)) {
+      if (!withinBounds(x) || !withinTime(time(first + l))) {
         ++ctx.counters.invalid_states;
         r.kind = CollisionReport::Kind::Invalid;
         return first + l;
@@ -606,7 +606,7 @@ void Scene::areFree(const double* states, int count, SceneContext& ctx, bool* fr
   for (int s = 0; s < count; ++s) {
     const double* state = states + static_cast<std::ptrdiff_t>(s) * dim;
     ++ctx.counters.states;
-    if (!withinBounds(state)) {
+    if (!withinBounds(state) || !withinTime(t)) {
       ++ctx.counters.invalid_states;
       free[s] = false;
       continue;
@@ -642,7 +642,7 @@ double Scene::clearance(const double* state, SceneContext& ctx, double* lower_bo
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const Effects& fx = description_.effects;
   if (!fx.clearance) return nan;
-  if (!withinBounds(state) || ctx.poses.size() != static_cast<std::size_t>(robot().linkCount())) return nan;
+  if (!withinBounds(state) || !withinTime(t) || ctx.poses.size() != static_cast<std::size_t>(robot().linkCount())) return nan;
   ++ctx.counters.clearance_queries;
   computePoses(state, ctx);
   // Distances first; EPA only when something touches (then the value is minus the deepest penetration).

@@ -232,3 +232,19 @@ TEST(Arguments, PlannedPathsReadBackExactly) {
   const ToolRun refused = runTool("check '" + scene + "' --states '" + past + "'");
   EXPECT_MENTIONS(refused.out + refused.err, "= 2.5000001 is outside [-2.5, 2.5]");
 }
+
+// Input that cannot be read to its end (/dev/zero: no end of line, ever) stops check and motion with an
+// error naming the file, exit 2: they stopped early and exited 0, as if every line had run.
+TEST(Arguments, UnreadableStatesAndMotionsFail) {
+  for (const char* command : {"check", "motion"}) {
+    const std::string option = std::string(command) == "check" ? " --states " : " --motions ";
+    const ToolRun r = runTool(std::string(command) + " " + kScene + option + "/dev/zero");
+    EXPECT_EQ(r.exit_code, 2) << command;
+    EXPECT_MENTIONS(r.err, "/dev/zero: a line longer than 16777216 bytes");
+  }
+  // A last line without a newline still runs.
+  const std::string states = writeTemp("no_newline.txt", "0 -0.6 -1.2 -1.34 0 0");
+  const ToolRun r = runTool("check " + kScene + " --states '" + states + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, "free\n");
+}

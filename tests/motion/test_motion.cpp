@@ -145,6 +145,34 @@ TEST(MotionCertified, JointValuesBeyondTheLargestAreNeverFree) {
                     "[-1e+17, 1e+17] reaches beyond ±1e6, the largest joint value a state may hold");
 }
 
+// Moments are finite and within ±kMaxTime (1e6 s): a segment spanning 1e17 s with a moving obstacle was
+// called free though it started inside a wall. Beyond it a state or segment is invalid, never free.
+TEST(MotionCertified, TimesBeyondTheLargestAreNeverFree) {
+  TempDir dir;
+  const auto scene = Scene::load(dir.write("moving.yaml", "format: 1\nname: moving\nrobot:\n  urdf: " +
+      test::sourceRobot("planar_arm/planar_arm.urdf") + "\n  group: [shoulder, elbow]\nenvironment:\n  obstacles:\n"
+      "    - {name: wall, box: {size: [0.1, 2, 1]}, pose: {position: [1.2, 0, 0]}}\n"
+      "    - {name: ball, sphere: {radius: 0.05}, pose: {position: [5, 5, 0]}, velocity: [1e-12, 0, 0]}\n"
+      "checks: [self, environment, moving]\n"));
+  const double inside[2] = {0, 0}, clear[2] = {1.5, 0};
+  SceneContext sc = scene->makeContext();
+  EXPECT_TRUE(scene->isFree(clear, sc, nullptr, 1e6));
+  EXPECT_FALSE(scene->isFree(clear, sc, nullptr, std::nextafter(1e6, 2e6)));
+  EXPECT_FALSE(scene->isFree(clear, sc, nullptr, -1e17));
+  for (const MotionMode mode : {MotionMode::Certified, MotionMode::Cast, MotionMode::Sampled}) {
+    MotionOptions options;
+    options.mode = mode;
+    const MotionChecker checker(scene, options);
+    MotionContext ctx = checker.makeContext();
+    EXPECT_TRUE(checker.check(clear, 0.0, clear, 1e6, ctx).free) << static_cast<int>(mode);
+    for (const double t1 : {1e17, -1e17, 2e6, std::nan("")}) {
+      EXPECT_FALSE(checker.check(inside, 0.0, clear, t1, ctx).free) << static_cast<int>(mode) << " " << t1;
+      EXPECT_FALSE(checker.check(clear, 0.0, clear, t1, ctx).free) << static_cast<int>(mode) << " " << t1;
+      EXPECT_FALSE(checker.check(clear, t1, clear, 0.0, ctx).free) << static_cast<int>(mode) << " " << t1;
+    }
+  }
+}
+
 TEST(MotionCertified, ThinWallIsNeverTunnelled) {
   // A 1 mm wall at x = 0: the 0.1 m block slides from x = −1 to x = 1. Sampling at 0.25 steps over it;
   // the certified check finds the contact at s = (1 − 0.0505) / 2, within contact_distance.

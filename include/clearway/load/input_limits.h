@@ -16,4 +16,8 @@ constexpr double kMinInputLength = 1e-9;
 /// no digit of a link's size (a segment starting inside a wall was called free).
 constexpr double kMaxJointValue = 1e6;
 
+/// The largest magnitude of a moment (s) a query may place moving obstacles at: an obstacle's path over
+/// a longer span leaves no digit of its size (a segment of 1e17 s was called free).
+constexpr double kMaxTime = 1e6;
+
 }  // namespace clearway

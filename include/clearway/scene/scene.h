@@ -8,10 +8,12 @@
 #include <clearway/environment/environment.h>
 #include <clearway/kinematics/kinematic_lanes.h>
 #include <clearway/kinematics/robot_model.h>
+#include <clearway/load/input_limits.h>
 #include <clearway/load/robot_loader.h>
 #include <clearway/scene/collision_filter.h>
 #include <clearway/scene/self_collision.h>
 
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -243,6 +245,8 @@ class Scene {
   void initEnvironment();  // the part of init() that depends on the environment
   SceneContext& threadContext() const;
   bool withinBounds(const double* state) const noexcept;  // the cheap check of every query (no reason)
+  // A moment obstacles may be placed at: finite and within ±kMaxTime (NaN fails).
+  static bool withinTime(double t) noexcept { return std::abs(t) <= kMaxTime; }
   // isFree's geometry, once the poses of the state's links (and its full joint vector q) are known.
   bool posedFree(const Pose* poses, const double* q, SceneContext& ctx, CollisionReport& r, double t) const noexcept;
   // Its two halves: the environment (placing the enclosing balls where the clearance grid is read, which
