@@ -170,7 +170,13 @@ void bindRobot(py::module_& m) {
           AuditOptions options;
           options.samples = samples;
           options.seed = seed;
-          options.threads = threads;
+          options.threads = std::min(threads, maxAuditThreads());
+          if (threads > options.threads) {
+            const std::string warning = "audit: threads=" + std::to_string(threads) +
+                                        " is more than this machine runs at once: " + std::to_string(options.threads) +
+                                        " threads used (4 per hardware thread, at most 256)";
+            if (PyErr_WarnEx(PyExc_RuntimeWarning, warning.c_str(), 1) != 0) throw py::error_already_set();
+          }
           const std::string srdf_path = srdf.is_none() ? "" : srdf.cast<std::string>();
           py::gil_scoped_release release;
           AuditResult result;
@@ -200,7 +206,8 @@ void bindRobot(py::module_& m) {
         py::arg("urdf"), py::arg("srdf") = py::none(), py::arg("samples") = 10000, py::arg("seed") = 1,
         py::arg("threads") = 2, py::arg("package_paths") = std::vector<std::string>{},
         "Audits every pair of links with geometry as MoveIt's Setup Assistant does, with evidence "
-        "(as clearway audit; the same seed gives the same audit). srdf is only compared with.");
+        "(as clearway audit; the same seed gives the same audit). srdf is only compared with. threads beyond 4 per "
+        "hardware thread (at most 256) are capped to that, with a RuntimeWarning.");
 
   m.def("clopper_pearson_upper", &clopperPearsonUpper, py::arg("k"), py::arg("n"),
         "The 95% one-sided Clopper-Pearson upper bound on p after k successes in n trials (1 when n = 0).");

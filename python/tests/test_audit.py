@@ -75,3 +75,12 @@ def test_bad_audits_raise(tmp_path):
     with pytest.raises(clearway.LoadError) as e:
         clearway.audit(str(ARM6 / "arm6.urdf"), srdf=str(tmp_path / "none.srdf"))
     assert e.value.file == str(tmp_path / "none.srdf")
+
+
+def test_too_many_threads_are_capped_with_a_warning():
+    # 100,000 threads were all asked of the system, which aborted the process when it could not give them.
+    urdf = str(ARM6 / "arm6.urdf")
+    with pytest.warns(RuntimeWarning, match="threads=100000 is more than this machine runs at once"):
+        capped = clearway.audit(urdf, samples=50, seed=3, threads=100000)
+    one = clearway.audit(urdf, samples=50, seed=3, threads=1)
+    assert [(p.reason, p.colliding) for p in capped.pairs] == [(p.reason, p.colliding) for p in one.pairs]

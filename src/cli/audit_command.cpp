@@ -189,6 +189,11 @@ int runAudit(AuditSettings& settings) {
     return kExitUsage;
   }
   const auto geometry = std::make_shared<const RobotGeometry>(model);
+  if (options.threads > maxAuditThreads()) {
+    printWarning("--threads " + std::to_string(options.threads) + " is more than this machine runs at once: " +
+                 std::to_string(maxAuditThreads()) + " threads used (4 per hardware thread, at most 256)");
+    options.threads = maxAuditThreads();
+  }
   if (!quiet())
     std::cerr << "clearway audit: " << model->name() << ", " << geometry->geometricLinks().size()
               << " links with geometry, " << options.samples << " samples (seed " << options.seed << "), "

@@ -14,6 +14,7 @@
 #include <random>
 #include <set>
 #include <stdexcept>
+#include <system_error>
 #include <thread>
 #include <tuple>
 
@@ -94,6 +95,11 @@ double clopperPearsonUpper(int k, int n) {
     (logBinomialCdf(log_choose, n, mid) > target ? lo : hi) = mid;
   }
   return hi;
+}
+
+int maxAuditThreads() {
+  const unsigned hardware = std::max(1u, std::thread::hardware_concurrency());  // 0 when unknown
+  return static_cast<int>(std::min(256u, 4 * hardware));
 }
 
 std::vector<PairAudit> auditSelfCollision(std::shared_ptr<const RobotGeometry> geometry, const AuditOptions& options) {
@@ -180,49 +186,61 @@ std::vector<PairAudit> auditSelfCollision(std::shared_ptr<const RobotGeometry> g
   // only a distance more than twice that below the smallest yet counts.
   const double tie = 1.0 - 2.0 * tol.gjk_relative;
 
-  // Each thread takes every threads-th sample and keeps its own counts and minima; merged after.
+  // Lane t takes every lanes-th sample from t, with its own warm starts, counts and minima (merged
+  // after); the threads started take lanes until none is left. So the audit depends on the lanes alone,
+  // not on how many threads the system gave.
   struct Partial {
     std::vector<int> colliding;
     std::vector<double> min_clearance;
   };
-  std::vector<Partial> partial(options.threads);
-  std::atomic<int> done{0};
+  const int lanes = std::min(options.threads, maxAuditThreads());
+  std::vector<Partial> partial(lanes);
+  std::atomic<int> next_lane{0}, done{0};
   const int report_every = std::max(1, options.samples / 100);
-  const auto work = [&](int t) {
-    Partial& mine = partial[t];
-    mine.colliding.assign(result.size(), 0);
-    mine.min_clearance.assign(result.size(), std::numeric_limits<double>::infinity());
+  const auto work = [&](bool reports) {
     std::vector<Pose> ps(n_links);
-    std::vector<BodyPair> bodies;  // the pairs' warm starts, this thread's own
-    bodies.reserve(result.size());
-    for (const PairAudit& p : result) bodies.emplace_back(*geometry->link(p.a), *geometry->link(p.b));
-    for (int s = t; s < options.samples; s += options.threads) {
-      // data() + offset: a robot without joints has no configurations to index (&v[0] of an empty vector).
-      computeLinkPoses(model, configurations.data() + static_cast<std::size_t>(s) * model.variableCount(), ps.data());
-      for (const int k : sampled_pairs) {
-        const PairAudit& p = result[k];
-        if (collides(p, ps)) {
-          ++mine.colliding[k];
-          mine.min_clearance[k] = 0.0;
-          continue;
+    for (int t; (t = next_lane.fetch_add(1)) < lanes;) {
+      Partial& mine = partial[t];
+      mine.colliding.assign(result.size(), 0);
+      mine.min_clearance.assign(result.size(), std::numeric_limits<double>::infinity());
+      std::vector<BodyPair> bodies;  // the pairs' warm starts, this lane's own
+      bodies.reserve(result.size());
+      for (const PairAudit& p : result) bodies.emplace_back(*geometry->link(p.a), *geometry->link(p.b));
+      for (int s = t; s < options.samples; s += lanes) {
+        // data() + offset: a robot without joints has no configurations to index (&v[0] of an empty vector).
+        computeLinkPoses(model, configurations.data() + static_cast<std::size_t>(s) * model.variableCount(), ps.data());
+        for (const int k : sampled_pairs) {
+          const PairAudit& p = result[k];
+          if (collides(p, ps)) {
+            ++mine.colliding[k];
+            mine.min_clearance[k] = 0.0;
+            continue;
+          }
+          // The smallest clearance is a running minimum, so only a distance below it matters: as the cutoff,
+          // it lets the balls, hulls and convex parts skip a sample they prove farther, and prunes element pairs.
+          double& least = mine.min_clearance[k];
+          if (!measured[k] || !(least > 0.0)) continue;
+          DistanceQuery q;
+          q.cutoff = least * tie;
+          const DistanceResult d = bodies[k].distance(ps[p.a], ps[p.b], tol, q);
+          if (!isFailure(d.status) && d.distance < q.cutoff) least = d.distance;
         }
-        // The smallest clearance is a running minimum, so only a distance below it matters: as the cutoff,
-        // it lets the balls, hulls and convex parts skip a sample they prove farther, and prunes element pairs.
-        double& least = mine.min_clearance[k];
-        if (!measured[k] || !(least > 0.0)) continue;
-        DistanceQuery q;
-        q.cutoff = least * tie;
-        const DistanceResult d = bodies[k].distance(ps[p.a], ps[p.b], tol, q);
-        if (!isFailure(d.status) && d.distance < q.cutoff) least = d.distance;
+        const int now = done.fetch_add(1, std::memory_order_relaxed) + 1;
+        // Only the calling thread reports, so the callback needs no locking.
+        if (reports && options.progress && now / report_every != (now - 1) / report_every) options.progress(now, options.samples);
       }
-      const int now = done.fetch_add(1, std::memory_order_relaxed) + 1;
-      // Only the calling thread reports, so the callback needs no locking.
-      if (t == 0 && options.progress && now / report_every != (now - 1) / report_every) options.progress(now, options.samples);
     }
   };
   std::vector<std::thread> pool;
-  for (int t = 1; t < options.threads; ++t) pool.emplace_back(work, t);
-  work(0);
+  pool.reserve(lanes - 1);
+  for (int t = 1; t < lanes; ++t) {
+    try {
+      pool.emplace_back(work, false);
+    } catch (const std::system_error&) {
+      break;  // no more threads (a process or memory limit): those started, and this one, take every lane
+    }
+  }
+  work(true);
   for (auto& th : pool) th.join();
   if (options.progress) options.progress(options.samples, options.samples);
 

@@ -140,3 +140,15 @@ TEST(AuditTool, ThreadsAndUsageErrors) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_MENTIONS(r.err, "cannot write " + dir.path("no/such/folder/out.srdf"));
 }
+
+// --threads 600 started 600 threads (and aborted where they could not be created): the audit uses at
+// most 4 per hardware thread, 256 in all, and says so.
+TEST(AuditTool, ThreadsBeyondTheCapAreCappedWithAWarning) {
+  TempDir dir;
+  const std::string urdf = dir.write("esc.urdf", kEscapedUrdf);
+  const int cap = static_cast<int>(std::min(256u, 4 * std::max(1u, std::thread::hardware_concurrency())));
+  const ToolRun r = runTool("audit " + q(urdf) + " --samples 20 --threads 600");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_MENTIONS(r.err, "--threads 600 is more than this machine runs at once: " + std::to_string(cap) + " threads used");
+  EXPECT_MENTIONS(r.err, std::to_string(cap) + " threads\n");
+}

@@ -8,9 +8,11 @@
 #include "srdf_reader.h"
 
 #include <gtest/gtest.h>
+#include <pthread.h>
 
 #include <algorithm>
 #include <cmath>
+#include <system_error>
 #include <tuple>
 
 namespace clearway {
@@ -271,6 +273,53 @@ TEST(Audit, BadInput) {
   o = {};
   o.most_fraction = 2;
   EXPECT_THROW(auditSelfCollision(geometry, o), std::invalid_argument);
+}
+
+// The same verdicts, counts and clearances.
+void expectSameAudit(const std::vector<PairAudit>& a, const std::vector<PairAudit>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(a[k].reason, b[k].reason);
+    EXPECT_EQ(a[k].colliding, b[k].colliding);
+    if (!std::isnan(a[k].min_clearance)) EXPECT_EQ(a[k].min_clearance, b[k].min_clearance);
+    else EXPECT_TRUE(std::isnan(b[k].min_clearance));
+  }
+}
+
+// Threads that cannot be created (here: every new thread asks for a 64 TiB stack by default) made
+// std::thread throw std::system_error out of the audit, and asking for 100,000 threads, more than the
+// system gives, aborted the process. The audit runs on the threads it gets, and asks for at most
+// maxAuditThreads().
+TEST(Audit, ThreadsThatCannotBeCreatedOrTooManyFallBack) {
+  TempDir dir;
+  auto model = std::make_shared<const RobotModel>(loadRobot(dir.write("a.urdf", kAuditUrdf)));
+  const auto geometry = std::make_shared<const RobotGeometry>(model);
+  AuditOptions options;
+  options.samples = 400;
+  options.threads = 1;
+  const std::vector<PairAudit> one = auditSelfCollision(geometry, options);
+
+  pthread_attr_t saved, huge;
+  ASSERT_EQ(pthread_getattr_default_np(&saved), 0);
+  ASSERT_EQ(pthread_getattr_default_np(&huge), 0);
+  ASSERT_EQ(pthread_attr_setstacksize(&huge, std::size_t{1} << 46), 0);
+  ASSERT_EQ(pthread_setattr_default_np(&huge), 0);
+  std::vector<PairAudit> starved;
+  std::string error;
+  options.threads = 4;
+  try {
+    starved = auditSelfCollision(geometry, options);
+  } catch (const std::system_error& e) {
+    error = e.what();
+  }
+  pthread_setattr_default_np(&saved);
+  pthread_attr_destroy(&saved);
+  pthread_attr_destroy(&huge);
+  EXPECT_EQ(error, "") << "the audit threw instead of running on the calling thread";
+  if (error.empty()) expectSameAudit(one, starved);
+
+  options.threads = 100000;
+  expectSameAudit(one, auditSelfCollision(geometry, options));
 }
 
 TEST(Audit, SharedPanda) {

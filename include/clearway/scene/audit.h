@@ -26,6 +26,8 @@ struct AuditOptions {
   double warn_fraction = 0.01;
   /// A pair left checked that collides in more than this fraction of the samples gets a warning.
   double most_fraction = 0.5;
+  /// Threads to sample on, at most maxAuditThreads() (more are capped to it); fewer run when the system
+  /// cannot start them all, with the same audit: it depends on the capped count alone.
   int threads = 2;
   Tolerances tolerances = {};
   /// Called from the calling thread with (samples done, samples in all) about every 1% of a run and once
@@ -50,6 +52,9 @@ struct PairAudit {
   /// warn_fraction of the samples, or a checked pair that collides in more than most_fraction.
   std::string warning;
 };
+
+/// The most threads an audit runs on: 4 per hardware thread, at most 256.
+int maxAuditThreads();
 
 /// The 95% one-sided Clopper–Pearson upper bound on p after k successes in n trials (1 when n = 0).
 double clopperPearsonUpper(int k, int n);
