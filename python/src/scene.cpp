@@ -14,7 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <map>
+#include <list>
 #include <memory>
 #include <mutex>
 #include <tuple>
@@ -24,24 +24,37 @@ namespace clearway::python {
 namespace {
 
 // The scene Python holds, and the motion checkers made for it (one per mode and contact distance: a
-// checker's construction measures the robot, too dear to repeat per call).
+// checker's construction measures the robot, too dear to repeat per call). The most recently used few
+// are kept: a caller sweeping 20,000 contact distances kept 20,000 checkers (788 MB).
 class PyScene {
  public:
   explicit PyScene(std::shared_ptr<const Scene> s) : scene(std::move(s)) {}
   std::shared_ptr<const Scene> scene;
 
-  /// The checker for these options (finite: motionOptions checks them, and a NaN key would break the map).
-  const MotionChecker& checker(const MotionOptions& options) {
+  /// The checker for these options (finite: motionOptions checks them, so keys compare exactly); the
+  /// caller's handle keeps it alive however many others are asked for meanwhile.
+  std::shared_ptr<const MotionChecker> checker(const MotionOptions& options) {
     const auto key = std::make_tuple(static_cast<int>(options.mode), options.resolution, options.contact_distance);
     std::lock_guard<std::mutex> lock(mutex_);
-    auto it = checkers_.find(key);
-    if (it == checkers_.end()) it = checkers_.emplace(key, std::make_unique<const MotionChecker>(scene, options)).first;
-    return *it->second;
+    auto it = std::find_if(checkers_.begin(), checkers_.end(), [&](const auto& c) { return c.first == key; });
+    if (it == checkers_.end()) {
+      if (checkers_.size() >= kKept) checkers_.pop_back();
+      checkers_.emplace_front(key, std::make_shared<const MotionChecker>(scene, options));
+    } else {
+      checkers_.splice(checkers_.begin(), checkers_, it);
+    }
+    return checkers_.front().second;
+  }
+  /// How many checkers are kept (at most kKept).
+  std::size_t kept() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return checkers_.size();
   }
 
  private:
+  static constexpr std::size_t kKept = 8;
   std::mutex mutex_;
-  std::map<std::tuple<int, double, double>, std::unique_ptr<const MotionChecker>> checkers_;
+  std::list<std::pair<std::tuple<int, double, double>, std::shared_ptr<const MotionChecker>>> checkers_;  // newest first
 };
 
 // A scene over an edited environment, for Python.
@@ -156,6 +169,9 @@ void bindScene(py::module_& m) {
         return out;
       }, "(dof, 2) array of each entry's lower and upper limit (+-inf when unbounded).")
       .def_property_readonly("effects", [](const PyScene& s) { return s.scene->effects(); }, "What the scene checks.")
+      .def_property_readonly("motion_checkers_kept", [](PyScene& s) { return s.kept(); },
+                             "How many motion checkers (one per mode, resolution and contact distance asked) the "
+                             "scene keeps: the 8 most recently used.")
       .def_property_readonly("warnings", [](const PyScene& s) {
         std::vector<std::string> all = s.scene->description().warnings;
         const std::vector<std::string>& robot = s.scene->robot().loadWarnings();
@@ -267,7 +283,8 @@ void bindScene(py::module_& m) {
              requireRows(Q1, "Q1", scene.dimension());
              if (Q0.shape(0) != Q1.shape(0))
                throw py::value_error("Q0 and Q1 must have as many rows, got " + shapeText(Q0) + " and " + shapeText(Q1));
-             const MotionChecker& checker = s.checker(motionOptions(mode, contact_distance));
+             const std::shared_ptr<const MotionChecker> held = s.checker(motionOptions(mode, contact_distance));
+             const MotionChecker& checker = *held;
              const py::ssize_t n = Q0.shape(0), dof = scene.dimension();
              const std::vector<double> t = batchTimes(times, n, 2);
              py::array_t<bool> free(n);

@@ -148,3 +148,15 @@ def test_timed_motions_equal_the_tools_timed_lines(rising_plate, tool, tmp_path)
     free, last_valid = scene.check_motions(still, still, times=[[0, 1]])
     assert not free[0] and 0.47 < last_valid[0] <= 0.479
     assert scene.check_motions(still, still)[0][0]  # without times, at t = 0 throughout
+
+
+def test_checkers_of_many_contact_distances_are_not_all_kept(arm6):
+    # A checker per distinct contact distance was kept for the scene's life: a sweep of 20,000 distances
+    # held 788 MB. Only the most recently used 8 are kept; the verdicts are those of a fresh checker.
+    q0, q1 = free_starts(arm6, 2, seed=17)
+    expected, _ = arm6.check_motions(q0, q1, contact_distance=1e-3)
+    for k in range(12):
+        arm6.check_motions(q0, q1, contact_distance=2e-3 + k * 1e-7)
+    assert arm6.motion_checkers_kept == 8
+    again, _ = arm6.check_motions(q0, q1, contact_distance=1e-3)
+    assert (again == expected).all()

@@ -89,7 +89,7 @@ def test_invalid_states_raise_naming_row_and_joint(arm6):
         arm6.check(states)
     states[7, 2] = 0.0
     states[4, 0] = 100.0
-    with pytest.raises(ValueError, match=r"Q\[4\]: state\[0\] \(shoulder_pan_joint\) = 100.0+ is outside"):
+    with pytest.raises(ValueError, match=r"Q\[4\]: state\[0\] \(shoulder_pan_joint\) = 100 is outside \["):
         arm6.check(states)
     with pytest.raises(ValueError, match=r"q\[0\]: state\[5\] \(wrist_3_joint\) is not finite"):
         arm6.is_free([0, 0, 0, 0, 0, math.inf])

@@ -327,9 +327,9 @@ Subcommand addAuditCommand(CLI::App& root) {
   addSeedOption(*app, s->options.seed, "the sampler's seed")->capture_default_str();
   app->add_option("--threads", s->options.threads, "threads (default: one per hardware thread)")
       ->check(wholeNumber(1, 1024));
-  app->add_option("--srdf-out", s->srdf_out, "write the SRDF here (- for stdout)")->type_name("FILE|-");
+  app->add_option("--srdf-out", s->srdf_out, "write the SRDF here (- for stdout)")->check(fileName())->type_name("FILE|-");
   app->add_option("--report", s->report, "write a Markdown report here, and its heat map beside it")
-      ->type_name("FILE");
+      ->check(fileName())->type_name("FILE");
   addLoadOptions(*app, s->load);
   app->footer(std::string(kAuditHelp) + kFormatsHelp);
   return {app, [s] { return runAudit(*s); }};

@@ -158,6 +158,11 @@ CLI::Validator wholeNumber(long long lo, long long hi) {
       "in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
 }
 
+CLI::Validator fileName() {
+  return CLI::Validator([](std::string& v) { return v.empty() ? std::string("needs a file name, got ''") : std::string(); },
+                        "FILE");
+}
+
 CLI::Validator numberAbove(double above, double at_most) {
   std::ostringstream bound;
   bound << "> " << above;

@@ -39,6 +39,9 @@ void addLoadOptions(CLI::App& app, LoadOptions& load);
 /// Accepts a whole number in [lo, hi] and names the range when it rejects one.
 CLI::Validator wholeNumber(long long lo, long long hi);
 
+/// Accepts a non-empty file name: "" would name no file, and the output would silently go nowhere.
+CLI::Validator fileName();
+
 /// Accepts a finite number above `above` and at most `at_most`, and names the range when it rejects one.
 CLI::Validator numberAbove(double above, double at_most = HUGE_VAL);
 

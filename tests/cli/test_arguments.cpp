@@ -176,6 +176,9 @@ TEST(Arguments, BadArgumentsNameTheOptionAndTheReason) {
       {"check " + kScene + " --states", "--states"},
       {"check " + kScene + " --package-path /nonexistent/folder", "/nonexistent/folder: folder not found"},
       {"audit " + kUrdf + " --samples 0", "--samples: needs a whole number from 1 to 100000000, got '0'"},
+      // An empty report name wrote nothing and exited 0.
+      {"audit " + kUrdf + " --samples 10 --report ''", "--report: needs a file name, got ''"},
+      {"audit " + kUrdf + " --samples 10 --srdf-out ''", "--srdf-out: needs a file name, got ''"},
       {"bench --count=x", "--count: needs a whole number"},
       {"bench --shard 2/2", "--shard: '2/2'"},
       {"query a b", "b"},
