@@ -48,7 +48,7 @@ std::shared_ptr<const RobotGeometry> loadRobotGeometry(const SceneDescription& d
       const std::string key = "robot.attached[" + std::to_string(i) + "]";
       const auto link = [&](const std::string& name, const std::string& k) {
         const int l = robot.linkIndex(name);
-        if (l < 0) throw LoadError(d.file, "key '" + k + "'", "link '" + name + "' is not in robot '" + robot.name() + "'");
+        if (l < 0) throw LoadError(d.file, "key '" + k + "'", "link '" + inputExcerpt(name) + "' is not in robot '" + inputExcerpt(robot.name()) + "'");
         return l;
       };
       AttachedBody b;
@@ -138,13 +138,13 @@ void Scene::init() {
     const std::string key = "robot.group[" + std::to_string(i) + "]";
     const std::string& name = description_.group[i];
     const int j = model.jointIndex(name);
-    if (j < 0) fail(key, "joint '" + name + "' is not in robot '" + model.name() + "' (" + description_.urdf + ")");
+    if (j < 0) fail(key, "joint '" + inputExcerpt(name) + "' is not in robot '" + inputExcerpt(model.name()) + "' (" + description_.urdf + ")");
     const Joint& joint = model.joint(j);
     if (joint.first_variable < 0)
-      fail(key, "joint '" + name + "' is " + (joint.isMimic() ? "a mimic" : "fixed") + ": it has no value to plan");
+      fail(key, "joint '" + inputExcerpt(name) + "' is " + (joint.isMimic() ? "a mimic" : "fixed") + ": it has no value to plan");
     for (int k = 0; k < jointVariableCount(joint.type); ++k) {
       const int v = joint.first_variable + k;
-      if (taken[v]) fail(key, "joint '" + name + "' is listed twice");
+      if (taken[v]) fail(key, "joint '" + inputExcerpt(name) + "' is listed twice");
       taken[v] = 1;
       group_variables_.push_back(v);
     }
@@ -162,11 +162,11 @@ void Scene::init() {
     upper_.push_back(model.variables()[v].upper);
   }
   for (const auto& [name, range] : description_.bounds) {
-    const std::string key = "robot.bounds." + name;
+    const std::string key = "robot.bounds." + inputExcerpt(name);
     const int v = model.variableIndex(name);
     const auto it = std::find(group_variables_.begin(), group_variables_.end(), v);
     if (v < 0 || it == group_variables_.end())
-      fail(key, "'" + name + "' is not a variable of the group (planar and floating joints name theirs joint/x, joint/y, ...)");
+      fail(key, "'" + inputExcerpt(name) + "' is not a variable of the group (planar and floating joints name theirs joint/x, joint/y, ...)");
     const std::size_t i = static_cast<std::size_t>(it - group_variables_.begin());
     const auto [lo, hi] = range;
     if (!std::isfinite(lo) || !std::isfinite(hi) || !(lo < hi)) fail(key, "expected finite [lower, upper] with lower < upper");
@@ -184,13 +184,13 @@ void Scene::init() {
   }
   std::vector<std::pair<int, double>> mimic_holds;
   for (const auto& [name, value] : description_.hold) {
-    const std::string key = "robot.hold." + name;
+    const std::string key = "robot.hold." + inputExcerpt(name);
     const int j = model.jointIndex(name);
-    if (j < 0) fail(key, "joint '" + name + "' is not in robot '" + model.name() + "'");
+    if (j < 0) fail(key, "joint '" + inputExcerpt(name) + "' is not in robot '" + inputExcerpt(model.name()) + "'");
     const Joint& joint = model.joint(j);
     if (joint.type == JointType::Fixed) {
       // A fixed joint has no value; MoveIt's converters still list it at 0, which says nothing.
-      if (value != 0.0) fail(key, "joint '" + name + "' is fixed: it cannot be held at " + std::to_string(value));
+      if (value != 0.0) fail(key, "joint '" + inputExcerpt(name) + "' is fixed: it cannot be held at " + std::to_string(value));
       continue;
     }
     if (joint.isMimic()) {
@@ -198,8 +198,8 @@ void Scene::init() {
       continue;
     }
     if (joint.first_variable < 0 || jointVariableCount(joint.type) != 1)
-      fail(key, "joint '" + name + "' does not have exactly one value to hold");
-    if (taken[joint.first_variable]) fail(key, "joint '" + name + "' is in the group: it cannot also be held");
+      fail(key, "joint '" + inputExcerpt(name) + "' does not have exactly one value to hold");
+    if (taken[joint.first_variable]) fail(key, "joint '" + inputExcerpt(name) + "' is in the group: it cannot also be held");
     base_q_[joint.first_variable] = value;  // without clamping, as MoveIt applies a held state
   }
   // A mimic joint follows its leader; a held value for it is accepted when it says the same.
@@ -226,8 +226,8 @@ void Scene::init() {
     const auto& [a, b] = description_.allow[i];
     const std::string key = "robot.allow[" + std::to_string(i) + "]";
     const int la = model.linkIndex(a), lb = model.linkIndex(b);
-    if (la < 0) fail(key, "link '" + a + "' is not in robot '" + model.name() + "'");
-    if (lb < 0) fail(key, "link '" + b + "' is not in robot '" + model.name() + "'");
+    if (la < 0) fail(key, "link '" + a + "' is not in robot '" + inputExcerpt(model.name()) + "'");
+    if (lb < 0) fail(key, "link '" + b + "' is not in robot '" + inputExcerpt(model.name()) + "'");
     if (la == lb) fail(key, "a link paired with itself");
     filter_.disable(la, lb, "allowed by scene");
   }
@@ -325,7 +325,7 @@ std::shared_ptr<const Scene> Scene::withAttached(const SceneDescription::Attache
   const std::string& name = spec.body.name;
   const auto link = [&](const std::string& l) {
     const int i = model.linkIndex(l);
-    if (i < 0) throw std::invalid_argument("attach '" + name + "': robot '" + model.name() + "' has no link '" + l + "'");
+    if (i < 0) throw std::invalid_argument("attach '" + inputExcerpt(name) + "': robot '" + inputExcerpt(model.name()) + "' has no link '" + inputExcerpt(l) + "'");
     return i;
   };
   AttachedBody b;
@@ -341,7 +341,7 @@ std::shared_ptr<const Scene> Scene::withAttached(const SceneDescription::Attache
     try {
       meshes.push_back(loadMesh(spec.body.mesh_file, spec.body.mesh_scale, nullptr, load.mesh));
     } catch (const std::exception& e) {
-      throw std::invalid_argument("attach '" + name + "': " + e.what());
+      throw std::invalid_argument("attach '" + inputExcerpt(name) + "': " + e.what());
     }
   }
   auto held = std::make_shared<const RobotModel>(attachBodies(model, {b}, meshes));

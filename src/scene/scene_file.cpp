@@ -27,7 +27,7 @@ class Parser {
       : file_(std::move(name)), base_(std::move(base)), text_(text) {}
 
   [[noreturn]] void fail(const std::string& key, const std::string& reason) const {
-    throw LoadError(file_, key.empty() ? "" : "key '" + key + "'", reason);
+    throw LoadError(file_, key.empty() ? "" : "key '" + inputExcerpt(key, 120) + "'", reason);
   }
   std::string where(const YAML::Node& n) const {
     const YAML::Mark m = n.Mark();
@@ -69,7 +69,7 @@ class Parser {
   double length(const YAML::Node& n, const std::string& key) const {
     const double v = number(n, key);
     if (std::abs(v) > kMaxInputLength)
-      fail(key, "'" + n.Scalar() + "' m is beyond the largest length an input may give (1e6 m)" + where(n));
+      fail(key, "'" + inputExcerpt(n.Scalar()) + "' m is beyond the largest length an input may give (1e6 m)" + where(n));
     return v;
   }
   // A size in metres: a length ≥ 0 (> 0 unless zero is allowed). One in (0, kMinInputLength), below
@@ -78,10 +78,10 @@ class Parser {
   double size(const YAML::Node& n, const std::string& key, bool zero_allowed) const {
     const double v = length(n, key);
     if (v < 0.0 || (v == 0.0 && !zero_allowed))
-      fail(key, "'" + n.Scalar() + "' m: a size must be " + (zero_allowed ? ">= 0" : "> 0") + where(n));
+      fail(key, "'" + inputExcerpt(n.Scalar()) + "' m: a size must be " + (zero_allowed ? ">= 0" : "> 0") + where(n));
     if (v > 0.0 && v < kMinInputLength) {
       warnings_.push_back(LoadError::format(file_, "key '" + key + "'",
-                                            "'" + n.Scalar() + "' m is below the smallest size Clearway computes "
+                                            "'" + inputExcerpt(n.Scalar()) + "' m is below the smallest size Clearway computes "
                                             "with (1e-9 m): checked as 1e-9 m" + where(n)));
       return kMinInputLength;
     }
@@ -103,7 +103,7 @@ class Parser {
   double number(const YAML::Node& n, const std::string& key) const {
     if (!n.IsScalar()) fail(key, "expected a number" + where(n));
     double v = 0.0;
-    const std::string s = n.Scalar();
+    const std::string s = inputExcerpt(n.Scalar());  // (a 'number' may be a megabyte of text)
     // yaml-cpp reads ".nan" and ".inf"; a plain "nan" too. Either way: not a usable number.
     if (!YAML::convert<double>::decode(n, v)) fail(key, "'" + s + "' is not a number" + where(n));
     if (!std::isfinite(v)) fail(key, "'" + s + "' is not a finite number" + where(n));
@@ -239,7 +239,7 @@ class Parser {
     d.file = file_;
     requireMap(root, "", {"format", "name", "source", "package_paths", "robot", "environment", "checks", "start", "goal"});
     if (!root["format"]) fail("format", "missing (this reader knows format 1)");
-    if (number(root["format"], "format") != 1.0) fail("format", "unsupported format " + root["format"].Scalar() + " (this reader knows 1)");
+    if (number(root["format"], "format") != 1.0) fail("format", "unsupported format " + inputExcerpt(root["format"].Scalar()) + " (this reader knows 1)");
     d.name = root["name"] ? text(root["name"], "name") : text_ ? std::string("scene") : fs::path(file_).stem().string();
 
     if (const YAML::Node p = root["package_paths"]; p && !p.IsNull()) {

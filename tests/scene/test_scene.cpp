@@ -147,6 +147,27 @@ TEST(SceneFile, BadInputNamesFileAndKey) {
   EXPECT_TRUE(parseSceneFile(same).effects.environment);
 }
 
+// Text quoted from a scene file is cut to a few dozen characters: a 100 KB "number" or joint name made
+// each error a 100 KB line (twice, with the key).
+TEST(SceneFile, ErrorsQuoteAFewDozenCharactersOfTheInput) {
+  TempDir dir;
+  const std::string long_text(100000, '7');
+  const std::string name(100000, 'j');
+  for (const std::string& text : {planarScene("[self]", "    - {name: w, box: {size: [0.1, 2, " + long_text + "x]}}\n"),
+                                  // (Explicit keys: YAML limits implicit ones to 1024 characters.)
+                                  planarScene("[self]", "", "  hold:\n    ? " + name + "\n    : 0\n"),
+                                  planarScene("[self]", "", "  bounds:\n    ? " + name + "\n    : [0, 1]\n")}) {
+    const std::string path = dir.write("long.yaml", text);
+    try {
+      Scene::load(path);
+      ADD_FAILURE() << "loaded";
+    } catch (const LoadError& e) {
+      EXPECT_LT(std::string(e.what()).size(), 400u) << std::string(e.what()).substr(0, 400);
+      EXPECT_NE(std::string(e.what()).find("..."), std::string::npos) << std::string(e.what()).substr(0, 400);
+    }
+  }
+}
+
 TEST(SceneFile, PackagePathsAreFoldersRelativeToTheSceneFile) {
   TempDir dir;
   // Two packages named my_robot: a tetrahedron of size 1 in ws/, of size 2 in other/.
