@@ -1,10 +1,6 @@
 // MotionBound: the per-link and per-pair coefficients of the motion bound, static and from the axes now.
 #include <clearway/motion/motion.h>
 
-#include <clearway/kinematics/forward_kinematics.h>
-#include <clearway/narrowphase/gjk.h>
-#include <clearway/narrowphase/ray_cast.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>

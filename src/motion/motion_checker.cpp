@@ -2,10 +2,6 @@
 // choice of mode.
 #include <clearway/motion/motion.h>
 
-#include <clearway/kinematics/forward_kinematics.h>
-#include <clearway/narrowphase/gjk.h>
-#include <clearway/narrowphase/ray_cast.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>

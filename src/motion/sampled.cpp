@@ -1,10 +1,6 @@
 // Sampled mode: states at a fixed resolution, as OMPL's DiscreteMotionValidator (may tunnel).
 #include <clearway/motion/motion.h>
 
-#include <clearway/kinematics/forward_kinematics.h>
-#include <clearway/narrowphase/gjk.h>
-#include <clearway/narrowphase/ray_cast.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
