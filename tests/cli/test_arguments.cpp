@@ -18,7 +18,6 @@ using clearway_test::ToolRun;
 
 namespace {
 
-#define EXPECT_MENTIONS(text, key) EXPECT_NE((text).find(key), std::string::npos) << "\"" << (text) << "\" should name " << (key)
 
 std::string source(const std::string& rel) { return "'" + std::string(CLEARWAY_SOURCE_DIR) + "/" + rel + "'"; }
 const std::string kScene = source("robots/scenes/arm6_wall.yaml");

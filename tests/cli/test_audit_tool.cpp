@@ -25,7 +25,6 @@ using clearway_test::ToolRun;
 
 namespace {
 
-#define EXPECT_MENTIONS(text, key) EXPECT_NE((text).find(key), std::string::npos) << "\"" << (text) << "\" should name " << (key)
 
 std::string q(const std::string& path) { return "'" + path + "'"; }
 

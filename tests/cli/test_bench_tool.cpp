@@ -25,7 +25,6 @@ using namespace clearway_test;
 
 namespace {
 
-#define EXPECT_MENTIONS(text, key) EXPECT_NE((text).find(key), std::string::npos) << "\"" << (text) << "\" should name " << (key)
 
 // The shared scenes when present; when CI=true they must be (the tests that use them fail otherwise).
 bool haveSharedScenes() { return fs::is_directory(clearway::test::sharedDir() + "/scenes") || clearway::test::sharedDataRequired(); }

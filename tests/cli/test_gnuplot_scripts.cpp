@@ -22,7 +22,6 @@ using clearway_test::ToolRun;
 
 namespace {
 
-#define EXPECT_MENTIONS(text, key) EXPECT_NE((text).find(key), std::string::npos) << "\"" << (text) << "\" should name " << (key)
 
 // `s` as one word for the shell the tool is run through.
 std::string shellWord(const std::string& s) {

@@ -58,8 +58,6 @@ double distanceOf(const std::string& shape_a, const std::string& position_b, con
   return ok(pair("distance", body(shape_a), body(shape_b, position_b)))["distance"].get<double>();
 }
 
-#define EXPECT_MENTIONS(text, key) EXPECT_NE((text).find(key), std::string::npos) << "error \"" << (text) << "\" should name " << (key)
-
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------

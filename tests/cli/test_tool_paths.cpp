@@ -18,7 +18,6 @@ using clearway_test::ToolRun;
 
 namespace {
 
-#define EXPECT_MENTIONS(text, key) EXPECT_NE((text).find(key), std::string::npos) << "\"" << (text) << "\" should name " << (key)
 
 // Runs `tool args` (the tool at any path) as runTool runs the built one.
 ToolRun runAt(const std::string& tool, const std::string& args) {

@@ -10,6 +10,9 @@
 #include <string>
 #include <sys/wait.h>
 
+/// Expects `text` to contain `key`, showing the whole text when it does not.
+#define EXPECT_MENTIONS(text, key) EXPECT_NE((text).find(key), std::string::npos) << "\"" << (text) << "\" should name " << (key)
+
 namespace clearway_test {
 struct ToolRun {
   int exit_code;
