@@ -1,7 +1,7 @@
 // Cores: balls certainly inside a link's solids. Two bodies whose cores overlap share interior points, so
 // they collide at any padding: one distance comparison decides what the exact triangles would spend many
 // box and triangle tests on (deeply interpenetrating links, a link deep in an obstacle). A mesh core's
-// centre is inside a closed piece by ray parity along three directions that all decide, and its radius
+// centre is inside the solids (not in a cavity) along three ray directions that all decide, and its radius
 // stays below the centre's distance to every triangle of the link, so the ball crosses no surface: being
 // connected, it lies inside. Primitives are solids, and their cores are inscribed balls.
 #include <clearway/body/link_geometry.h>
@@ -109,7 +109,7 @@ void LinkGeometry::findCores() {
     const Aabb& box = solid_boxes_[s];
     const double share = volume > 0.0 ? box.extents().prod() / volume : 1.0;
     const int grid = std::clamp(static_cast<int>(std::cbrt(kCandidates * share)), 2, 6);
-    const auto inside = [&](const Vec3& p) { return surelyInside(s, p); };
+    const auto inside = [&](const Vec3& p) { return surelyInside(p); };
     std::vector<Ball> mine;
     for (int i = 0; i < grid; ++i)
       for (int j = 0; j < grid; ++j)

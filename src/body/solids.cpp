@@ -1,16 +1,31 @@
-// Closed meshes as solids: which pieces of a link's triangles are closed, and whether a point lies inside
-// one (ray parity). A piece is closed when every edge of it, its vertices welded by exact coordinates, is
-// shared by an even number of its triangles: the surface is then a cycle mod 2, and a ray from a point not
-// on it crosses it an odd number of times exactly when the point is inside (Jordan–Brouwer). A ray that
-// passes within rounding of an edge, a vertex or a triangle's plane could count a crossing twice or not at
-// all: such a ray is dropped and the next of a fixed set of directions is tried; when all are dropped, the
-// point counts as inside (never "outside" by accident).
+// Closed meshes as solids: which triangles of a link form closed shells, and whether a point lies inside
+// them (ray crossings). Vertices are welded by exact coordinates. A shell is the triangles joined across
+// edges that exactly two of them share, so shells touching at a corner or along an edge stay apart (one
+// piece of both would count a nested shell's inside as outside by parity). A shell is closed when every
+// edge of it is shared by an even number of its triangles: the surface is then a cycle mod 2, and a ray
+// from a point not on it crosses it an odd number of times exactly when the point is inside
+// (Jordan–Brouwer). Shells open on their own that close together (through edges of four triangles) are
+// joined by shared vertices and tested again. A closed shell whose every edge runs as often one way as
+// the other is wound: its crossings, signed, sum to its winding number (+1 inside an outward shell, −1
+// inside an inward one).
+//
+// When wound shells of both windings nest as one solid (an outer surface, cavities within its material,
+// solids within the cavities), the winding numbers summed over them decide, so a cavity is empty. The
+// nesting is checked at each triangle's centre, where the other shells' winding number must be 0 for a
+// shell wound as the whole (it bounds material from outside) and the whole's for a shell wound against
+// it (a cavity lies in material). Otherwise (a turned part crossing another, say) a point is inside when
+// it is inside any shell on its own: never free by accident.
+//
+// A ray that passes within rounding of an edge, a vertex or a triangle's plane could count a crossing
+// twice or not at all: such a ray is dropped and the next of a fixed set of directions is tried; when all
+// are dropped, the point counts as inside (never "outside" by accident).
 #include <clearway/body/link_geometry.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <numeric>
+#include <utility>
 
 namespace clearway {
 namespace {
@@ -31,6 +46,9 @@ const Vec3& rayDirection(int i) noexcept {
 // is not decided by rounding; far above double's rounding of the triple products involved.
 constexpr double kEdgeMargin = 1e-9;
 constexpr double kParallelMargin = 1e-9;
+// A shell's signed volume below this fraction of the sum of its tetrahedra's absolute volumes gives it no
+// winding (a sheet seen from both sides); far above the rounding of the sum.
+constexpr double kFlatVolume = 1e-6;
 
 struct Dsu {
   std::vector<std::int32_t> parent;
@@ -40,6 +58,13 @@ struct Dsu {
     return x;
   }
   void join(std::int32_t a, std::int32_t b) { parent[find(a)] = find(b); }
+};
+
+// One use of a welded edge (lower id in the high half) by a triangle, +1 when it runs from the lower id.
+struct EdgeUse {
+  std::uint64_t key;
+  std::int32_t triangle;
+  std::int32_t dir;
 };
 
 }  // namespace
@@ -63,53 +88,162 @@ void LinkGeometry::findSolids() {
     id[order[k]] = ids;
   }
   if (n > 0) ++ids;
-  // Pieces: vertices joined by triangles.
-  Dsu pieces(static_cast<std::size_t>(ids));
-  for (std::size_t t = 0; t < n; ++t) {
-    pieces.join(id[3 * t], id[3 * t + 1]);
-    pieces.join(id[3 * t], id[3 * t + 2]);
+  // Probes: one vertex per piece of triangles joined by shared vertices (each lies wholly inside or
+  // outside another body's solids while the surfaces do not meet).
+  {
+    Dsu pieces(static_cast<std::size_t>(ids));
+    for (std::size_t t = 0; t < n; ++t) {
+      pieces.join(id[3 * t], id[3 * t + 1]);
+      pieces.join(id[3 * t], id[3 * t + 2]);
+    }
+    std::vector<char> probed(static_cast<std::size_t>(ids), 0);
+    for (std::size_t t = 0; t < n; ++t) {
+      const std::int32_t root = pieces.find(id[3 * t]);
+      if (!probed[root]) {
+        probed[root] = 1;
+        probes_.push_back(triangles_[t].v[0]);
+      }
+    }
   }
-  // Edges (welded, unordered) and how many triangles share each; a piece with an odd count is open.
-  std::vector<std::uint64_t> edges;
-  edges.reserve(3 * n);
-  for (std::size_t t = 0; t < n; ++t)
+  // Edge uses. A triangle with two welded corners equal has no area and its edges cancel in pairs: it
+  // belongs to no shell (and stays a surface).
+  std::vector<char> flat(n, 0);
+  std::vector<EdgeUse> uses;
+  uses.reserve(3 * n);
+  for (std::size_t t = 0; t < n; ++t) {
+    const std::int32_t* c = &id[3 * t];
+    if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) {
+      flat[t] = 1;
+      continue;
+    }
     for (int e = 0; e < 3; ++e) {
-      const std::uint32_t a = static_cast<std::uint32_t>(id[3 * t + e]);
-      const std::uint32_t b = static_cast<std::uint32_t>(id[3 * t + (e + 1) % 3]);
-      if (a != b) edges.push_back((static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b));
+      const std::uint32_t a = static_cast<std::uint32_t>(c[e]), b = static_cast<std::uint32_t>(c[(e + 1) % 3]);
+      uses.push_back({(static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b),
+                      static_cast<std::int32_t>(t), a < b ? 1 : -1});
     }
-  std::sort(edges.begin(), edges.end());
-  std::vector<char> open(static_cast<std::size_t>(ids), 0);
-  for (std::size_t i = 0; i < edges.size();) {
-    std::size_t j = i;
-    while (j < edges.size() && edges[j] == edges[i]) ++j;
-    if ((j - i) % 2 != 0) open[pieces.find(static_cast<std::int32_t>(edges[i] >> 32))] = 1;
-    i = j;
   }
-  // Number the closed pieces; one probe (a vertex) per piece, closed or not.
-  std::vector<std::int32_t> number(static_cast<std::size_t>(ids), -1);
-  std::vector<char> probed(static_cast<std::size_t>(ids), 0);
-  for (std::size_t t = 0; t < n; ++t) {
-    const std::int32_t root = pieces.find(id[3 * t]);
-    if (!probed[root]) {
-      probed[root] = 1;
-      probes_.push_back(triangles_[t].v[0]);
+  std::sort(uses.begin(), uses.end(),
+            [](const EdgeUse& x, const EdgeUse& y) { return x.key < y.key || (x.key == y.key && x.triangle < y.triangle); });
+  const auto forEachEdge = [&](auto&& f) {
+    for (std::size_t i = 0; i < uses.size();) {
+      std::size_t j = i;
+      while (j < uses.size() && uses[j].key == uses[i].key) ++j;
+      f(i, j);
+      i = j;
     }
+  };
+  // Shells: triangles joined across edges that exactly two of them use.
+  Dsu shells(n);
+  forEachEdge([&](std::size_t i, std::size_t j) {
+    if (j - i == 2) shells.join(uses[i].triangle, uses[i + 1].triangle);
+  });
+  // Per shell (its root): open when an edge is used an odd number of times in it, unwound when an edge's
+  // uses in it do not run once each way as often.
+  std::vector<char> open(n), unwound(n);
+  const auto classify = [&] {
+    std::fill(open.begin(), open.end(), 0);
+    std::fill(unwound.begin(), unwound.end(), 0);
+    std::vector<std::pair<std::int32_t, std::int32_t>> mine;  // (shell, direction) of one edge's uses
+    forEachEdge([&](std::size_t i, std::size_t j) {
+      mine.clear();
+      for (std::size_t k = i; k < j; ++k) mine.emplace_back(shells.find(uses[k].triangle), uses[k].dir);
+      std::sort(mine.begin(), mine.end());
+      for (std::size_t a = 0; a < mine.size();) {
+        std::size_t b = a;
+        int sum = 0;
+        for (; b < mine.size() && mine[b].first == mine[a].first; ++b) sum += mine[b].second;
+        if ((b - a) % 2 != 0) open[mine[a].first] = 1;
+        if (sum != 0) unwound[mine[a].first] = 1;
+        a = b;
+      }
+    });
+  };
+  classify();
+  // Shells open on their own may close together (pieces meeting along edges of four triangles): join
+  // their triangles by shared vertices, as pieces, and classify again. Every closed piece of triangles
+  // joined by vertices thus stays closed, split into closed shells where it can be.
+  {
+    std::vector<char> was_open(n, 0);
+    bool any = false;
+    for (std::size_t t = 0; t < n; ++t)
+      if (!flat[t] && open[shells.find(static_cast<std::int32_t>(t))]) was_open[t] = 1, any = true;
+    if (any) {
+      std::vector<std::int32_t> first(static_cast<std::size_t>(ids), -1);
+      for (std::size_t t = 0; t < n; ++t) {
+        if (!was_open[t]) continue;
+        for (int k = 0; k < 3; ++k) {
+          std::int32_t& f = first[id[3 * t + k]];
+          if (f < 0) f = static_cast<std::int32_t>(t);
+          else shells.join(static_cast<std::int32_t>(t), f);
+        }
+      }
+      classify();
+    }
+  }
+  // Number the closed shells.
+  std::vector<std::int32_t> number(n, -1);
+  for (std::size_t t = 0; t < n; ++t) {
+    if (flat[t]) continue;
+    const std::int32_t root = shells.find(static_cast<std::int32_t>(t));
     if (open[root]) continue;
     if (number[root] < 0) {
       number[root] = static_cast<std::int32_t>(solid_boxes_.size());
       solid_boxes_.emplace_back();
+      solid_sign_.push_back(unwound[root] ? 0 : 1);
     }
     solid_of_[t] = number[root];
     for (const Vec3& v : triangles_[t].v) solid_boxes_[number[root]].grow(v);
   }
-  if (solid_boxes_.empty()) solid_of_.clear();
   // A primitive's core point lies in it (spheres and capsules: the centre or the axis).
   for (const Primitive& p : primitives_)
     probes_.push_back(std::visit([&](const auto& s) { return p.pose * s.support(Vec3::UnitX()); }, p.shape));
+  if (solid_boxes_.empty()) {
+    solid_of_.clear();
+    return;
+  }
+  // Windings: the sign of each wound shell's volume (about its box's centre, for rounding).
+  const std::size_t shell_count = solid_boxes_.size();
+  std::vector<double> volume(shell_count, 0.0), scale(shell_count, 0.0);
+  for (std::size_t t = 0; t < n; ++t) {
+    const std::int32_t s = solid_of_[t];
+    if (s < 0 || solid_sign_[s] == 0) continue;
+    const Vec3 o = solid_boxes_[s].center();
+    const Vec3 a = triangles_[t].v[0] - o, b = triangles_[t].v[1] - o, c = triangles_[t].v[2] - o;
+    const double v = a.dot(b.cross(c));
+    volume[s] += v;
+    scale[s] += std::abs(v);
+  }
+  bool outward = false, inward = false;
+  double total = 0.0, total_scale = 0.0;
+  for (std::size_t s = 0; s < shell_count; ++s) {
+    if (solid_sign_[s] == 0) continue;
+    solid_sign_[s] = volume[s] > kFlatVolume * scale[s] ? 1 : volume[s] < -kFlatVolume * scale[s] ? -1 : 0;
+    outward |= solid_sign_[s] > 0;
+    inward |= solid_sign_[s] < 0;
+    if (solid_sign_[s] != 0) total += volume[s], total_scale += scale[s];
+  }
+  // Shells of one winding only never cancel: "inside any shell" is their winding number's answer too.
+  if (!outward || !inward) return;
+  const int solid = total > kFlatVolume * total_scale ? 1 : total < -kFlatVolume * total_scale ? -1 : 0;
+  if (solid == 0) return;
+  // Nesting: in front of each triangle lies the outside (winding 0), behind it the material (winding
+  // `solid`); a shell wound as the solid adds its 1 behind, one wound against it its −1 in front.
+  for (std::size_t t = 0; t < n; ++t) {
+    const std::int32_t s = solid_of_[t];
+    if (s < 0 || solid_sign_[s] == 0) continue;
+    const Triangle& tri = triangles_[t];
+    if (!((tri.v[1] - tri.v[0]).cross(tri.v[2] - tri.v[0]).norm() > 1e-300)) continue;  // no area, no side
+    const Vec3 centre = (tri.v[0] + tri.v[1] + tri.v[2]) / 3.0;
+    const int expected = solid_sign_[s] == solid ? 0 : solid;
+    int winding = 0;
+    bool decided = false;
+    for (int r = 0; r < kRays && !decided; ++r) decided = rayCrossings(kWound, s, centre, rayDirection(r), winding);
+    if (!decided || winding != expected) return;
+  }
+  nested_ = true;
 }
 
-int LinkGeometry::rayParity(int s, const Vec3& p, const Vec3& dir) const noexcept {
+bool LinkGeometry::rayCrossings(int s, int skip, const Vec3& p, const Vec3& dir, int& winding) const noexcept {
   const Vec3 inv(1.0 / dir.x(), 1.0 / dir.y(), 1.0 / dir.z());
   const double grow = 1e-9 * (1.0 + p.cwiseAbs().maxCoeff() + bounding_radius_);  // (boxes' rounding)
   const auto reaches = [&](const Aabb& box) {
@@ -122,7 +256,7 @@ int LinkGeometry::rayParity(int s, const Vec3& p, const Vec3& dir) const noexcep
     }
     return !(lo > hi);  // (a NaN keeps the node)
   };
-  int crossings = 0;
+  winding = 0;
   const auto& nodes = tree_.nodes();
   std::int32_t stack[AabbTree::kMaxDepth + 1];
   int top = 0;
@@ -137,7 +271,9 @@ int LinkGeometry::rayParity(int s, const Vec3& p, const Vec3& dir) const noexcep
     }
     for (std::int32_t slot = node.first; slot < node.first + node.count; ++slot) {
       const std::int32_t t = tree_.items()[slot];
-      if (solid_of_[t] != s || !reaches(tree_.slotBoxes()[slot])) continue;
+      const std::int32_t piece = solid_of_[t];
+      if (s >= 0 ? piece != s : (piece < 0 || piece == skip || solid_sign_[piece] == 0)) continue;
+      if (!reaches(tree_.slotBoxes()[slot])) continue;
       const Vec3 a = triangles_[t].v[0] - p, b = triangles_[t].v[1] - p, c = triangles_[t].v[2] - p;
       const Vec3 normal = (b - a).cross(c - a);
       const double nn = normal.norm();
@@ -151,7 +287,7 @@ int LinkGeometry::rayParity(int s, const Vec3& p, const Vec3& dir) const noexcep
         // Beside it, the plane is crossed at t = |n·a| / |d·n| > max(|a|, |b|, |c|): past every vertex, so off
         // the triangle.
         const double reach = std::max({a.norm(), b.norm(), c.norm()});
-        if (std::abs(normal.dot(a)) <= kParallelMargin * nn * (reach + 1e-300)) return -1;
+        if (std::abs(normal.dot(a)) <= kParallelMargin * nn * (reach + 1e-300)) return false;
         continue;
       }
       const double la = wa / sum, lb = wb / sum, lc = wc / sum;
@@ -159,30 +295,53 @@ int LinkGeometry::rayParity(int s, const Vec3& p, const Vec3& dir) const noexcep
       const double along = normal.dot(a) / sum;  // the ray parameter of the plane
       const double near = 1e-12 * (a.norm() + b.norm() + c.norm());
       if (along < -near) continue;  // behind p
-      if (along <= near) return -1;  // p on the triangle (touching) or next to it
-      if (la <= kEdgeMargin || lb <= kEdgeMargin || lc <= kEdgeMargin) return -1;  // at an edge or vertex
-      ++crossings;
+      if (along <= near) return false;  // p on the triangle (touching) or next to it
+      if (la <= kEdgeMargin || lb <= kEdgeMargin || lc <= kEdgeMargin) return false;  // at an edge or vertex
+      winding += sum > 0.0 ? 1 : -1;  // leaving through the front, or entering
     }
   }
-  return crossings & 1;
+  return true;
+}
+
+int LinkGeometry::insideAlong(const Vec3& p, int r) const noexcept {
+  const Vec3& dir = rayDirection(r);
+  const double grow = 1e-9 * (1.0 + bounding_radius_);
+  bool undecided = false, wound = false;
+  for (int s = 0; s < solidCount(); ++s) {
+    const Aabb& box = solid_boxes_[s];
+    if ((p.array() < box.min.array() - grow).any() || (p.array() > box.max.array() + grow).any()) continue;
+    if (nested_ && solid_sign_[s] != 0) {
+      wound = true;  // summed over every wound shell below
+      continue;
+    }
+    int w = 0;
+    if (!rayCrossings(s, kWound, p, dir, w)) {
+      undecided = true;
+    } else if (solid_sign_[s] != 0 ? w != 0 : (w & 1) != 0) {
+      return 1;
+    }
+  }
+  if (wound) {
+    int w = 0;
+    if (!rayCrossings(kWound, kWound, p, dir, w)) return -1;
+    if (w != 0) return 1;
+  }
+  return undecided ? -1 : 0;
 }
 
 bool LinkGeometry::containsPoint(const Vec3& p) const noexcept {
   if (!p.allFinite()) return !solid_boxes_.empty();
-  for (int s = 0; s < solidCount(); ++s) {
-    const Aabb& box = solid_boxes_[s];
-    const double grow = 1e-9 * (1.0 + bounding_radius_);
-    if ((p.array() < box.min.array() - grow).any() || (p.array() > box.max.array() + grow).any()) continue;
-    int parity = -1;
-    for (int r = 0; r < kRays && parity < 0; ++r) parity = rayParity(s, p, rayDirection(r));
-    if (parity != 0) return true;  // inside, or undecided
+  if (solid_boxes_.empty()) return false;
+  for (int r = 0; r < kRays; ++r) {
+    const int inside = insideAlong(p, r);
+    if (inside >= 0) return inside == 1;
   }
-  return false;
+  return true;  // inside, or undecided
 }
 
-bool LinkGeometry::surelyInside(int s, const Vec3& p) const noexcept {
+bool LinkGeometry::surelyInside(const Vec3& p) const noexcept {
   for (int r = 0; r < 3; ++r)
-    if (rayParity(s, p, rayDirection(r)) != 1) return false;
+    if (insideAlong(p, r) != 1) return false;
   return true;
 }
 

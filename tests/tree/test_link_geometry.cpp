@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "box_surface.h"
 #include "shared_data.h"
 #include "tree/mesh_reference.h"
 
@@ -210,6 +211,69 @@ TEST(LinkGeometry, TouchingCountsAndSurfacesInsideDoNot) {
   EXPECT_TRUE(meshesIntersect(ring, id, pebble, Pose::translation(Vec3(0.5, 0, 0)), tol, GeometryMode::Mesh));
   EXPECT_TRUE(shapeIntersectsLink(Sphere(0.02), Pose::translation(Vec3(0, 0.5, 0)), ring, id, tol, GeometryMode::Mesh));
   EXPECT_FALSE(shapeIntersectsLink(Sphere(0.02), id, ring, id, tol, GeometryMode::Mesh));
+}
+
+// A box surface of half size h about the origin with its (−, −, −) corner pulled out to `corner`: it touches
+// a box of half size 0.5 there alone when `corner` is that box's corner. Outward triangles, or inward ones.
+TriangleMesh pulledBox(double h, const Vec3& corner, bool inward) {
+  TriangleMesh m = test::boxSurface(Vec3(h, h, h));
+  m.vertices[0] = corner;
+  if (inward)
+    for (auto& t : m.triangles) std::swap(t[1], t[2]);
+  return m;
+}
+
+// Issue 43: two nested closed shells sharing one corner were one piece, and its ray parity called the
+// inner shell's inside outside. Whether a point is inside must not depend on whether the shells touch;
+// the winding decides what lies between them (an inward inner shell bounds a cavity, which is empty).
+TEST(LinkGeometry, NestedShellsAreSolidHoweverTheyTouch) {
+  const Tolerances tol;
+  const Pose id = Pose::identity();
+  const TriangleMesh outer = test::boxSurface(Vec3(0.5, 0.5, 0.5));
+  const LinkGeometry pebble(tree_ref::uvSphere(0.02, 6, 8));
+  const Vec3 centre(0.02, 0.01, 0.0), wall(0.4, 0.35, 0.4), beyond(0.7, 0.0, 0.0);
+  // Whether the pebble (a sphere mesh, and a sphere) placed at p collides with the link, and whether the
+  // point itself lies inside it; all three must agree.
+  const auto collides = [&](const LinkGeometry& g, const Vec3& p) {
+    const bool mesh = meshesIntersect(g, id, pebble, Pose::translation(p), tol, GeometryMode::Mesh);
+    const bool sphere = shapeIntersectsLink(Sphere(0.02), Pose::translation(p), g, id, tol, GeometryMode::Mesh);
+    EXPECT_EQ(mesh, sphere) << p.transpose();
+    EXPECT_EQ(mesh, g.containsPoint(p)) << p.transpose();
+    return mesh;
+  };
+  for (const bool touching : {true, false}) {
+    const Vec3 corner = touching ? Vec3(-0.5, -0.5, -0.5) : Vec3(-0.45, -0.45, -0.45);
+    const std::string what = touching ? "sharing a corner" : "apart";
+    // Both shells outward: the inner one's inside is inside both solids.
+    const LinkGeometry twice(tree_ref::joined(outer, pulledBox(0.2, corner, false), Vec3::Zero()));
+    EXPECT_EQ(twice.solidCount(), 2) << what;
+    EXPECT_TRUE(collides(twice, centre)) << what;
+    EXPECT_TRUE(collides(twice, wall)) << what;
+    EXPECT_FALSE(collides(twice, beyond)) << what;
+    // The inner shell inward: a thick-walled box. Its cavity is empty, its wall solid; no core in the cavity.
+    const LinkGeometry hollow(tree_ref::joined(outer, pulledBox(0.2, corner, true), Vec3::Zero()));
+    EXPECT_EQ(hollow.solidCount(), 2) << what;
+    EXPECT_FALSE(collides(hollow, centre)) << what;
+    EXPECT_TRUE(collides(hollow, wall)) << what;
+    EXPECT_FALSE(collides(hollow, beyond)) << what;
+    for (const LinkGeometry::Ball& c : hollow.cores()) EXPECT_TRUE(hollow.containsPoint(c.center)) << what;
+    // The same box with every triangle turned (inward outer shell, outward inner one): the same solid.
+    TriangleMesh inverted = tree_ref::joined(outer, pulledBox(0.2, corner, true), Vec3::Zero());
+    for (auto& t : inverted.triangles) std::swap(t[1], t[2]);
+    const LinkGeometry turned(inverted);
+    EXPECT_FALSE(collides(turned, centre)) << what;
+    EXPECT_TRUE(collides(turned, wall)) << what;
+    EXPECT_FALSE(collides(turned, beyond)) << what;
+  }
+  // An inward shell that is no cavity: it crosses the outer surface (a part exported with its winding
+  // turned). Where the two overlap, both call the point inside: never free by accident.
+  TriangleMesh crossing = test::boxSurface(Vec3(0.2, 0.2, 0.2));
+  for (auto& t : crossing.triangles) std::swap(t[1], t[2]);
+  const LinkGeometry overlapping(tree_ref::joined(outer, crossing, Vec3(0.5, 0.0, 0.0)));
+  EXPECT_TRUE(collides(overlapping, Vec3(0.4, 0.0, 0.0)));
+  EXPECT_TRUE(collides(overlapping, Vec3(0.6, 0.0, 0.0)));
+  EXPECT_TRUE(collides(overlapping, Vec3(0.0, 0.0, 0.0)));
+  EXPECT_FALSE(collides(overlapping, Vec3(0.8, 0.0, 0.0)));
 }
 
 TEST(LinkGeometry, NeverFreeByAccident) {

@@ -6,9 +6,13 @@
 // primitive–primitive tests through the narrow phase).
 //
 // A closed (watertight) mesh is a solid: every edge of its triangles is shared by an even number of
-// them, so a ray from a point crosses it an odd number of times exactly when the point is inside. When no
-// surfaces meet, one point of each connected piece of a body (probes()) decides whether it lies inside a
-// closed mesh of the other. An open mesh stays a surface (as in FCL's BVHModel): a body wholly inside it
+// them, so a ray from a point crosses it an odd number of times exactly when the point is inside. Closed
+// pieces are shells (triangles joined across edges that exactly two of them share), so shells that touch
+// at a corner or an edge stay apart. Shells wound consistently, nested as one solid's outer surface and
+// cavities (opposite windings, each inner shell within the material of the ones around it), bound the
+// points of non-zero winding number: a cavity is empty. Otherwise a point is inside when it is inside one
+// shell on its own. When no surfaces meet, one point of each connected piece of a body (probes())
+// decides whether it lies inside a closed mesh of the other. An open mesh stays a surface (as in FCL's BVHModel): a body wholly inside it
 // does not touch it, though its hull does. Primitives (boxes, spheres, ...) are solids. Closed sets
 // throughout: touching counts as intersecting.
 //
@@ -84,10 +88,11 @@ class LinkGeometry {
   const Vec3& sphereCenter() const noexcept { return sphere_center_; }
   double sphereRadius() const noexcept { return sphere_radius_; }
 
-  /// How many closed pieces of triangles (solids) the link has; the other triangles are open surfaces.
+  /// How many closed shells of triangles the link has (edge-connected, however they touch); the other
+  /// triangles are open surfaces.
   int solidCount() const noexcept { return static_cast<int>(solid_boxes_.size()); }
-  /// True when the point (link frame) lies inside one of the link's closed meshes, or on it, or so near
-  /// it that no ray decides (never "outside" by accident). False for a link without solids.
+  /// True when the point (link frame) lies inside the link's closed meshes (outside their cavities), or on
+  /// them, or so near that no ray decides (never "outside" by accident). False for a link without solids.
   bool containsPoint(const Vec3& p) const noexcept;
   /// One point of each connected piece of the link (triangles joined by shared vertices; each primitive),
   /// link frame: while the surfaces of two bodies do not meet, each piece lies wholly inside or wholly
@@ -123,11 +128,15 @@ class LinkGeometry {
   double coverSolids() const;
   // The distance from p to the nearest triangle, or `cutoff` when none is nearer.
   double surfaceDistance(const Vec3& p, double cutoff) const noexcept;
-  // Ray parity of solid s at p along `dir`: 1 inside, 0 outside, −1 when the ray passes too near an edge,
-  // a vertex or a plane to tell.
-  int rayParity(int s, const Vec3& p, const Vec3& dir) const noexcept;
-  // True only when three ray directions all decide that p lies inside closed piece s.
-  bool surelyInside(int s, const Vec3& p) const noexcept;
+  // The crossings of the ray from p along `dir` with shell s (s ≥ 0), or with every wound shell but
+  // `skip` (s = kWound), each +1 leaving through a triangle's front and −1 entering: false when the ray
+  // passes too near an edge, a vertex or a plane to tell.
+  static constexpr int kWound = -1;
+  bool rayCrossings(int s, int skip, const Vec3& p, const Vec3& dir, int& winding) const noexcept;
+  // Whether p lies inside the solids along ray direction r: 1 inside, 0 outside, −1 undecided.
+  int insideAlong(const Vec3& p, int r) const noexcept;
+  // True only when three ray directions all decide that p lies inside.
+  bool surelyInside(const Vec3& p) const noexcept;
 
   std::vector<Triangle> triangles_;
   std::vector<Primitive> primitives_;
@@ -140,6 +149,8 @@ class LinkGeometry {
   double sphere_radius_ = 0.0;
   std::vector<std::int32_t> solid_of_;  // per triangle: its closed piece, −1 for an open one
   std::vector<Aabb> solid_boxes_;       // per closed piece
+  std::vector<std::int8_t> solid_sign_;  // per closed piece: its winding (+1 outward, −1 inward), 0 unwound
+  bool nested_ = false;                  // the wound shells nest as one solid: the winding number decides
   std::vector<Vec3> probes_;
   std::vector<Ball> cores_;
   // partBallMargin once proven (NaN before). Copies keep it; two threads asking at once both prove it, to the
