@@ -30,11 +30,13 @@
 #include <ompl/util/Console.h>
 #include <ompl/util/RandomNumbers.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <functional>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <map>
 
 // The bundled scene, relative to the tool's data folder (data_paths.h).
@@ -150,9 +152,18 @@ int runPlan(const PlanSettings& s) {
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
   const ob::StateSpacePtr space = makeStateSpace(*scene);
   og::SimpleSetup setup(space);
+  // Segments checked once the planner's time is up end at once, capped (never free): one segment near
+  // contact could otherwise run for tens of seconds past the limit. Unset again for the simplification
+  // and the final check.
+  const auto deadline = std::make_shared<std::atomic<std::chrono::steady_clock::rep>>(
+      std::numeric_limits<std::chrono::steady_clock::rep>::max());
+  MotionOptions motion_options;
+  motion_options.stop = [deadline] {
+    return std::chrono::steady_clock::now().time_since_epoch().count() > deadline->load(std::memory_order_relaxed);
+  };
   CollisionChecking checking;
   try {
-    checking = setupCollisionChecking(setup.getSpaceInformation(), scene);
+    checking = setupCollisionChecking(setup.getSpaceInformation(), scene, motion_options);
   } catch (const std::exception& e) {
     std::cerr << "clearway plan: " << scene_path << ": " << e.what() << "\n";
     return kExitUsage;
@@ -184,7 +195,12 @@ int runPlan(const PlanSettings& s) {
   const auto t0 = std::chrono::steady_clock::now();
   // A condition that reads the clock where the planner asks: SimpleSetup::solve(seconds) starts a thread to
   // watch the limit for runs of a second or more, which costs milliseconds, more than many a solve.
+  deadline->store((t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                 std::chrono::duration<double>(time_limit)))
+                      .time_since_epoch()
+                      .count());
   const ob::PlannerStatus status = setup.solve(ob::timedPlannerTerminationCondition(time_limit));
+  deadline->store(std::numeric_limits<std::chrono::steady_clock::rep>::max());
   const double solve_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (status != ob::PlannerStatus::EXACT_SOLUTION) {
     std::cerr << "clearway plan: " << planner_name << " found no path in " << time_limit << " s (" << status.asString()

@@ -83,6 +83,16 @@ struct MotionChecker::Sweep {
   // the first one), and nothing else is measured.
   bool verdict_only = false;
   bool stop() const noexcept { return capped || (verdict_only && hit); }
+  // The cap on distance queries reached, or the caller's stop condition true (asked every 256 queries).
+  bool overBudget() const noexcept {
+    if (r.distance_queries >= mc.options_.max_queries) return true;
+    if ((r.distance_queries & 255) != 0 || !mc.options_.stop) return false;
+    try {
+      return mc.options_.stop();
+    } catch (...) {  // (a condition that throws: stopping is the answer that is never wrong)
+      return true;
+    }
+  }
   double at_s = -1.0;         // the parameter ctx.scene.q holds
   // The last measurement's self item whose hulls' GJK axis separates them (splitClearances), −1: none.
   static constexpr std::size_t kSplit = 8;
@@ -173,7 +183,7 @@ struct MotionChecker::Sweep {
     const double cutoff = it.padding + mc.options_.contact_distance;
     const bool exact = sc.options().mode != GeometryMode::Hull;
     ++r.distance_queries;
-    if (r.distance_queries >= mc.options_.max_queries) capped = true;
+    if (overBudget()) capped = true;
     const Pose pa = pose(s, it.frame_a);
     double d;
     BoundQuery q;  // (no warm starts: an end's clearance must not depend on what was measured before)
@@ -248,7 +258,7 @@ struct MotionChecker::Sweep {
         report.hit = hit;
       }
     }
-    if (r.distance_queries >= mc.options_.max_queries) capped = true;
+    if (overBudget()) capped = true;
     return d;
   }
 

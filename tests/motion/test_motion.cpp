@@ -173,6 +173,39 @@ TEST(MotionCertified, TimesBeyondTheLargestAreNeverFree) {
   }
 }
 
+// MotionOptions::stop (a planner's termination condition) is asked every 256 distance queries; true ends
+// the check capped, never free: a segment near contact could run for tens of seconds past a time limit.
+TEST(MotionCertified, AStopConditionEndsTheCheckCappedNeverFree) {
+  TempDir dir;
+  // The block slides 2 m beside a wall 1.5 mm away (contact distance 1 mm): free, in many small steps.
+  const auto scene =
+      sliderScene(dir, "    - {name: wall, box: {size: [3, 0.01, 1]}, pose: {position: [0, 0.0565, 0]}}\n");
+  const double q0[2] = {-1, 0}, q1[2] = {1, 0};
+  const MotionChecker plain(scene);
+  MotionContext pc = plain.makeContext();
+  const MotionResult free = plain.check(q0, q1, pc);
+  ASSERT_TRUE(free.free);
+  ASSERT_GT(free.distance_queries, 600) << "the test needs a segment of many queries";
+  MotionOptions options;
+  int asked = 0;
+  options.stop = [&asked] { return ++asked == 2; };
+  const MotionChecker stopped(scene, options);
+  MotionContext sc = stopped.makeContext();
+  const MotionResult r = stopped.check(q0, q1, sc);
+  EXPECT_FALSE(r.free);
+  EXPECT_TRUE(r.capped);
+  EXPECT_EQ(asked, 2);
+  EXPECT_EQ(r.distance_queries, 512);
+  options.stop = [] { return false; };
+  const MotionChecker never(scene, options);
+  MotionContext nc = never.makeContext();
+  EXPECT_TRUE(never.check(q0, q1, nc).free);
+  options.stop = []() -> bool { throw std::runtime_error("no"); };
+  const MotionChecker throwing(scene, options);
+  MotionContext tc = throwing.makeContext();
+  EXPECT_FALSE(throwing.check(q0, q1, tc).free);
+}
+
 TEST(MotionCertified, ThinWallIsNeverTunnelled) {
   // A 1 mm wall at x = 0: the 0.1 m block slides from x = −1 to x = 1. Sampling at 0.25 steps over it;
   // the certified check finds the contact at s = (1 − 0.0505) / 2, within contact_distance.

@@ -29,6 +29,7 @@
 // number of distance queries ends them too (reported as a collision).
 #include <clearway/scene/scene.h>
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -124,6 +125,10 @@ struct MotionOptions {
   double distance_relative_error = 0.1;
   /// Certified: cap on distance queries per segment; reaching it reports a collision (never free by accident).
   int max_queries = 200000;
+  /// Certified: asked every 256 distance queries of a segment; true ends the check as the cap does
+  /// (capped, never free). A planner's termination condition here keeps its time limit however long a
+  /// segment near contact would take (200,000 queries of meshes are tens of seconds). Empty: never asked.
+  std::function<bool()> stop;
   /// Sampled: the largest step between checked states, in the state's Euclidean norm.
   double resolution = 0.01;
   /// Sampled: cap on states per segment; a segment needing more is reported as a collision (capped),
