@@ -423,77 +423,72 @@ class Reader {
     }
   }
 
-  // A polygon in its plane: a fan when convex (up to rounding), ear clipping otherwise. Clipping costs up
-  // to n² inside tests per ear; the file's budget of them (kClipWork per byte) ends any loop through
-  // crafted polygons with an error instead of minutes of work.
+  // A polygon in its plane: a fan when convex (up to rounding), ear clipping otherwise, without corners
+  // that repeat the one before (exporters write them; kept, they blocked the ears beside them and left
+  // zero-area triangles). The file's budget of clipping work (kClipWork per byte) ends any loop through
+  // crafted polygons with an error instead of seconds of work.
   void triangulate(const Face& f) {
     if (f.size < 3) {
       ++mesh_.points_and_lines;
       return;
     }
-    const auto fan = [&] {
-      for (std::size_t k = 1; k + 1 < f.size; ++k) mesh_.triangles.push_back({corner(f, 0), corner(f, k), corner(f, k + 1)});
+    const auto fan = [&](const std::vector<std::uint32_t>& ring) {
+      for (std::size_t k = 1; k + 1 < ring.size(); ++k) mesh_.triangles.push_back({ring[0], ring[k], ring[k + 1]});
     };
-    if (f.size == 3) return fan();
-    // Newell's normal; the plane's 2-D coordinates drop its largest axis, turned so that the polygon
-    // runs counter-clockwise.
+    const auto at = [&](std::uint32_t i) -> const Vec3& { return mesh_.vertices[i]; };
+    std::vector<std::uint32_t> ring;
+    ring.reserve(f.size);
+    for (std::size_t k = 0; k < f.size; ++k)
+      if (ring.empty() || at(ring.back()) != at(corner(f, k))) ring.push_back(corner(f, k));
+    while (ring.size() > 1 && at(ring.back()) == at(ring.front())) ring.pop_back();
+    if (ring.size() < 3) {  // no area: the corners as written, every triangle dropped as degenerate
+      ring.clear();
+      for (std::size_t k = 0; k < f.size; ++k) ring.push_back(corner(f, k));
+      return fan(ring);
+    }
+    if (ring.size() == 3) return fan(ring);
+    // Newell's normal; the plane's 2-D coordinates drop its largest axis, the second turned so that the
+    // polygon runs counter-clockwise.
     Vec3 normal = Vec3::Zero();
-    for (std::size_t k = 0; k < f.size; ++k) {
-      const Vec3& p = mesh_.vertices[corner(f, k)];
-      const Vec3& q = mesh_.vertices[corner(f, (k + 1) % f.size)];
+    for (std::size_t k = 0; k < ring.size(); ++k) {
+      const Vec3& p = at(ring[k]);
+      const Vec3& q = at(ring[(k + 1) % ring.size()]);
       normal += Vec3((p.y() - q.y()) * (p.z() + q.z()), (p.z() - q.z()) * (p.x() + q.x()), (p.x() - q.x()) * (p.y() + q.y()));
     }
     int axis = 0;
     normal.cwiseAbs().maxCoeff(&axis);
-    if (!(std::abs(normal[axis]) > 0.0)) return fan();  // no area: every triangle is dropped as degenerate
+    if (!(std::abs(normal[axis]) > 0.0)) return fan(ring);  // no area: every triangle is dropped as degenerate
     const int u = (axis + 1) % 3, v = (axis + 2) % 3;
     const double turn = normal[axis] > 0 ? 1.0 : -1.0;
-    std::vector<std::uint32_t> ring(f.size);
-    for (std::size_t k = 0; k < f.size; ++k) ring[k] = corner(f, k);
-    const auto cross = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
-      const Vec3 &p = mesh_.vertices[a], &q = mesh_.vertices[b], &r = mesh_.vertices[c];
-      return turn * ((q[u] - p[u]) * (r[v] - p[v]) - (q[v] - p[v]) * (r[u] - p[u]));
-    };
+    std::vector<std::array<double, 2>> points(ring.size());
+    for (std::size_t k = 0; k < ring.size(); ++k) points[k] = {at(ring[k])[u], turn * at(ring[k])[v]};
     // Convex up to rounding: a turn below 1e-12 of its edges' product is straight (corners along a
     // slanted edge, written in floats).
     bool convex = true;
-    for (std::size_t k = 0; k < f.size && convex; ++k) {
-      const std::uint32_t a = ring[k], b = ring[(k + 1) % f.size], c = ring[(k + 2) % f.size];
-      const Vec3 &p = mesh_.vertices[a], &q = mesh_.vertices[b], &r = mesh_.vertices[c];
-      convex = cross(a, b, c) >= -1e-12 * (q - p).norm() * (r - q).norm();
+    for (std::size_t k = 0; k < ring.size() && convex; ++k) {
+      const std::size_t a = k, b = (k + 1) % ring.size(), c = (k + 2) % ring.size();
+      const double cross = (points[b][0] - points[a][0]) * (points[c][1] - points[a][1]) -
+                           (points[b][1] - points[a][1]) * (points[c][0] - points[a][0]);
+      convex = cross >= -1e-12 * (at(ring[b]) - at(ring[a])).norm() * (at(ring[c]) - at(ring[b])).norm();
     }
-    if (convex) return fan();
-    const auto inside = [&](std::uint32_t p, std::uint32_t a, std::uint32_t b, std::uint32_t c) {
-      return cross(a, b, p) >= 0.0 && cross(b, c, p) >= 0.0 && cross(c, a, p) >= 0.0;
-    };
+    if (convex) return fan(ring);
     const double budget = kClipWork * static_cast<double>(bytes_.size()) + 1e6;
-    std::size_t k = 0;  // where the search for the next ear starts: next to the last one
-    while (ring.size() > 3) {
-      bool clipped = false;
-      for (std::size_t tried = 0; tried < ring.size() && !clipped; ++tried, k = (k + 1) % ring.size()) {
-        const std::uint32_t a = ring[(k + ring.size() - 1) % ring.size()], b = ring[k], c = ring[(k + 1) % ring.size()];
-        if (!(cross(a, b, c) > 0.0)) continue;
-        clip_work_ += static_cast<double>(ring.size());
-        if (clip_work_ > budget)
-          throw LoadError(path_, here(f.at), "face " + std::to_string(f.instance) + " (" + std::to_string(f.size) +
-                                                 " corners, not convex) takes more work to triangulate than the file's "
-                                                 "size allows");
-        if (std::any_of(ring.begin(), ring.end(), [&](std::uint32_t p) { return p != a && p != b && p != c && inside(p, a, b, c); }))
-          continue;
-        mesh_.triangles.push_back({a, b, c});
-        ring.erase(ring.begin() + static_cast<std::ptrdiff_t>(k));
-        k = (k + ring.size() - 2) % ring.size();  // (the loop's step then starts at the clipped corner's neighbour)
-        clipped = true;
-      }
-      if (!clipped) {  // the polygon crosses itself: no ear is free of other corners
-        warn(here(f.at), "face " + std::to_string(f.instance) + " crosses itself; the rest of it is triangulated as a fan");
-        break;
-      }
-    }
-    for (std::size_t j = 1; j + 1 < ring.size(); ++j) mesh_.triangles.push_back({ring[0], ring[j], ring[j + 1]});
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    const EarClip end = clipEars(points, false, budget, clip_work_, triangles);
+    if (end == EarClip::OverBudget)
+      throw LoadError(path_, here(f.at), "face " + std::to_string(f.instance) + " (" + std::to_string(f.size) +
+                                             " corners, not convex) takes more work to triangulate than the file's "
+                                             "size allows");
+    if (end == EarClip::Crossed)
+      warn(here(f.at), "face " + std::to_string(f.instance) + " crosses itself; the rest of it is triangulated as a fan");
+    for (const auto& t : triangles) mesh_.triangles.push_back({ring[t[0]], ring[t[1]], ring[t[2]]});
   }
 
-  static constexpr double kClipWork = 1000.0;  // inside tests per byte of the file
+  // Clipping work (clipEars) per byte of the file. A simple polygon's clipping costs about 40 to 250 per
+  // corner, and a corner takes at least 16 bytes in binary (its vertex and its index); a crafted file,
+  // reusing its vertices in face after face, is refused after 32 per byte (at most about 0.35 s per MB in
+  // a Release build, where 1,000 inside tests per byte took 5 s).
+  static constexpr double kClipWork = 32.0;
   static constexpr int kWarnedLines = 3;        // header lines warned of one by one
 
   std::string path_;
@@ -519,5 +514,148 @@ class Reader {
 }  // namespace
 
 PlyMesh readPly(const std::string& path, std::vector<std::string>* warnings) { return Reader(path, warnings).read(); }
+
+EarClip clipEars(const std::vector<std::array<double, 2>>& points, bool exact, double budget, double& work,
+                 std::vector<std::array<std::uint32_t, 3>>& out) {
+  const std::uint32_t n = static_cast<std::uint32_t>(points.size());
+  if (n < 3) return EarClip::Done;
+  // The ring as a linked list: clipping an ear unlinks its middle corner.
+  std::vector<std::uint32_t> prev(n), next(n);
+  for (std::uint32_t i = 0; i < n; ++i) prev[i] = (i + n - 1) % n, next[i] = (i + 1) % n;
+  std::vector<char> gone(n, 0);
+  using Point = std::array<double, 2>;
+  const auto turn = [](const Point& p, const Point& q, const Point& r) {
+    return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]);
+  };
+  const auto cross = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) { return turn(points[a], points[b], points[c]); };
+  // In the closed triangle, and not at one of its corners (a polygon that touches itself there, as a
+  // hole's bridge does, keeps its ear).
+  const auto inside = [&](std::uint32_t p, std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+    return points[p] != points[a] && points[p] != points[b] && points[p] != points[c] && cross(a, b, p) >= 0.0 &&
+           cross(b, c, p) >= 0.0 && cross(c, a, p) >= 0.0;
+  };
+  const auto convex = [&](std::uint32_t b) { return cross(prev[b], b, next[b]) > 0.0; };
+  // The corners that are not convex in a k-d tree (boxes halved at the median across their longer side,
+  // down to kLeaf corners): a test visits only the boxes that may meet the ear's triangle, so it costs
+  // about the logarithm of their number however they lie. A corner that stops being convex later (only in
+  // a polygon that crosses itself) joins `late`, which every test reads.
+  struct Node {
+    Point lo, hi;
+    std::uint32_t begin, end, child;  // its corners in `items`; its first child (0: a leaf)
+  };
+  constexpr std::uint32_t kLeaf = 8;
+  std::vector<Node> nodes;
+  std::vector<std::uint32_t> items, late;
+  std::vector<char> listed(n, 0);
+  // (Coordinates that are not numbers, which the loader refuses anyway, would break the median's order.)
+  const bool scan = exact || !std::all_of(points.begin(), points.end(), [](const Point& p) { return p[0] == p[0] && p[1] == p[1]; });
+  if (!scan) {
+    for (std::uint32_t i = 0; i < n; ++i)
+      if (!convex(i)) items.push_back(i), listed[i] = 1;
+    if (!items.empty()) nodes.push_back({{}, {}, 0, static_cast<std::uint32_t>(items.size()), 0});
+    for (std::size_t k = 0; k < nodes.size(); ++k) {  // (breadth first: children follow)
+      Node node = nodes[k];
+      node.lo = node.hi = points[items[node.begin]];
+      for (std::uint32_t j = node.begin; j < node.end; ++j)
+        for (int axis = 0; axis < 2; ++axis) {
+          node.lo[axis] = std::min(node.lo[axis], points[items[j]][axis]);
+          node.hi[axis] = std::max(node.hi[axis], points[items[j]][axis]);
+        }
+      if (node.end - node.begin > kLeaf) {
+        const int axis = node.hi[0] - node.lo[0] >= node.hi[1] - node.lo[1] ? 0 : 1;
+        const std::uint32_t mid = node.begin + (node.end - node.begin) / 2;
+        std::nth_element(items.begin() + node.begin, items.begin() + mid, items.begin() + node.end,
+                         [&](std::uint32_t x, std::uint32_t y) { return points[x][axis] < points[y][axis]; });
+        node.child = static_cast<std::uint32_t>(nodes.size());
+        nodes.push_back({{}, {}, node.begin, mid, 0});
+        nodes.push_back({{}, {}, mid, node.end, 0});
+      }
+      nodes[k] = node;
+    }
+  }
+  std::vector<std::uint32_t> stack;
+  const auto blocked = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+    if (scan) {
+      for (std::uint32_t p = next[c]; p != a; p = next[p]) {
+        work += 1.0;
+        if (inside(p, a, b, c)) return true;
+      }
+      return false;
+    }
+    const auto test = [&](std::uint32_t p) {
+      work += 1.0;
+      return !gone[p] && p != a && p != b && p != c && inside(p, a, b, c);
+    };
+    if (std::any_of(late.begin(), late.end(), test)) return true;
+    const Point* corner[3] = {&points[a], &points[b], &points[c]};
+    Point lo = *corner[0], hi = *corner[0];
+    for (const Point* q : corner)
+      for (int axis = 0; axis < 2; ++axis) lo[axis] = std::min(lo[axis], (*q)[axis]), hi[axis] = std::max(hi[axis], (*q)[axis]);
+    // A box lies wholly outside the triangle when it misses the triangle's box, or when all its corners
+    // lie beyond one edge's line by more than the rounding of the turns the test computes.
+    const auto misses = [&](const Node& node) {
+      if (node.hi[0] < lo[0] || node.lo[0] > hi[0] || node.hi[1] < lo[1] || node.lo[1] > hi[1]) return true;
+      for (int e = 0; e < 3; ++e) {
+        const Point &p = *corner[e], &q = *corner[(e + 1) % 3];
+        const double edge = std::abs(q[0] - p[0]) + std::abs(q[1] - p[1]);
+        bool beyond = true;
+        for (int k = 0; k < 4 && beyond; ++k) {
+          const Point x = {k & 1 ? node.hi[0] : node.lo[0], k & 2 ? node.hi[1] : node.lo[1]};
+          const double reach =
+              std::abs(x[0] - p[0]) + std::abs(x[1] - p[1]) + (node.hi[0] - node.lo[0]) + (node.hi[1] - node.lo[1]);
+          beyond = turn(p, q, x) < -1e-12 * edge * reach;
+        }
+        if (beyond) return true;
+      }
+      return false;
+    };
+    stack.clear();
+    if (!nodes.empty()) stack.push_back(0);
+    while (!stack.empty()) {
+      const Node& node = nodes[stack.back()];
+      stack.pop_back();
+      work += 1.0;
+      if (misses(node)) continue;
+      if (node.child != 0) {
+        stack.push_back(node.child);
+        stack.push_back(node.child + 1);
+        continue;
+      }
+      for (std::uint32_t j = node.begin; j < node.end; ++j)
+        if (test(items[j])) return true;
+    }
+    return false;
+  };
+  std::uint32_t size = n, k = 0;  // k: where the search for the next ear starts, next to the last one
+  EarClip end = EarClip::Done;
+  while (size > 3) {
+    bool clipped = false;
+    for (std::uint32_t tried = 0; tried < size && !clipped; ++tried, k = next[k]) {
+      work += 1.0;
+      if (work > budget) return EarClip::OverBudget;
+      const std::uint32_t a = prev[k], b = k, c = next[k];
+      if (!convex(b) || blocked(a, b, c)) continue;
+      out.push_back({a, b, c});
+      gone[b] = 1;
+      next[a] = c;
+      prev[c] = a;
+      --size;
+      for (const std::uint32_t turned : {a, c})
+        if (!scan && !listed[turned] && !convex(turned)) late.push_back(turned), listed[turned] = 1;
+      k = prev[a];  // (the loop's step then starts at a)
+      clipped = true;
+    }
+    if (work > budget) return EarClip::OverBudget;
+    if (!clipped) {
+      end = EarClip::Crossed;
+      break;
+    }
+  }
+  // The last triangle, or the rest as a fan: from the first corner left.
+  std::uint32_t first = 0;
+  while (gone[first]) ++first;
+  for (std::uint32_t j = next[first]; next[j] != first; j = next[j]) out.push_back({first, j, next[j]});
+  return end;
+}
 
 }  // namespace clearway::detail

@@ -5,6 +5,7 @@
 #include <clearway/load/mesh_loader.h>
 
 #include "load/robot_files.h"
+#include "../src/load/ply_reader.h"  // (clipEars, the reader's own ear clipping)
 
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
@@ -281,6 +282,233 @@ TEST(Ply, PolygonsAreTriangulatedInTheirPlaneAndStripsUnrolled) {
   const std::string bow = dir.write("bow.ply", header("face", 1) + "1 0 0\n1 1 1\n1 1 0\n1 0 1\n1 3 3\n1 4 4\n" + "4 0 1 2 3\n");
   warnings.clear();
   EXPECT_EQ(loadMesh(bow, Vec3::Ones(), &warnings).triangles.size(), 2u);
+}
+
+// The warnings other than "not closed" (an L or a star alone is a surface).
+std::vector<std::string> notAboutClosing(const std::vector<std::string>& warnings) {
+  std::vector<std::string> out;
+  for (const std::string& w : warnings)
+    if (w.find("not closed") == std::string::npos) out.push_back(w);
+  return out;
+}
+
+// The area a mesh's triangles cover, each counted whole (overlapping triangles count twice).
+double surfaceArea(const TriangleMesh& m) {
+  double area = 0.0;
+  for (const auto& t : m.triangles)
+    area += (m.vertices[t[1]] - m.vertices[t[0]]).cross(m.vertices[t[2]] - m.vertices[t[0]]).norm() / 2;
+  return area;
+}
+
+// Exporters write a corner twice in a row, or close a polygon with its first corner: the polygon is
+// triangulated as if written without the repeat (a repeated corner made every ear next to it hold its
+// twin, so the polygon was called self-crossing and fanned, covering more than its area).
+TEST(Ply, RepeatedCornersAreTriangulatedAsWithoutThem) {
+  TempDir dir;
+  // The L of area 3 (not convex) in the plane x = 1; vertices 6 and 7 repeat the positions of 1 and 0.
+  const std::string vertices = "1 0 0\n1 2 0\n1 2 1\n1 1 1\n1 1 2\n1 0 2\n1 2 0\n1 0 0\n";
+  const auto load = [&](const std::vector<int>& face, std::vector<std::string>* warnings) {
+    std::string text = "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
+                       "element face 1\nproperty list uchar int vertex_indices\nend_header\n" + vertices + std::to_string(face.size());
+    for (const int i : face) text += " " + std::to_string(i);
+    return loadMesh(dir.write("l.ply", text + "\n"), Vec3::Ones(), warnings);
+  };
+  const auto twin = [](int i) { return i == 1 ? 6 : i == 0 ? 7 : i; };
+  for (int first = 0; first < 6; ++first) {
+    std::vector<int> l;
+    for (int k = 0; k < 6; ++k) l.push_back((first + k) % 6);
+    const TriangleMesh plain = load(l, nullptr);
+    ASSERT_EQ(plain.triangles.size(), 4u);
+    EXPECT_NEAR(surfaceArea(plain), 3.0, 1e-12);
+    std::vector<std::vector<int>> repeated;
+    for (std::size_t k = 0; k < l.size(); ++k) {
+      std::vector<int> once = l, twice = l, as_twin = l;
+      once.insert(once.begin() + static_cast<std::ptrdiff_t>(k) + 1, l[k]);
+      twice.insert(twice.begin() + static_cast<std::ptrdiff_t>(k) + 1, {l[k], l[k]});
+      as_twin.insert(as_twin.begin() + static_cast<std::ptrdiff_t>(k) + 1, twin(l[k]));
+      repeated.insert(repeated.end(), {once, twice, as_twin});
+    }
+    std::vector<int> closed = l, closed_by_twin = l;
+    closed.push_back(l[0]);
+    closed_by_twin.push_back(twin(l[0]));
+    repeated.insert(repeated.end(), {closed, closed_by_twin});
+    for (const std::vector<int>& face : repeated) {
+      std::string written;
+      for (const int i : face) written += " " + std::to_string(i);
+      SCOPED_TRACE("face" + written);
+      std::vector<std::string> warnings;
+      const TriangleMesh mesh = load(face, &warnings);
+      EXPECT_EQ(notAboutClosing(warnings), std::vector<std::string>{});
+      EXPECT_EQ(trianglesOf(mesh), trianglesOf(plain));
+      EXPECT_NEAR(surfaceArea(mesh), 3.0, 1e-12);
+    }
+  }
+  // A star of 64 corners (not convex), every corner written twice.
+  std::string star = "ply\nformat ascii 1.0\nelement vertex 64\nproperty double x\nproperty double y\nproperty double z\n"
+                     "element face 1\nproperty list ushort int vertex_indices\nend_header\n";
+  for (int k = 0; k < 64; ++k) {
+    const double angle = 2 * M_PI * k / 64, r = k % 2 ? 0.5 : 1.0;
+    star += std::to_string(r * std::cos(angle)) + " " + std::to_string(r * std::sin(angle)) + " 0\n";
+  }
+  std::string once = "64", twice = "128";
+  for (int k = 0; k < 64; ++k) once += " " + std::to_string(k), twice += " " + std::to_string(k) + " " + std::to_string(k);
+  const TriangleMesh plain_star = loadMesh(dir.write("star.ply", star + once + "\n"), Vec3::Ones());
+  std::vector<std::string> warnings;
+  const TriangleMesh doubled_star = loadMesh(dir.write("star2.ply", star + twice + "\n"), Vec3::Ones(), &warnings);
+  EXPECT_EQ(notAboutClosing(warnings), std::vector<std::string>{});
+  EXPECT_EQ(plain_star.triangles.size(), 62u);
+  EXPECT_EQ(trianglesOf(doubled_star), trianglesOf(plain_star));
+  EXPECT_NEAR(surfaceArea(doubled_star), surfaceArea(plain_star), 1e-12);
+  // Boxes of quads, each quad written with one corner repeated (in turn each corner, or the first again at
+  // the end), in every encoding: exactly assimp's triangles of the same quads written once, no warning.
+  std::mt19937 rng(20260519);
+  for (int shape = 0; shape < 3; ++shape) {
+    const Polyhedron p = gridBox(rng);
+    Polyhedron repeats = p;
+    for (std::size_t f = 0; f < repeats.faces.size(); ++f) {
+      std::vector<int>& face = repeats.faces[f];
+      const std::size_t k = f % 5;
+      face.insert(face.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(k, 3)) + 1, face[k % 4]);
+    }
+    for (const std::string format : {"ascii", "binary_little_endian", "binary_big_endian"}) {
+      SCOPED_TRACE(format);
+      const std::string path = dir.write("box.ply", plyFile(p, format, "float", "uchar", "int", false));
+      const std::string with_repeats = dir.write("repeats.ply", plyFile(repeats, format, "float", "uchar", "int", false));
+      std::vector<std::string> box_warnings;
+      const TriangleMesh mesh = loadMesh(with_repeats, Vec3::Ones(), &box_warnings);
+      EXPECT_TRUE(box_warnings.empty()) << box_warnings.front();
+      EXPECT_EQ(mesh.triangles.size(), 2 * p.faces.size());
+      EXPECT_EQ(trianglesOf(mesh), assimpTriangles(path));
+    }
+  }
+}
+
+double signedArea(const std::vector<std::array<double, 2>>& polygon) {
+  double twice = 0.0;
+  for (std::size_t k = 0; k < polygon.size(); ++k) {
+    const auto &p = polygon[k], &q = polygon[(k + 1) % polygon.size()];
+    twice += p[0] * q[1] - p[1] * q[0];
+  }
+  return twice / 2;
+}
+
+// Simple polygons in general position, counter-clockwise, of every kind the fast lookup could miss a
+// corner in: star-shaped (long thin ears through the middle), combs of slanted teeth (an ear's box holds
+// the other teeth's roots), fine detail in one corner of a large outline, and spiral strips.
+std::vector<std::vector<std::array<double, 2>>> simplePolygons(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<std::vector<std::array<double, 2>>> out;
+  for (const int n : {4, 5, 12, 50, 300, 2000}) {
+    std::vector<std::array<double, 2>> star;
+    for (int k = 0; k < n; ++k) {
+      const double angle = 2 * M_PI * (k + 0.8 * u(rng)) / n, r = 0.05 + u(rng);
+      star.push_back({r * std::cos(angle), r * std::sin(angle)});
+    }
+    out.push_back(star);
+  }
+  for (const int teeth : {3, 40, 400}) {
+    std::vector<std::array<double, 2>> comb = {{0.0, -1.0}, {2.0 * teeth, -1.0}};
+    for (int i = teeth - 1; i >= 0; --i) {
+      const double x = 2.0 * i + 0.1 * u(rng), length = teeth * (0.5 + u(rng));
+      comb.insert(comb.end(), {{x + 1, 0.01 * u(rng)}, {x + 1 + length, length}, {x + length, length + 0.1}, {x, 0.01 * u(rng)}});
+    }
+    out.push_back(comb);
+  }
+  for (const int detail : {10, 500}) {
+    // The square's corner (0, 0) cut off by teeth hanging from y = 2 between x = 0 and 2.
+    std::vector<std::array<double, 2>> outline = {{2, 0}, {1000, 0}, {1000, 1000}, {0, 1000}, {0, 2}};
+    for (int i = 0; i < detail; ++i)
+      outline.insert(outline.end(), {{2.0 * (i + 0.3 + 0.4 * u(rng)) / detail, 0.01 + 0.001 * u(rng)},
+                                     {2.0 * (i + 1) / detail, 2.0 - 0.1 * u(rng)}});
+    outline.back() = {2, 2};
+    out.push_back(outline);
+  }
+  for (const int n : {30, 1500}) {
+    std::vector<std::array<double, 2>> spiral;
+    for (int k = 0; k < n; ++k) {
+      const double a = 0.02 * k + 0.001 * u(rng), r = 1 + 0.02 * k;
+      spiral.push_back({r * std::cos(a), r * std::sin(a)});
+    }
+    for (int k = n - 1; k >= 0; --k) {
+      const double a = 0.02 * k + 0.001 * u(rng), r = 1.1 + 0.02 * k;
+      spiral.push_back({r * std::cos(a), r * std::sin(a)});
+    }
+    out.push_back(spiral);
+  }
+  // Each counter-clockwise, turned, moved and started at a random corner.
+  for (auto& polygon : out) {
+    if (signedArea(polygon) < 0.0) std::reverse(polygon.begin(), polygon.end());
+    const double turn = 2 * M_PI * u(rng), c = std::cos(turn), s = std::sin(turn), dx = 100 * u(rng), dy = -50 * u(rng);
+    for (auto& p : polygon) p = {c * p[0] - s * p[1] + dx, s * p[0] + c * p[1] + dy};
+    std::rotate(polygon.begin(), polygon.begin() + static_cast<std::ptrdiff_t>(u(rng) * polygon.size()), polygon.end());
+  }
+  return out;
+}
+
+// The ear clipper looks up only the corners that are not convex, and only in boxes that may meet the ear
+// (a k-d tree); the exact clipper tests every corner. On simple polygons they clip the same ears, and the
+// triangles cover the polygon once; the lookup's work grows with the corners about as n log n, where the
+// exact clipper's grows as n².
+TEST(Ply, EarClippingMatchesTheExactClipping) {
+  std::mt19937 rng(20260520);
+  for (int round = 0; round < 3; ++round)
+    for (const auto& polygon : simplePolygons(rng)) {
+      const std::size_t n = polygon.size();
+      SCOPED_TRACE(std::to_string(n) + " corners, round " + std::to_string(round));
+      double fast_work = 0.0, exact_work = 0.0;
+      std::vector<std::array<std::uint32_t, 3>> fast, exact;
+      ASSERT_EQ(detail::clipEars(polygon, false, 1e18, fast_work, fast), detail::EarClip::Done);
+      ASSERT_EQ(detail::clipEars(polygon, true, 1e18, exact_work, exact), detail::EarClip::Done);
+      EXPECT_EQ(fast, exact);
+      ASSERT_EQ(fast.size(), n - 2);
+      double area = 0.0;
+      for (const auto& t : fast) {
+        const std::vector<std::array<double, 2>> triangle = {polygon[t[0]], polygon[t[1]], polygon[t[2]]};
+        EXPECT_GT(signedArea(triangle), 0.0);
+        area += signedArea(triangle);
+      }
+      EXPECT_NEAR(area, signedArea(polygon), 1e-9 * signedArea(polygon));
+      if (n >= 2000) EXPECT_LT(fast_work, 0.1 * exact_work);
+    }
+  // Past the budget clipping stops, having done at most a few corners' work more.
+  std::vector<std::array<double, 2>> star;
+  for (int k = 0; k < 1000; ++k) star.push_back({(k % 2 ? 0.5 : 1.0) * std::cos(2 * M_PI * k / 1000), (k % 2 ? 0.5 : 1.0) * std::sin(2 * M_PI * k / 1000)});
+  double work = 0.0;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  EXPECT_EQ(detail::clipEars(star, false, 5000.0, work, triangles), detail::EarClip::OverBudget);
+  EXPECT_LT(work, 5000.0 + 1000.0);
+}
+
+// A face crafted to make ear clipping costly (4,000 corners turning 120° about a centre, on three rays,
+// then two that turn back) is clipped within its file's budget; the same face written three times costs
+// more than 32 per byte of the file (the face list is a small part of it): refused, naming the face.
+TEST(Ply, EarClippingWorkIsBoundedByTheFileSize) {
+  TempDir dir;
+  std::vector<std::array<double, 2>> corners;
+  for (int k = 0; k < 4000; ++k) {
+    const double a = 2 * M_PI * k / 3, r = std::pow(0.99999, k);
+    corners.push_back({r * std::cos(a), r * std::sin(a)});
+  }
+  corners.insert(corners.end(), {{0.3, -0.2}, {0.0, 0.0}});
+  const int n = static_cast<int>(corners.size());
+  const auto file = [&](int faces) {
+    PlyWriter w{"binary_little_endian", ""};
+    for (const auto& c : corners)
+      for (const double v : {c[0], c[1], 0.0}) w.value("float", v);
+    for (int f = 0; f < faces; ++f) {
+      w.value("ushort", n);
+      for (int k = 0; k < n; ++k) w.value("int", k);
+    }
+    return dir.write("rosette" + std::to_string(faces) + ".ply",
+                     "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(n) +
+                         "\nproperty float x\nproperty float y\nproperty float z\nelement face " + std::to_string(faces) +
+                         "\nproperty list ushort int vertex_indices\nend_header\n" + w.data);
+  };
+  std::vector<std::string> warnings;
+  EXPECT_EQ(detail::readPly(file(1), &warnings).triangles.size(), static_cast<std::size_t>(n - 2));
+  const std::string three = file(3);
+  EXPECT_LOAD_ERROR(loadMesh(three, Vec3::Ones()), three, "byte 64207",
+                    "face 1 (4002 corners, not convex) takes more work to triangulate than the file's size allows");
 }
 
 TEST(Ply, ReadsOnlyWhatTheHeaderDeclares) {
