@@ -23,7 +23,7 @@ using tinyxml2::XMLElement;
 constexpr int kMaxNodeDepth = 256;
 constexpr std::int64_t kMaxExpandedNodes = 100000;
 // The triangles the instances may expand to, unless the file writes out more (see collada_check.h).
-constexpr std::uint64_t kMaxExpandedTriangles = std::uint64_t{1} << 22;
+constexpr std::uint64_t kMaxExpandedTriangles = std::uint64_t{1} << 20;
 
 std::uint64_t saturatingAdd(std::uint64_t a, std::uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; }
 

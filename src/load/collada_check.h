@@ -16,11 +16,12 @@ namespace clearway::detail {
 /// reaching past the end of its array; a <skew>; an <input> of a <mesh> whose source holds a <Name_array>
 /// or <IDREF_array>; an <instance_node> that leads back to its own node; a node hierarchy, with its
 /// instances expanded, deeper than 256 levels or larger than 100,000 nodes; a node or visual scene whose
-/// instances reach more than 4,194,304 (2^22) triangles, each geometry counted once per path to it
+/// instances reach more than 1,048,576 (2^20) triangles, each geometry counted once per path to it
 /// (polygons as the triangles they fan into), unless the file's geometries themselves hold more. The
-/// limit is a hundred times the largest mesh of ../shared/robots (43,000 triangles): within it a mesh
-/// loads in seconds, past it in minutes and gigabytes (9.8 million triangles took 31 s and 805 MB in the
-/// ASan build); and it keeps the merged mesh far inside its 32-bit indices and the AABB tree's 2^30 items.
+/// limit is 24 times the largest mesh of ../shared/robots (43,000 triangles): within it a mesh loads in
+/// a few seconds even in a sanitized build, past it in minutes and gigabytes (9.8 million triangles took
+/// 31 s and 805 MB in the ASan build, 2.5 million over 10 s in the fuzzer's); and it keeps the merged
+/// mesh far inside its 32-bit indices and the AABB tree's 2^30 items.
 void checkCollada(const std::string& path);
 
 }  // namespace clearway::detail

@@ -135,8 +135,18 @@ TEST(HostileMesh, ColladaInstancesExpandingToMillionsOfTrianglesAreRefused) {
   const std::string bomb =
       dir.write("bomb.dae", collada("<node id=\"n\"><instance_node url=\"#d0\"/></node>", nodes, array, p, 1200));
   EXPECT_LT(std::filesystem::file_size(bomb), 40000u);
-  // d1, the first node past the limit: 4,096 copies.
-  EXPECT_LOAD_ERROR_IN_TIME(loadMesh(bomb, Vec3::Ones()), bomb, "<node> (line 12)", "4915200 triangles");
+  // d3, the first node past the limit: 1,024 copies.
+  EXPECT_LOAD_ERROR_IN_TIME(loadMesh(bomb, Vec3::Ones()), bomb, "<node> (line 14)", "1228800 triangles");
+
+  // Found by fuzz_mesh_dae (FUZZ_SEED=1): the same file with one instance of d1 naming no node and one of
+  // d8's a mangled tag expands to 2,457,600 triangles, under 2^22, and took over 10 s in the fuzzer's build.
+  std::string mangled = nodes;
+  mangled.replace(mangled.find("url=\"#d2\""), 9, "url=\"#e2\"");
+  const std::size_t d8 = mangled.find("<instance_node", mangled.find("id=\"d8\""));
+  mangled.replace(mangled.find("<instance_node", d8 + 1), 14, "<insta\x92\x9c\x9a\xaanode");
+  const std::string fuzzed =
+      dir.write("fuzzed.dae", collada("<node id=\"n\"><instance_node url=\"#d0\"/></node>", mangled, array, p, 1200));
+  EXPECT_LOAD_ERROR_IN_TIME(loadMesh(fuzzed, Vec3::Ones()), fuzzed, "<node>", "triangles");
 
   // Within the limit the same instancing loads: 8 copies, welded into one tetrahedron's corners.
   std::string few;
