@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 namespace clearway::detail {
@@ -55,10 +56,19 @@ class Checker {
     if (name == "p" || name == "vcount" || name == "v" || name == "h" || name == "int_array") tokens(e, true);
     if (name == "float_array") tokens(e, false);
     for (const char* attribute : {"count", "stride", "offset"}) wholeNumber(e, attribute);
-    if (const char* id = e->Attribute("id")) ids_.emplace(id, e);
+    if (const char* id = e->Attribute("id")) {
+      // Instances name nodes, geometries and controllers by id: with two of one id, the one counted here
+      // and the one assimp expands could differ (a fuzzed file hid 2.5 million triangles so).
+      const auto [first, added] = ids_.emplace(id, e);
+      if (!added && (instanced(name) || instanced(first->second->Name())))
+        fail(e, "a second element with id '" + inputExcerpt(id) + "' (the first is on line " +
+                    std::to_string(first->second->GetLineNum()) + "): ids must be unique");
+    }
     if (name == "node") {
       nodes_.push_back(e);
-      if (const char* n = e->Attribute("name")) names_.emplace(n, e);
+      if (const char* n = e->Attribute("name")) {
+        if (!names_.emplace(n, e).second) repeated_names_.insert(n);
+      }
     }
     if (name == "accessor") accessors_.push_back(e);
     for (const XMLElement* c = e->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) visit(c);
@@ -280,8 +290,12 @@ class Checker {
     const auto by_id = ids_.find(url + 1);
     if (by_id != ids_.end() && std::strcmp(by_id->second->Name(), "node") == 0) return by_id->second;
     const auto by_name = names_.find(url + 1);
+    if (by_name != names_.end() && repeated_names_.count(url + 1) > 0)
+      fail(instance, "url=\"" + inputExcerpt(url) + "\" names no id but several nodes' name: which one is instanced is unclear");
     return by_name != names_.end() ? by_name->second : nullptr;
   }
+
+  static bool instanced(const std::string& name) { return name == "node" || name == "geometry" || name == "controller"; }
 
   const Expanded& expand(const XMLElement* node, int level) {
     Expanded& x = expanded_[node];
@@ -376,6 +390,7 @@ class Checker {
   std::string path_;
   std::uint64_t file_size_;
   std::unordered_map<std::string, const XMLElement*> ids_, names_;
+  std::unordered_set<std::string> repeated_names_;  // node names given to more than one node
   std::vector<const XMLElement*> nodes_, accessors_, mesh_inputs_, visual_scenes_;
   std::unordered_map<const XMLElement*, Expanded> expanded_;
   std::unordered_map<const XMLElement*, std::uint64_t> geometry_triangles_;

@@ -147,6 +147,17 @@ TEST(HostileMesh, ColladaInstancesExpandingToMillionsOfTrianglesAreRefused) {
   const std::string fuzzed =
       dir.write("fuzzed.dae", collada("<node id=\"n\"><instance_node url=\"#d0\"/></node>", mangled, array, p, 1200));
   EXPECT_LOAD_ERROR_IN_TIME(loadMesh(fuzzed, Vec3::Ones()), fuzzed, "<node>", "triangles");
+  // Then, with d9 renamed a second d8: the count followed the first d8 (its d9 gone, nothing), assimp the
+  // second (2,457,600 triangles). Ids of what instances name must be unique, and names they fall back to.
+  std::string twin = mangled;
+  twin.replace(twin.find("<node id=\"d9\">"), 15, "<node id=\"d8\">");
+  const std::string twins =
+      dir.write("twins.dae", collada("<node id=\"n\"><instance_node url=\"#d0\"/></node>", twin, array, p, 1200));
+  EXPECT_LOAD_ERROR_IN_TIME(loadMesh(twins, Vec3::Ones()), twins, "<node>", "a second element with id 'd8'");
+  const std::string named = dir.write(
+      "named.dae", collada("<node id=\"n\"><instance_node url=\"#x\"/></node>",
+                           "<node id=\"a\" name=\"x\"/><node id=\"b\" name=\"x\"><instance_geometry url=\"#g\"/></node>"));
+  EXPECT_LOAD_ERROR_IN_TIME(loadMesh(named, Vec3::Ones()), named, "<instance_node>", "several nodes' name");
 
   // Within the limit the same instancing loads: 8 copies, welded into one tetrahedron's corners.
   std::string few;
