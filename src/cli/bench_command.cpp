@@ -6,6 +6,7 @@
 // `clearway bench merge` checks that shards 0 … N−1 of one configuration are all there, each once, and
 // writes the same files an unsharded run writes. Rows are copied verbatim and ordered by case, so a
 // merged results.csv equals an unsharded one except for the measured times.
+#include "bench_results.h"
 #include "commands.h"
 #include "data_paths.h"
 #include "exit_codes.h"
@@ -15,11 +16,9 @@
 #include "suites.h"  // (the clearway_bench_suites library)
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -50,136 +49,6 @@ const char* const kBenchHelp =
     "Exit status: 0 when every case ran, 1 when a case failed, 2 on a usage error, missing shared data or\n"
     "an output that cannot be written.\n";
 
-constexpr const char* kColumns =
-    "suite,case,subject,engine,mode,tolerance,items,ns_per_item,work_per_item,positives,misses,false_alarms,"
-    "error,max_error";
-constexpr int kFields = 14;
-
-struct Row {
-  long case_index = 0;
-  std::string suite, subject, engine, mode;
-  double tolerance = 0, items = 0, ns = 0, work = 0, positives = 0, misses = 0, false_alarms = 0, error = 0,
-         max_error = 0;
-  std::string line;  // as written: merges copy it
-};
-
-// The identity of a run: its configuration line, the shard and the number of cases.
-struct Results {
-  std::string config;
-  long shard = -1, shards = 0;  // -1: all cases
-  long cases = 0;
-  std::vector<Row> rows;
-};
-
-std::vector<std::string> split(const std::string& s, char sep) {
-  std::vector<std::string> out;
-  std::stringstream in(s);
-  std::string field;
-  while (std::getline(in, field, sep)) out.push_back(field);
-  if (!s.empty() && s.back() == sep) out.emplace_back();
-  return out;
-}
-
-bool parseLong(const std::string& s, long& out) {
-  if (s.empty()) return false;
-  char* end = nullptr;
-  errno = 0;
-  out = std::strtol(s.c_str(), &end, 10);
-  return errno == 0 && *end == '\0';
-}
-
-bool parseDouble(const std::string& s, double& out) {
-  if (s.empty()) return false;
-  char* end = nullptr;
-  out = std::strtod(s.c_str(), &end);
-  return *end == '\0';
-}
-
-// "I/N" with 0 ≤ I < N.
-bool parseShard(const std::string& s, long& index, long& count, std::string& why) {
-  const auto slash = s.find('/');
-  if (slash == std::string::npos || !parseLong(s.substr(0, slash), index) || !parseLong(s.substr(slash + 1), count)) {
-    why = "expected I/N, two integers";
-    return false;
-  }
-  if (count < 1 || index < 0 || index >= count) {
-    why = "the index must be in [0, N) and N at least 1";
-    return false;
-  }
-  return true;
-}
-
-Row parseRow(const std::string& line, const std::string& where) {
-  const std::vector<std::string> f = split(line, ',');
-  if (static_cast<int>(f.size()) != kFields) throw std::runtime_error(where + ": expected " + std::to_string(kFields) +
-                                                                       " fields, found " + std::to_string(f.size()));
-  Row r;
-  r.line = line;
-  r.suite = f[0], r.subject = f[2], r.engine = f[3], r.mode = f[4];
-  double* numbers[] = {&r.tolerance, &r.items, &r.ns, &r.work, &r.positives, &r.misses, &r.false_alarms, &r.error,
-                       &r.max_error};
-  if (!parseLong(f[1], r.case_index) || r.case_index < 0) throw std::runtime_error(where + ": bad case index '" + f[1] + "'");
-  for (int k = 0; k < 9; ++k)
-    if (!parseDouble(f[5 + k], *numbers[k]))
-      throw std::runtime_error(where + ": field " + std::to_string(6 + k) + " is not a number: '" + f[5 + k] + "'");
-  return r;
-}
-
-Results readResults(const std::string& file) {
-  std::ifstream in(file);
-  if (!in) throw std::runtime_error("cannot open " + file + ": " + std::strerror(errno));
-  Results res;
-  std::string line;
-  int n = 0;
-  bool header = false, seen_shard = false, seen_cases = false, seen_end = false;
-  while (std::getline(in, line)) {
-    const std::string where = file + ":" + std::to_string(++n);
-    if (n == 1 && line != "# clearway bench results v1") throw std::runtime_error(where + ": not a clearway bench results file");
-    if (line.rfind("# config: ", 0) == 0) res.config = line.substr(10);
-    else if (line.rfind("# shard: ", 0) == 0) {
-      seen_shard = true;
-      const std::string s = line.substr(9);
-      std::string why;
-      if (s != "all" && !parseShard(s, res.shard, res.shards, why)) throw std::runtime_error(where + ": shard '" + s + "': " + why);
-    } else if (line.rfind("# cases: ", 0) == 0) {
-      seen_cases = parseLong(line.substr(9), res.cases) && res.cases >= 0;
-      if (!seen_cases) throw std::runtime_error(where + ": bad case count");
-    } else if (line.rfind("# end: ", 0) == 0) {
-      // Written last: a file cut short anywhere (even inside a number of the last row) lacks it.
-      long count = -1;
-      seen_end = parseLong(line.substr(7, line.find(' ', 7) - 7), count) && count == static_cast<long>(res.rows.size());
-      if (!seen_end) throw std::runtime_error(where + ": the end line does not match the " + std::to_string(res.rows.size()) + " rows read");
-    } else if (seen_end) {
-      throw std::runtime_error(where + ": text after the end line");
-    } else if (line.rfind("#", 0) == 0) {
-      continue;
-    } else if (!header) {
-      if (line != kColumns) throw std::runtime_error(where + ": unexpected column header");
-      header = true;
-    } else {
-      res.rows.push_back(parseRow(line, where));
-      if (res.rows.back().case_index >= res.cases) throw std::runtime_error(where + ": case index beyond the case count");
-    }
-  }
-  if (!header || res.config.empty() || !seen_shard || !seen_cases || !seen_end)
-    throw std::runtime_error(file + ": truncated: the config, shard, cases, column or end lines are missing");
-  return res;
-}
-
-void writeResults(const std::string& file, const Results& res) {
-  std::ofstream out(file);
-  out << "# clearway bench results v1\n# config: " << res.config << "\n# shard: "
-      << (res.shard < 0 ? std::string("all") : std::to_string(res.shard) + "/" + std::to_string(res.shards))
-      << "\n# cases: " << res.cases << "\n"
-      << "# ns_per_item is thread CPU time (planning: median solve time); every other field depends only on\n"
-      << "# the config and the case\n"
-      << kColumns << "\n";
-  for (const Row& r : res.rows) out << r.line << "\n";
-  out << "# end: " << res.rows.size() << " rows\n";
-  out.flush();
-  if (!out) throw std::runtime_error("cannot write " + file);
-}
-
 // ---- Summary, table and plots ---------------------------------------------------------------------------
 
 struct Summary {
@@ -192,9 +61,9 @@ struct Summary {
   std::string key() const { return engine + " " + mode; }
 };
 
-std::vector<Summary> summarize(const std::vector<Row>& rows) {
+std::vector<Summary> summarize(const std::vector<BenchRow>& rows) {
   std::vector<Summary> out;
-  for (const Row& r : rows) {
+  for (const BenchRow& r : rows) {
     auto it = std::find_if(out.begin(), out.end(), [&](const Summary& s) {
       return s.suite == r.suite && s.engine == r.engine && s.mode == r.mode && s.tolerance == r.tolerance;
     });
@@ -262,13 +131,13 @@ std::string table(const std::vector<Summary>& all) {
 // exact state check one per call and batched, a certified motion at a 1 mm contact distance, and RRTConnect
 // with the certified validator, each against FCL in the same run (states: OBBRSS; motions and planning:
 // OMPL's 1% sampling over FCL). A family's ratio is FCL's total time over ours on the same items.
-std::string targets(const std::vector<Row>& rows) {
+std::string targets(const std::vector<BenchRow>& rows) {
   struct Family {
     double one = 0, one_n = 0, batch = 0, batch_n = 0, fcl_state = 0, fcl_state_n = 0, motion = 0, motion_n = 0,
            fcl_motion = 0, fcl_motion_n = 0, plan = 0, fcl_plan = 0;
   };
   std::vector<std::pair<std::string, Family>> families;
-  for (const Row& r : rows) {
+  for (const BenchRow& r : rows) {
     if (r.suite != "states" && r.suite != "motions" && r.suite != "plan") continue;
     const std::size_t cut = r.subject.find_last_of('_');
     const std::string name = cut == std::string::npos ? r.subject : r.subject.substr(0, cut);
@@ -401,7 +270,7 @@ void writePlots(const std::string& dir, const std::vector<Summary>& all) {
   if (!runGnuplot(file, why)) std::cerr << "clearway bench: plots not drawn: " << why << "\n";
 }
 
-void finish(const std::string& dir, const Results& res) {
+void finish(const std::string& dir, const BenchResults& res) {
   writeResults(dir + "/results.csv", res);
   const std::vector<Summary> all = summarize(res.rows);
   writeSummaryCsv(dir + "/summary.csv", all);
@@ -418,35 +287,19 @@ int usageError(const std::string& why) {
 
 int runMerge(const std::string& out, const std::vector<std::string>& dirs) {
   try {
-    Results merged;
-    std::vector<int> seen;
+    std::vector<BenchResults> shards;
+    std::vector<std::string> files;
     for (const std::string& d : dirs) {
-      const std::string file = d + "/results.csv";
-      Results shard = readResults(file);
-      if (shard.shard < 0) throw std::runtime_error(file + ": not a shard (its shard line says all)");
-      if (merged.config.empty()) {
-        merged.config = shard.config, merged.cases = shard.cases, merged.shards = shard.shards;
-        seen.assign(shard.shards, 0);
-      }
-      if (shard.config != merged.config) throw std::runtime_error(file + ": another configuration: " + shard.config);
-      if (shard.shards != merged.shards || shard.cases != merged.cases)
-        throw std::runtime_error(file + ": shard " + std::to_string(shard.shard) + "/" + std::to_string(shard.shards) +
-                                 " of " + std::to_string(shard.cases) + " cases does not match the first shard");
-      if (seen[shard.shard]++) throw std::runtime_error(file + ": shard " + std::to_string(shard.shard) + " given twice");
-      for (const Row& r : shard.rows)
-        if (r.case_index % shard.shards != shard.shard)
-          throw std::runtime_error(file + ": case " + std::to_string(r.case_index) + " does not belong to this shard");
-      merged.rows.insert(merged.rows.end(), shard.rows.begin(), shard.rows.end());
+      files.push_back(d + "/results.csv");
+      shards.push_back(readResults(files.back()));
+    }
+    const BenchResults merged = mergeShards(shards, files);
+    for (const std::string& d : dirs)
       if (fs::is_directory(d + "/plan")) {
         fs::create_directories(out + "/plan");
         for (const auto& log : fs::directory_iterator(d + "/plan"))
           fs::copy_file(log.path(), out + "/plan/" + log.path().filename().string(), fs::copy_options::overwrite_existing);
       }
-    }
-    for (std::size_t i = 0; i < seen.size(); ++i)
-      if (!seen[i]) throw std::runtime_error("shard " + std::to_string(i) + "/" + std::to_string(seen.size()) + " is missing");
-    std::stable_sort(merged.rows.begin(), merged.rows.end(),
-                     [](const Row& a, const Row& b) { return a.case_index < b.case_index; });
     fs::create_directories(out);
     finish(out, merged);
   } catch (const std::exception& e) {
@@ -470,7 +323,7 @@ int runBench(BenchSettings& settings) {
   std::string why;
   if (!settings.shard.empty()) parseShard(settings.shard, shard, shards, why);
   for (const std::string& list : settings.subjects)
-    for (const std::string& s : split(list, ','))
+    for (const std::string& s : splitFields(list, ','))
       if (!s.empty()) config.subjects.push_back(s);
   if (std::find(config.suites.begin(), config.suites.end(), "all") != config.suites.end()) config.suites = bench::suiteNames();
   if (config.suites.empty()) config.suites = {"narrowphase", "states", "motions"};
@@ -483,7 +336,7 @@ int runBench(BenchSettings& settings) {
   // Built without FCL: say which comparisons are not made, rather than leave rows silently out.
   for (const std::string& m : bench::missingComparisons())
     std::cerr << "clearway bench: built without FCL (libfcl-dev), not measured: " << m << "\n";
-  Results res;
+  BenchResults res;
   std::string suites;
   for (const std::string& s : bench::suiteNames())
     if (std::find(config.suites.begin(), config.suites.end(), s) != config.suites.end()) suites += (suites.empty() ? "" : ",") + s;
