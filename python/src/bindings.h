@@ -10,5 +10,7 @@ void bindNarrowphase(pybind11::module_& m);
 void bindScene(pybind11::module_& m);
 /// load_robot, Robot, audit, AuditResult (robot.cpp).
 void bindRobot(pybind11::module_& m);
+/// plan, PlanResult, planners (planning.cpp; built with the OMPL plugin).
+void bindPlanning(pybind11::module_& m);
 
 }  // namespace clearway::python

@@ -32,4 +32,7 @@ PYBIND11_MODULE(clearway, m) {
   clearway::python::bindNarrowphase(m);
   clearway::python::bindScene(m);
   clearway::python::bindRobot(m);
+#ifdef CLEARWAY_PYTHON_HAVE_OMPL
+  clearway::python::bindPlanning(m);
+#endif
 }
