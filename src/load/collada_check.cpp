@@ -50,7 +50,14 @@ class Checker {
     // Assimp 5.2 asserts (aborts) when it composes a node's transform from a <skew>.
     if (name == "skew") fail(e, "<skew> is not supported (assimp aborts on it): write the node's transform as a <matrix>");
     if (name == "input" && inMesh(e)) mesh_inputs_.push_back(e);
-    if (name == "visual_scene") visual_scenes_.push_back(e);
+    if (name == "visual_scene") {
+      // Assimp keeps each visual scene as a node (its root node, named "Scene" unless it has a name), which
+      // an <instance_node> may name by id or name like any other: a node of the scene instancing it made
+      // assimp recurse until the stack overflowed.
+      visual_scenes_.push_back(e);
+      const char* n = e->Attribute("name");
+      if (!names_.emplace(n != nullptr ? n : "Scene", e).second) repeated_names_.insert(n != nullptr ? n : "Scene");
+    }
     const std::uint64_t outer = triangles_;  // a <geometry> counts its own primitives' triangles
     if (name == "geometry") triangles_ = 0;
     if (name == "p" || name == "vcount" || name == "v" || name == "h" || name == "int_array") tokens(e, true);
@@ -210,12 +217,8 @@ class Checker {
   void checkNodes() {
     triangle_limit_ = std::max(kMaxExpandedTriangles, written_triangles_);
     for (const XMLElement* n : nodes_) expand(n, 1);
-    for (const XMLElement* scene : visual_scenes_) {
-      std::uint64_t triangles = 0;
-      for (const XMLElement* n = scene->FirstChildElement("node"); n != nullptr; n = n->NextSiblingElement("node"))
-        triangles = saturatingAdd(triangles, expand(n, 1).triangles);
-      if (triangles > triangle_limit_) fail(scene, tooManyTriangles(triangles));
-    }
+    // A visual scene is the root above its nodes (level 0): its nodes stand at level 1.
+    for (const XMLElement* scene : visual_scenes_) expand(scene, 0);
   }
 
  private:
@@ -288,19 +291,25 @@ class Checker {
     const char* url = instance->Attribute("url");
     if (url == nullptr || url[0] != '#') return nullptr;
     const auto by_id = ids_.find(url + 1);
-    if (by_id != ids_.end() && std::strcmp(by_id->second->Name(), "node") == 0) return by_id->second;
+    if (by_id != ids_.end() && nodeLike(by_id->second)) return by_id->second;
     const auto by_name = names_.find(url + 1);
     if (by_name != names_.end() && repeated_names_.count(url + 1) > 0)
       fail(instance, "url=\"" + inputExcerpt(url) + "\" names no id but several nodes' name: which one is instanced is unclear");
     return by_name != names_.end() ? by_name->second : nullptr;
   }
 
-  static bool instanced(const std::string& name) { return name == "node" || name == "geometry" || name == "controller"; }
+  static bool instanced(const std::string& name) {
+    return name == "node" || name == "visual_scene" || name == "geometry" || name == "controller";
+  }
+  // What an <instance_node> may name: a node, or a visual scene (assimp's root nodes).
+  static bool nodeLike(const XMLElement* e) {
+    return std::strcmp(e->Name(), "node") == 0 || std::strcmp(e->Name(), "visual_scene") == 0;
+  }
 
   const Expanded& expand(const XMLElement* node, int level) {
     Expanded& x = expanded_[node];
     if (x.state == 2) return x;
-    if (x.state == 1) fail(node, "the node contains itself through <instance_node>: its hierarchy never ends");
+    if (x.state == 1) fail(node, "the " + std::string(node->Name()) + " contains itself through <instance_node>: its hierarchy never ends");
     if (level > kMaxNodeDepth)
       fail(node, "nodes nested deeper than " + std::to_string(kMaxNodeDepth) + " levels (instances expanded)");
     x.state = 1;

@@ -14,9 +14,10 @@ namespace clearway::detail {
 /// an integer in <p>, <vcount>, <v>, <h> or <int_array>, or other than a number in <float_array>; a
 /// count, stride or offset attribute that is not a whole number or exceeds the file's size; an <accessor>
 /// reaching past the end of its array; a <skew>; an <input> of a <mesh> whose source holds a <Name_array>
-/// or <IDREF_array>; two nodes, geometries or controllers with one id, or an instance naming (by name,
-/// for want of an id) several nodes; an <instance_node> that leads back to its own node; a node hierarchy, with its
-/// instances expanded, deeper than 256 levels or larger than 100,000 nodes; a node or visual scene whose
+/// or <IDREF_array>; two nodes, visual scenes, geometries or controllers with one id, or an instance
+/// naming (by name, for want of an id) several nodes; an <instance_node> that leads back to its own node
+/// or visual scene (assimp keeps a visual scene as a node, named by its id, its name or "Scene"); a node
+/// hierarchy, with its instances expanded, deeper than 256 levels or larger than 100,000 nodes; a node or visual scene whose
 /// instances reach more than 1,048,576 (2^20) triangles, each geometry counted once per path to it
 /// (polygons as the triangles they fan into), unless the file's geometries themselves hold more. The
 /// limit is 24 times the largest mesh of ../shared/robots (43,000 triangles): within it a mesh loads in

@@ -169,6 +169,30 @@ TEST(HostileMesh, ColladaInstancesExpandingToMillionsOfTrianglesAreRefused) {
   EXPECT_EQ(loadMesh(fine, Vec3::Ones()).triangles.size(), 32u);
 }
 
+// Found by fuzz_mesh_dae: a node of the visual scene instancing the visual scene itself. Assimp keeps a
+// visual scene as a node, found by its id, by its name, or by "Scene" when it has none, and recursed
+// until the stack overflowed (SIGSEGV); the pre-check looked for nodes only. Another visual scene may be
+// instanced, as assimp does.
+TEST(HostileMesh, ColladaVisualScenesInstancedByTheirOwnNodesAreRefused) {
+  TempDir dir;
+  const std::string scene = "<node id=\"n\"><instance_geometry url=\"#g\"/><node id=\"again\"><instance_node url=\"#";
+  const std::string by_id = dir.write("by_id.dae", collada(scene + "s\"/></node></node>"));
+  EXPECT_LOAD_ERROR_IN_TIME(loadMesh(by_id, Vec3::Ones()), by_id, "<node> (line 12)",
+                            "contains itself through <instance_node>");
+  const std::string unnamed = dir.write("unnamed.dae", collada(scene + "Scene\"/></node></node>"));
+  EXPECT_LOAD_ERROR_IN_TIME(loadMesh(unnamed, Vec3::Ones()), unnamed, "<node>", "contains itself");
+  std::string text = collada(scene + "world\"/></node></node>");
+  text.replace(text.find("<visual_scene id=\"s\">"), 21, "<visual_scene id=\"s\" name=\"world\">");
+  const std::string by_name = dir.write("by_name.dae", text);
+  EXPECT_LOAD_ERROR_IN_TIME(loadMesh(by_name, Vec3::Ones()), by_name, "<node>", "contains itself");
+
+  // A second visual scene, instanced by a node of the first: its tetrahedron joins the first one's.
+  text = collada(scene + "s2\"/></node></node>");
+  text.replace(text.find("</library_visual_scenes>"), 0,
+               "<visual_scene id=\"s2\"><node id=\"k\"><translate>5 0 0</translate><instance_geometry url=\"#g\"/></node></visual_scene>");
+  EXPECT_EQ(loadMesh(dir.write("other.dae", text), Vec3::Ones()).triangles.size(), 8u);
+}
+
 // An OBJ whose material library is a FIFO: assimp opened it and waited for a writer forever. A FIFO
 // given as the mesh itself is refused as not a regular file.
 TEST(HostileMesh, FifosAreNeverOpened) {
