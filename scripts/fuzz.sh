@@ -23,7 +23,7 @@ CC=clang CXX=clang++ cmake -S . -B "$BUILD" -DCLEARWAY_BUILD_FUZZERS=ON -DBUILD_
 cmake --build "$BUILD" -j2 --target clearway_fuzzers
 
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(urdf mesh_stl mesh_obj mesh_dae mesh_ply scene octomap query state_line motion_line)
+[ ${#targets[@]} -gt 0 ] || targets=(urdf mesh_stl mesh_obj mesh_dae mesh_ply scene octomap query state_line motion_line bench_merge)
 
 # Seeds of our own beyond fuzz/corpus/, by target (files as they are; the URDF target's SRDF after a
 # separator line).
@@ -39,12 +39,13 @@ seed() {
   esac
   # Inputs that once broke the tool (../shared is development data, never copied into the repository).
   if [ -d "$SHARED/bad-inputs" ]; then
-    local pattern
+    local pattern=''
     case "$target" in
       urdf) pattern='*.urdf' ;; mesh_*) pattern="*.${target#mesh_}" ;; scene) pattern='*.yaml' ;;
       octomap) pattern='*.[bo]t' ;; query) pattern='*.jsonl' ;; state_line) pattern='state*.txt' ;;
       motion_line) pattern='motions*.txt' ;;
     esac
+    [ -n "$pattern" ] || return 0
     find "$SHARED/bad-inputs" -name "$pattern" -type f | while read -r f; do
       cp "$f" "$dir/bad-$(basename "$(dirname "$f")")-$(basename "$f")"
     done

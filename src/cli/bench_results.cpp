@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -75,17 +76,27 @@ BenchResults readResults(const std::string& file) {
   BenchResults res;
   std::string line;
   int n = 0;
-  bool header = false, seen_shard = false, seen_cases = false, seen_end = false;
+  bool header = false, seen_config = false, seen_shard = false, seen_cases = false, seen_end = false;
   while (std::getline(in, line)) {
     const std::string where = file + ":" + std::to_string(++n);
     if (n == 1 && line != "# clearway bench results v1") throw std::runtime_error(where + ": not a clearway bench results file");
-    if (line.rfind("# config: ", 0) == 0) res.config = line.substr(10);
-    else if (line.rfind("# shard: ", 0) == 0) {
-      seen_shard = true;
+    // The run's identity, once each and before the rows: a case count given again after some rows would
+    // leave them beyond it.
+    const auto identity = [&](bool& seen, const char* what) {
+      if (seen) throw std::runtime_error(where + ": a second " + what + " line");
+      if (header) throw std::runtime_error(where + ": the " + what + " line comes after the column line");
+      seen = true;
+    };
+    if (line.rfind("# config: ", 0) == 0) {
+      identity(seen_config, "config");
+      res.config = line.substr(10);
+    } else if (line.rfind("# shard: ", 0) == 0) {
+      identity(seen_shard, "shard");
       const std::string s = line.substr(9);
       std::string why;
       if (s != "all" && !parseShard(s, res.shard, res.shards, why)) throw std::runtime_error(where + ": shard '" + s + "': " + why);
     } else if (line.rfind("# cases: ", 0) == 0) {
+      identity(seen_cases, "cases");
       seen_cases = parseLong(line.substr(9), res.cases) && res.cases >= 0;
       if (!seen_cases) throw std::runtime_error(where + ": bad case count");
     } else if (line.rfind("# end: ", 0) == 0) {
@@ -127,27 +138,29 @@ void writeResults(const std::string& file, const BenchResults& res) {
 BenchResults mergeShards(const std::vector<BenchResults>& shards, const std::vector<std::string>& files) {
   if (shards.empty()) throw std::runtime_error("no shards to merge");
   BenchResults merged;
-  std::vector<int> seen;
+  std::set<long> seen;  // the shards given (not a flag per shard: N may be anything a file says)
   for (std::size_t k = 0; k < shards.size(); ++k) {
     const BenchResults& shard = shards[k];
     const std::string& file = files[k];
     if (shard.shard < 0) throw std::runtime_error(file + ": not a shard (its shard line says all)");
-    if (merged.config.empty()) {
-      merged.config = shard.config, merged.cases = shard.cases, merged.shards = shard.shards;
-      seen.assign(shard.shards, 0);
-    }
+    if (merged.config.empty()) merged.config = shard.config, merged.cases = shard.cases, merged.shards = shard.shards;
     if (shard.config != merged.config) throw std::runtime_error(file + ": another configuration: " + shard.config);
     if (shard.shards != merged.shards || shard.cases != merged.cases)
       throw std::runtime_error(file + ": shard " + std::to_string(shard.shard) + "/" + std::to_string(shard.shards) +
                                " of " + std::to_string(shard.cases) + " cases does not match the first shard");
-    if (seen[shard.shard]++) throw std::runtime_error(file + ": shard " + std::to_string(shard.shard) + " given twice");
+    if (!seen.insert(shard.shard).second) throw std::runtime_error(file + ": shard " + std::to_string(shard.shard) + " given twice");
     for (const BenchRow& r : shard.rows)
       if (r.case_index % shard.shards != shard.shard)
         throw std::runtime_error(file + ": case " + std::to_string(r.case_index) + " does not belong to this shard");
     merged.rows.insert(merged.rows.end(), shard.rows.begin(), shard.rows.end());
   }
-  for (std::size_t i = 0; i < seen.size(); ++i)
-    if (!seen[i]) throw std::runtime_error("shard " + std::to_string(i) + "/" + std::to_string(seen.size()) + " is missing");
+  // The first shard missing: shards 0 … N−1 given once each are N shards, so one is missing while fewer
+  // were given, and it lies among the first few.
+  if (static_cast<long>(seen.size()) < merged.shards) {
+    long missing = 0;
+    while (seen.count(missing) > 0) ++missing;
+    throw std::runtime_error("shard " + std::to_string(missing) + "/" + std::to_string(merged.shards) + " is missing");
+  }
   merged.shard = -1, merged.shards = 0;
   std::stable_sort(merged.rows.begin(), merged.rows.end(),
                    [](const BenchRow& a, const BenchRow& b) { return a.case_index < b.case_index; });

@@ -45,7 +45,8 @@ bool parseShard(const std::string& s, long& index, long& count, std::string& why
 BenchRow parseRow(const std::string& line, const std::string& where);
 
 /// Reads a results.csv. Throws std::runtime_error naming the file, the line and the reason for a file
-/// that cannot be opened or is not one, a bad line or row, or a file cut short.
+/// that cannot be opened or is not one, a bad line or row, a config, shard or cases line given twice or
+/// after the column line, or a file cut short.
 BenchResults readResults(const std::string& file);
 
 /// Writes `res` as a results.csv. Throws std::runtime_error when the file cannot be written.

@@ -408,3 +408,37 @@ TEST(BenchTool, BadInputIsAClearError) {
   EXPECT_MENTIONS(r.err, "not a shard");
   fs::remove_all(dir);
 }
+
+// Found by fuzz_bench_merge's checks on its first inputs: a shard's own lines that disagree. "# shard:
+// 0/4000000000000" made the merge allocate a flag per shard (16 TB: std::bad_alloc, an ASan abort in
+// the sanitized tool); a second "# cases:" line after the rows lowered the case count below them, and
+// the merge wrote a results.csv that does not read back. Both are errors naming the file and line.
+TEST(BenchTool, ShardFilesThatContradictThemselvesAreAClearError) {
+  const std::string dir = tempDir("contradict");
+  const auto shard = [&](const std::string& name, const std::string& shard_line, const std::string& before_end) {
+    fs::create_directories(dir + "/" + name);
+    std::ofstream(dir + "/" + name + "/results.csv")
+        << "# clearway bench results v1\n# config: suites=narrowphase count=3 seed=1\n# shard: " << shard_line
+        << "\n# cases: 3\n"
+        << "suite,case,subject,engine,mode,tolerance,items,ns_per_item,work_per_item,positives,misses,false_alarms,"
+           "error,max_error\n"
+        << "narrowphase,0,box-capsule,clearway,distance,0.01,3,504.3,3,0,0,0,0,0\n"
+        << "narrowphase,0,box-capsule,fcl-indep,distance,0.01,3,1288.3,0,0,0,0,0.0045,0.011\n"
+        << before_end << "# end: 2 rows\n";
+    return "'" + dir + "/" + name + "'";
+  };
+  ToolRun r = runTool("bench merge --out '" + dir + "/m' " + shard("huge", "0/4000000000000", ""));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_MENTIONS(r.err, "shard 1/4000000000000 is missing");
+  r = runTool("bench merge --out '" + dir + "/m' " + shard("lowered", "0/1", "# cases: 1\n"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_MENTIONS(r.err, "lowered/results.csv:8: a second cases line");
+  r = runTool("bench merge --out '" + dir + "/m' " + shard("twice", "0/1\n# shard: 0/2", ""));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_MENTIONS(r.err, "twice/results.csv:4: a second shard line");
+  EXPECT_FALSE(fs::exists(dir + "/m/results.csv"));
+  // The same file without the contradiction merges.
+  r = runTool("bench merge --out '" + dir + "/m' " + shard("fine", "0/1", ""));
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  fs::remove_all(dir);
+}
