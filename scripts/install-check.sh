@@ -15,26 +15,28 @@ trap 'rm -rf "$work"' EXIT
 step() { echo "install-check: $*" >&2; }
 fail() { echo "install-check: FAILED: $*" >&2; exit 1; }
 
-step "copying the source to $work/src"
-mkdir "$work/src"
+# The source in WORK/src/clearway and its build in WORK/build/clearway: laid out as colcon-check.sh's and
+# pip-check.sh's Release builds, so that a compiler cache shared by them (.ci/run) serves all three.
+step "copying the source to $work/src/clearway"
+mkdir -p "$work/src/clearway"
 # Tracked files (as modified in the working tree) and new files git does not ignore: a clone's content.
 # A tracked file deleted in the working tree is skipped (--ignore-failed-read).
 (cd "$root" && git ls-files -z --cached --others --exclude-standard | tar --null --ignore-failed-read -T - -cf - 2>/dev/null) |
-  tar -xf - -C "$work/src"
-version=$(sed -n 's/^project(clearway VERSION \([0-9.]*\).*/\1/p' "$work/src/CMakeLists.txt")
+  tar -xf - -C "$work/src/clearway"
+version=$(sed -n 's/^project(clearway VERSION \([0-9.]*\).*/\1/p' "$work/src/clearway/CMakeLists.txt")
 [ -n "$version" ] || fail "no version in CMakeLists.txt's project()"
-cp -r "$work/src/tests/install/downstream" "$work/downstream"
+cp -r "$work/src/clearway/tests/install/downstream" "$work/downstream"
 
 step "building and installing (the README's Install section)"
 (
-  cd "$work/src"
-  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DCLEARWAY_BUILD_TESTS=OFF -DCLEARWAY_BUILD_BENCHMARKS=OFF >/dev/null
-  cmake --build build -j"${JOBS:-2}" >/dev/null
-  cmake --install build --prefix "$work/prefix" >/dev/null
+  cd "$work/src/clearway"
+  cmake -S . -B ../../build/clearway -DCMAKE_BUILD_TYPE=Release -DCLEARWAY_BUILD_TESTS=OFF -DCLEARWAY_BUILD_BENCHMARKS=OFF >/dev/null
+  cmake --build ../../build/clearway -j"${JOBS:-2}" >/dev/null
+  cmake --install ../../build/clearway --prefix "$work/prefix" >/dev/null
 ) || fail "the build or install"
 
 # Nothing installed may need the source or the build tree, nor the path it was installed to.
-rm -rf "$work/src"
+rm -rf "$work/src" "$work/build"
 mkdir "$work/moved" "$work/elsewhere"
 mv "$work/prefix" "$work/moved/prefix"
 P=$work/moved/prefix

@@ -15,6 +15,11 @@ packages=(
   libcli11-dev                       # the clearway tool's argument parser
   libgtest-dev libgmock-dev libbenchmark-dev  # tests and benchmarks
   python3-dev pybind11-dev python3-numpy python3-pytest  # the Python module and its tests
+  python3-venv python3-setuptools python3-wheel  # pip install . (setup.py drives CMake; scripts/pip-check.sh)
+  colcon python3-colcon-cmake python3-colcon-ros python3-colcon-recursive-crawl python3-colcon-parallel-executor
+  python3-colcon-package-selection python3-colcon-bash python3-colcon-output  # a colcon workspace (scripts/colcon-check.sh)
+  ccache                             # CI: one compiler cache for its three Release builds (.ci/run)
+  doxygen                            # the API reference (target clearway_docs)
   libfcl-dev                         # benchmarks only: FCL side by side
   gnuplot-nox                        # benchmark plots (PNG)
   clang libfuzzer-14-dev             # scripts/fuzz.sh: the libFuzzer targets in fuzz/
