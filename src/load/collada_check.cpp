@@ -133,9 +133,10 @@ class Checker {
       // Assimp reads as many values as the array's count="N" says (none when it is missing), at most
       // the values written.
       const std::uint64_t length = std::min(countTokens(it->second), wholeNumber(it->second, "count"));
-      // Each of these is at most the file size (wholeNumber), so the sum cannot overflow 64 bits.
-      const std::uint64_t needed = offset + (count - 1) * stride + params;
-      if (count > 0 && params > 0 && needed > length)
+      // Each of these is at most the file size (wholeNumber), so the sum cannot overflow 64 bits. Without
+      // a <param> assimp still reads one value per item (every component at sub-offset 0).
+      const std::uint64_t needed = offset + (count - 1) * stride + std::max<std::uint64_t>(params, 1);
+      if (count > 0 && needed > length)
         fail(a, "reaches value " + std::to_string(needed) + " of '" + inputExcerpt(source + 1) + "', which holds " +
                     std::to_string(length));
     }

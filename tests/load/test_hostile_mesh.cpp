@@ -193,6 +193,26 @@ TEST(HostileMesh, ColladaVisualScenesInstancedByTheirOwnNodesAreRefused) {
   EXPECT_EQ(loadMesh(dir.write("other.dae", text), Vec3::Ones()).triangles.size(), 8u);
 }
 
+// Found by fuzz_mesh_dae: an <accessor> without <param> elements over a <float_array> without count="N"
+// (of which assimp reads no value). Assimp still reads one value per item, at sub-offset 0: a null read
+// (SIGSEGV). The pre-check skipped accessors without parameters.
+TEST(HostileMesh, ColladaAccessorsWithoutParamsStayWithinTheirArrays) {
+  TempDir dir;
+  const auto without_params = [](std::string text) {
+    const std::string params =
+        "<param name=\"X\" type=\"float\"/><param name=\"Y\" type=\"float\"/><param name=\"Z\" type=\"float\"/>";
+    return text.replace(text.find(params), params.size(), "");
+  };
+  const std::string uncounted = dir.write(
+      "uncounted.dae", without_params(collada(kTetScene, "", "<float_array id=\"pa\">0 0 0 1 0 0 0 1 0 0 0 1</float_array>")));
+  EXPECT_LOAD_ERROR_IN_TIME(loadMesh(uncounted, Vec3::Ones()), uncounted, "<accessor> (line 6)",
+                            "reaches value 10 of 'pa', which holds 0");
+  std::string text = without_params(collada(kTetScene));
+  text.replace(text.find("count=\"4\" stride=\"3\""), 20, "count=\"5\" stride=\"3\"");
+  const std::string beyond = dir.write("beyond.dae", text);
+  EXPECT_LOAD_ERROR_IN_TIME(loadMesh(beyond, Vec3::Ones()), beyond, "<accessor>", "reaches value 13 of 'pa', which holds 12");
+}
+
 // An OBJ whose material library is a FIFO: assimp opened it and waited for a writer forever. A FIFO
 // given as the mesh itself is refused as not a regular file.
 TEST(HostileMesh, FifosAreNeverOpened) {
