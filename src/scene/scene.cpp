@@ -357,6 +357,10 @@ std::shared_ptr<const Scene> Scene::withoutAttached(const std::string& name) con
                                [&](const SceneDescription::AttachedSpec& a) { return a.body.name == name; });
   if (it == d.attached.end()) throw std::invalid_argument("detach '" + name + "': no attached body has that name");
   d.attached.erase(it);
+  // The pairs the scene allows with the body go with it: no link has its name any more.
+  d.allow.erase(std::remove_if(d.allow.begin(), d.allow.end(),
+                               [&](const std::pair<std::string, std::string>& p) { return p.first == name || p.second == name; }),
+                d.allow.end());
   auto bare = std::make_shared<const RobotModel>(detachBodies(robot(), {name}));
   return std::make_shared<const Scene>(d, std::make_shared<const RobotGeometry>(std::move(bare), *geometry_),
                                        environment_, options_);

@@ -11,7 +11,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace clearway {
@@ -99,6 +101,33 @@ TEST(Attached, CertifiedCatchesASweepThroughAPostThatSamplingMisses) {
   MotionChecker one_percent(scene, sampled);
   MotionContext sctx = one_percent.makeContext();
   EXPECT_TRUE(one_percent.check(q0.data(), q1.data(), sctx).free) << "the 1% sampling was to step over the post";
+}
+
+// Found by fuzz_scene_attached: a body the scene file allows a pair with (robot.allow) could not be taken
+// off (Scene::withoutAttached, World::detach, Python's without_attached): the scene built without it still
+// allowed the pair, and its check of the file's keys threw LoadError (key 'robot.allow[0]': link 'stick'
+// is not in robot 'arm6'). The pairs naming the body now go with it; the others stay.
+TEST(Attached, TakingABodyOffTakesItsAllowedPairsOff) {
+  TempDir dir;
+  std::string text = armScene(kStick, kWall);
+  text.insert(text.find("environment:\n"), "  allow: [[stick, forearm_link], [base_link, forearm_link]]\n");
+  const auto held = Scene::load(dir.write("held.yaml", text));
+  const RobotModel& m = held->robot();
+  EXPECT_FALSE(held->filter().enabled(m.linkIndex("stick"), m.linkIndex("forearm_link")));
+  std::shared_ptr<const Scene> bare;
+  ASSERT_NO_THROW(bare = held->withoutAttached("stick"));
+  EXPECT_LT(bare->robot().linkIndex("stick"), 0);
+  ASSERT_EQ(bare->description().allow.size(), 1u);
+  EXPECT_EQ(bare->description().allow[0], std::make_pair(std::string("base_link"), std::string("forearm_link")));
+  const RobotModel& b = bare->robot();
+  EXPECT_FALSE(bare->filter().enabled(b.linkIndex("base_link"), b.linkIndex("forearm_link")));
+  const std::vector<double> upright(6, 0.0);
+  EXPECT_FALSE(held->isFree(upright));  // the stick in the wall
+  EXPECT_TRUE(bare->isFree(upright));
+  // Held again, as the file holds it.
+  SceneDescription::AttachedSpec stick = held->description().attached[0];
+  const auto again = bare->withAttached(stick);
+  EXPECT_FALSE(again->isFree(upright));
 }
 
 TEST(Attached, BadDeclarationsNameTheKey) {

@@ -154,8 +154,9 @@ class Scene {
   /// geometry. Throws std::invalid_argument for an unknown link or touch link, a name a link already has,
   /// or a mesh that cannot be read.
   std::shared_ptr<const Scene> withAttached(const SceneDescription::AttachedSpec& body, const LoadOptions& load = {}) const;
-  /// This scene without the named attached body (one attached by withAttached or by the scene file).
-  /// Throws std::invalid_argument when no attached body has that name.
+  /// This scene without the named attached body (one attached by withAttached or by the scene file), and
+  /// without the allowed pairs (robot.allow) that name it. Throws std::invalid_argument when no attached
+  /// body has that name.
   std::shared_ptr<const Scene> withoutAttached(const std::string& name) const;
 
   /// parseSceneFile + the constructor.
