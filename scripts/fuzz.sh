@@ -23,7 +23,7 @@ CC=clang CXX=clang++ cmake -S . -B "$BUILD" -DCLEARWAY_BUILD_FUZZERS=ON -DBUILD_
 cmake --build "$BUILD" -j2 --target clearway_fuzzers
 
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(urdf mesh_stl mesh_obj mesh_dae mesh_ply scene octomap query state_line motion_line bench_merge)
+[ ${#targets[@]} -gt 0 ] || targets=(urdf mesh_stl mesh_obj mesh_dae mesh_ply scene octomap query state_line motion_line bench_merge scene_attached)
 
 # Seeds of our own beyond fuzz/corpus/, by target (files as they are; the URDF target's SRDF after a
 # separator line).
@@ -34,14 +34,14 @@ seed() {
       for f in robots/*/*.urdf; do cp "$f" "$dir/"; done
       { cat robots/arm6/arm6.urdf; printf '\n@@SRDF@@\n'; cat robots/arm6/arm6.srdf; } >"$dir/arm6_with_srdf.urdf" ;;
     mesh_*) find robots -name "*.${target#mesh_}" -exec cp {} "$dir/" \; ;;
-    scene) cp robots/scenes/*.yaml "$dir/" ;;
+    scene | scene_attached) cp robots/scenes/*.yaml "$dir/" ;;
     query) cp robots/demo/queries.jsonl "$dir/" ;;
   esac
   # Inputs that once broke the tool (../shared is development data, never copied into the repository).
   if [ -d "$SHARED/bad-inputs" ]; then
     local pattern=''
     case "$target" in
-      urdf) pattern='*.urdf' ;; mesh_*) pattern="*.${target#mesh_}" ;; scene) pattern='*.yaml' ;;
+      urdf) pattern='*.urdf' ;; mesh_*) pattern="*.${target#mesh_}" ;; scene | scene_attached) pattern='*.yaml' ;;
       octomap) pattern='*.[bo]t' ;; query) pattern='*.jsonl' ;; state_line) pattern='state*.txt' ;;
       motion_line) pattern='motions*.txt' ;;
     esac
