@@ -142,6 +142,8 @@ void Scene::init() {
     const Joint& joint = model.joint(j);
     if (joint.first_variable < 0)
       fail(key, "joint '" + inputExcerpt(name) + "' is " + (joint.isMimic() ? "a mimic" : "fixed") + ": it has no value to plan");
+    // A floating joint's state entries are x, y, z, then its quaternion's qx, qy, qz, qw.
+    if (joint.type == JointType::Floating) quaternions_.push_back(static_cast<int>(group_variables_.size()) + 3);
     for (int k = 0; k < jointVariableCount(joint.type); ++k) {
       const int v = joint.first_variable + k;
       if (taken[v]) fail(key, "joint '" + inputExcerpt(name) + "' is listed twice");
@@ -413,6 +415,13 @@ bool Scene::validState(const double* state, std::string* why) const {
       return false;
     }
   }
+  for (const int i : quaternions_)
+    if (!rotates(state + i)) {
+      if (why)
+        *why = "state[" + std::to_string(i) + ".." + std::to_string(i + 3) + "] (" + model.variables()[group_variables_[i]].name +
+               " ...) is a zero quaternion (its squares add up to 0): it names no rotation";
+      return false;
+    }
   return true;
 }
 
@@ -421,6 +430,8 @@ bool Scene::withinBounds(const double* state) const noexcept {
     // Written so that a NaN fails.
     if (!(state[i] >= valid_lower_[i] && state[i] <= valid_upper_[i])) return false;
   }
+  for (const int i : quaternions_)
+    if (!rotates(state + i)) return false;
   return true;
 }
 

@@ -1,5 +1,6 @@
 // Scenes: the file format (every error names the file and the key), the effects a scene declares
 // (and the work it does not do), and the shared MotionBenchMaker problems.
+#include <clearway/motion/motion.h>
 #include <clearway/scene/scene.h>
 
 #include "load/robot_files.h"
@@ -844,6 +845,40 @@ TEST(Scene, TheClearanceGridChangesNoVerdict) {
       }
   }
   std::printf("the grid cleared %lld links\n", clears);
+}
+
+// Found by fuzz_scene_edits: a floating joint's quaternion of zeros passed validState (the tool's check
+// and motion, Python, OMPL's bounds), while its poses are NaN: check called the state a collision with
+// "environment", and the certified and cast motions called a segment ending there free. The flyer by its
+// post (the plate taken away): [1, 1, 1, 0, 0, 0, 0] is now invalid, naming the quaternion, everywhere.
+TEST(Scene, AZeroQuaternionIsAnInvalidState) {
+  TempDir dir;
+  std::ifstream in(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/flyer_post.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = std::regex_replace(text.str(), std::regex("    - name: plate\n.*\n.*\n"), "");
+  yaml = std::regex_replace(yaml, std::regex("\\.\\./flyer/"), test::sourceRobot("flyer/"));
+  ASSERT_EQ(yaml.find("name: plate"), std::string::npos);
+  const auto scene = Scene::load(dir.write("post.yaml", yaml));
+  const std::vector<double> zero{1, 1, 1, 0, 0, 0, 0}, upright{1, 1, 1, 0, 0, 0, 1}, tiny{1, 1, 1, 0, 0, 0, 1e-170};
+  std::string why;
+  EXPECT_FALSE(scene->validState(zero.data(), &why));
+  EXPECT_NE(why.find("state[3..6] (fly/qx ...) is a zero quaternion"), std::string::npos) << why;
+  EXPECT_FALSE(scene->validState(tiny.data()));  // its square is 0 in doubles: no rotation either
+  EXPECT_TRUE(scene->validState(upright.data()));
+  EXPECT_TRUE(scene->validState(std::vector<double>{1, 1, 1, 0, 0, 0, 1e-150}.data()));  // normalises
+  CollisionReport report;
+  EXPECT_FALSE(scene->isFree(zero, &report));
+  EXPECT_EQ(report.kind, CollisionReport::Kind::Invalid);
+  EXPECT_TRUE(scene->isFree(upright));
+  for (const MotionMode mode : {MotionMode::Certified, MotionMode::Cast}) {
+    MotionOptions options;
+    options.mode = mode;
+    const MotionChecker checker(scene, options);
+    MotionContext ctx = checker.makeContext();
+    EXPECT_FALSE(checker.check(upright.data(), zero.data(), ctx).free) << static_cast<int>(mode);
+    EXPECT_FALSE(checker.check(zero.data(), upright.data(), ctx).free) << static_cast<int>(mode);
+  }
 }
 
 }  // namespace

@@ -204,8 +204,8 @@ class Scene {
   /// Fills context.q (full joint vector) and context.poses from a state; no checks.
   void computePoses(const double* state, SceneContext& context) const noexcept;
 
-  /// True when the state is within bounds and finite (then `why` is untouched), else false and `why`
-  /// names the entry, its value and the bound.
+  /// True when the state is within bounds and finite, and each floating joint's quaternion is not zero
+  /// (then `why` is untouched), else false and `why` names the entry, its value and the bound.
   bool validState(const double* state, std::string* why = nullptr) const;
 
   /// True when the state is valid and free of every declared collision effect at time t (t is used
@@ -248,6 +248,9 @@ class Scene {
   bool withinBounds(const double* state) const noexcept;  // the cheap check of every query (no reason)
   // A moment obstacles may be placed at: finite and within ±kMaxTime (NaN fails).
   static bool withinTime(double t) noexcept { return std::abs(t) <= kMaxTime; }
+  // A floating joint's quaternion (qx, qy, qz, qw) that the kinematics can normalise: its squares do not
+  // add up to 0, as validateJointVector asks (a zero quaternion's poses are NaN).
+  static bool rotates(const double* q) noexcept { return q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] > 0.0; }
   // isFree's geometry, once the poses of the state's links (and its full joint vector q) are known.
   bool posedFree(const Pose* poses, const double* q, SceneContext& ctx, CollisionReport& r, double t) const noexcept;
   // Its two halves: the environment (placing the enclosing balls where the clearance grid is read, which
@@ -272,6 +275,7 @@ class Scene {
   // What a state entry may hold: the limits widened by kJointLimitTolerance, within ±kMaxJointValue.
   std::vector<double> valid_lower_, valid_upper_;
   std::vector<double> base_q_;  // held values and defaults; group entries overwritten per query
+  std::vector<int> quaternions_;  // the state index of each floating joint's qx (qy, qz, qw follow)
   std::vector<int> moving_links_, env_links_;
   std::vector<double> link_padding_;
   CollisionReport static_collision_;  // a collision no state can undo (static links), found at construction
