@@ -7,13 +7,13 @@
 
 namespace clearway {
 
-using Vec3 = Eigen::Vector3d;
-using Mat3 = Eigen::Matrix3d;
+using Vec3 = Eigen::Vector3d;  ///< a point or vector (metres where a length; its frame is always stated)
+using Mat3 = Eigen::Matrix3d;  ///< a 3×3 matrix (rotations: Pose::R)
 
 /// A rigid transform: a point p in the local frame is R·p + t in the parent frame.
 struct Pose {
-  Mat3 R = Mat3::Identity();
-  Vec3 t = Vec3::Zero();
+  Mat3 R = Mat3::Identity();  ///< rotation: orthonormal, det +1 (the caller's promise; not checked)
+  Vec3 t = Vec3::Zero();      ///< translation (metres, parent frame)
 
   /// The identity transform.
   static Pose identity() { return {}; }

@@ -15,8 +15,8 @@ struct PenetrationResult {
   Vec3 normal = Vec3::Zero();    ///< unit: B moves along it to separate (points from A towards B)
   Vec3 point_a = Vec3::Zero();   ///< deepest (or closest) point of A (world)
   Vec3 point_b = Vec3::Zero();   ///< deepest (or closest) point of B (world)
-  Status status = Status::NotConverged;
-  int iterations = 0;
+  Status status = Status::NotConverged;  ///< why it stopped; isFailure(status): treat as a collision
+  int iterations = 0;            ///< GJK's iterations plus EPA's (0 for invalid input)
 };
 
 namespace detail {

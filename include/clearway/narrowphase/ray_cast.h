@@ -22,15 +22,15 @@ struct CastResult {
   double t = 0.0;           ///< time of impact (ray parameter); 0 when starting in contact
   Vec3 normal = Vec3::Zero();  ///< unit outward normal of the still shape at the contact; zero when starting inside
   Vec3 point = Vec3::Zero();   ///< contact point on the still shape
-  Status status = Status::NotConverged;
-  int iterations = 0;
+  Status status = Status::NotConverged;  ///< why it stopped; isFailure(status): hit is true
+  int iterations = 0;          ///< cast and advancement steps run (≤ Tolerances::cast_max_iterations)
 };
 
 /// A ray in the world frame: the points origin + t·direction, 0 ≤ t ≤ max_t.
 struct Ray {
-  Vec3 origin = Vec3::Zero();
-  Vec3 direction = Vec3::UnitX();
-  double max_t = 1.0;
+  Vec3 origin = Vec3::Zero();      ///< the point at t = 0 (world)
+  Vec3 direction = Vec3::UnitX();  ///< any length: t counts multiples of it
+  double max_t = 1.0;              ///< the last t considered
 };
 
 namespace detail {

@@ -21,6 +21,7 @@ class ConvexHull {
   Vec3 support(const Vec3& d) const noexcept;
   /// The same, hill-climbing from vertex `hint` (if valid) and leaving the answer's index in it.
   Vec3 support(const Vec3& d, std::int32_t& hint) const noexcept;
+  /// 0: the hull is its own core.
   double radius() const noexcept { return 0.0; }
   /// An interior point of the hull (the mean of its vertices).
   Vec3 center() const noexcept { return center_; }

@@ -10,8 +10,8 @@ namespace clearway {
 
 /// An indexed triangle mesh: vertices (no duplicates) and triangles indexing them.
 struct TriangleMesh {
-  std::vector<Vec3> vertices;
-  std::vector<std::array<std::int32_t, 3>> triangles;
+  std::vector<Vec3> vertices;                          ///< positions (metres, the mesh's frame)
+  std::vector<std::array<std::int32_t, 3>> triangles;  ///< three indices into vertices each
 };
 
 }  // namespace clearway

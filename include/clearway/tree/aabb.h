@@ -12,8 +12,8 @@ namespace clearway {
 
 /// A closed axis-aligned box [min, max] in some frame; empty when min > max on an axis (the default).
 struct Aabb {
-  Vec3 min = Vec3::Constant(std::numeric_limits<double>::infinity());
-  Vec3 max = Vec3::Constant(-std::numeric_limits<double>::infinity());
+  Vec3 min = Vec3::Constant(std::numeric_limits<double>::infinity());   ///< lowest corner (+∞ when empty)
+  Vec3 max = Vec3::Constant(-std::numeric_limits<double>::infinity());  ///< highest corner (−∞ when empty)
 
   /// The empty box: grow() and merge() turn it into the box of what they are given.
   static Aabb empty() noexcept { return {}; }
@@ -31,10 +31,12 @@ struct Aabb {
   /// Extends the box to contain b (an empty b changes nothing).
   void merge(const Aabb& b) noexcept { min = min.cwiseMin(b.min); max = max.cwiseMax(b.max); }
 
+  ///@{
   /// The centre, half extents and extents (max − min) of a non-empty box.
   Vec3 center() const noexcept { return 0.5 * (min + max); }
   Vec3 halfExtents() const noexcept { return 0.5 * (max - min); }
   Vec3 extents() const noexcept { return max - min; }
+  ///@}
   /// Surface area (the SAH cost of a node); 0 for an empty box.
   double surfaceArea() const noexcept {
     if (isEmpty()) return 0.0;

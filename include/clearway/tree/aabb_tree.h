@@ -33,7 +33,7 @@ enum class TreeSplit {
 /// (benchmarks/tree_bench.cpp: tree-vs-tree with SAH takes 0.6–0.8 of the median split's time; leaves
 /// of 3 beat 1, 2 and 4 by 5–15 %), at 3–4× the build time of the median split.
 struct TreeBuildOptions {
-  TreeSplit split = TreeSplit::Sah;
+  TreeSplit split = TreeSplit::Sah;  ///< how each node divides its items
   /// Maximum items per leaf, 1 … AabbTree::kMaxLeafSize.
   int leaf_size = 3;
 };
@@ -44,13 +44,14 @@ class AabbTree {
  public:
   /// Depth bound the build guarantees (root at depth 0); traversal stacks are sized by it.
   static constexpr int kMaxDepth = 64;
-  static constexpr int kMaxLeafSize = 4;
+  static constexpr int kMaxLeafSize = 4;  ///< the largest TreeBuildOptions::leaf_size a build accepts
 
   /// A node: its box and either two children (at `first` and `first + 1`) or a range of item slots.
   struct Node {
-    Aabb box;
+    Aabb box;  ///< contains the boxes of every item below the node (tree frame)
     std::int32_t first = 0;  ///< inner node: index of the left child (the right one follows it); leaf: first slot
     std::int32_t count = 0;  ///< leaf: number of items (1 … leaf_size); inner node: 0
+    /// True for a leaf (count > 0).
     bool isLeaf() const noexcept { return count > 0; }
   };
 
@@ -60,8 +61,11 @@ class AabbTree {
   /// empty or non-finite box, a leaf size outside 1 … kMaxLeafSize, or more than 2³⁰ items.
   explicit AabbTree(const std::vector<Aabb>& item_boxes, const TreeBuildOptions& options = {});
 
+  /// True for the default tree (a build has at least one item).
   bool empty() const noexcept { return nodes_.empty(); }
+  /// The number of items (the size of item_boxes).
   int itemCount() const noexcept { return static_cast<int>(items_.size()); }
+  /// The number of nodes, leaves included (0 for the empty tree).
   int nodeCount() const noexcept { return static_cast<int>(nodes_.size()); }
   /// The number of edges on the longest root-to-leaf path (0 for a single leaf, or an empty tree).
   int depth() const noexcept { return depth_; }

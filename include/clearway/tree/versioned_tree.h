@@ -74,12 +74,15 @@ class VersionedAabbTree {
   class Key {
    public:
     Key() = default;
+    /// A strict total order: the Morton order of the items' box centres at insertion, then insertion order.
     friend bool operator<(const Key& a, const Key& b) noexcept {
       return a.morton_ < b.morton_ || (a.morton_ == b.morton_ && a.serial_ < b.serial_);
     }
+    /// Equal keys name the same item in versions derived from one another (default keys: none).
     friend bool operator==(const Key& a, const Key& b) noexcept {
       return a.morton_ == b.morton_ && a.serial_ == b.serial_;
     }
+    /// !(a == b).
     friend bool operator!=(const Key& a, const Key& b) noexcept { return !(a == b); }
 
    private:
@@ -162,7 +165,9 @@ class VersionedAabbTree {
     return item ? &item->value : nullptr;
   }
 
+  /// The number of items in this version.
   int size() const noexcept { return items_.size(); }
+  /// True when this version holds no item.
   bool empty() const noexcept { return items_.empty(); }
   /// Nodes on the longest root-to-leaf path: 0 when empty, below 1.4405·log₂(size + 2).
   int height() const noexcept { return items_.height(); }
