@@ -41,7 +41,7 @@ class EnclosingBalls {
 
   /// A ball as placed, world frame.
   struct Placed {
-    Vec3 center;
+    Vec3 center;    ///< world frame
     double radius;  ///< grown by the rounding of the placement: it holds what the link-frame ball held
   };
   /// How many balls link i has: 0 without geometry, else its bounding ball and, when it has several

@@ -43,8 +43,8 @@ class LinkGeometry {
  public:
   /// A primitive collision element placed in the link frame.
   struct Primitive {
-    Shape shape;
-    Pose pose;
+    Shape shape;  ///< in its own local frame
+    Pose pose;    ///< the shape's frame in the link frame
   };
 
   /// The triangles of one mesh (already in the link frame). Throws ShapeError for a mesh without
@@ -75,18 +75,21 @@ class LinkGeometry {
   /// and one per primitive; each with a ball that contains it (link frame). Tighter than hull() where the
   /// link is concave, and far cheaper than the triangles.
   struct Part {
-    ConvexHull hull;
-    Vec3 center;
-    double radius;
+    ConvexHull hull;  ///< the piece (link frame)
+    Vec3 center;      ///< centre of a ball containing hull (link frame)
+    double radius;    ///< that ball's radius (metres)
   };
   /// At most this many parts come from the triangles (each primitive adds one more). Four: a pair of
   /// links may cost parts² GJKs, and on the shared UR5 motions 8 and 16 parts cost more than their
   /// tighter bound saved, while 2 were too loose (mesh searches made motions 5 times slower).
   static constexpr int kMaxParts = 4;
+  /// The parts: at most kMaxParts from the triangles, plus one per primitive.
   const std::vector<Part>& parts() const noexcept { return parts_; }
+  ///@{
   /// A ball containing the hull (the first, cheapest test): centre in the link frame, and radius.
   const Vec3& sphereCenter() const noexcept { return sphere_center_; }
   double sphereRadius() const noexcept { return sphere_radius_; }
+  ///@}
 
   /// How many closed shells of triangles the link has (edge-connected, however they touch); the other
   /// triangles are open surfaces.
@@ -101,8 +104,8 @@ class LinkGeometry {
 
   /// A ball, link frame.
   struct Ball {
-    Vec3 center;
-    double radius;
+    Vec3 center;    ///< link frame
+    double radius;  ///< metres
   };
   /// At most this many cores per link: a pair compares up to kMaxCores² of them, which must stay cheap
   /// beside the hull test they follow.
@@ -180,6 +183,7 @@ Aabb placedBox(const S& s, const Pose& pose) noexcept {
   }
   return box;
 }
+/// placedBox of any Shape (the variant visited once).
 Aabb placedBox(const Shape& shape, const Pose& pose) noexcept;
 
 /// The narrow phase's band for a query whose coordinates and sizes are at most `scale` metres: GJK calls
@@ -228,7 +232,10 @@ bool meshesIntersectExactly(const LinkGeometry& a, const Pose& pose_a, const Lin
                             const Tolerances& tol, double padding = 0.0) noexcept;
 /// Two triangles, one of each link (indices into triangles()), that touch: a witness that the links do.
 struct TrianglePair {
-  std::int32_t a = -1, b = -1;
+  ///@{
+  std::int32_t a = -1, b = -1;  ///< index into the first / the second link's triangles(); -1: none
+  ///@}
+  /// True when both indices are set (a pair was found).
   bool valid() const noexcept { return a >= 0 && b >= 0; }
 };
 /// meshesIntersectExactly, also giving (when the answer is true because two triangles touch) the pair found.

@@ -47,9 +47,12 @@ enum class Rung : char { Balls, Hulls, Parts, Exact };
 /// without allocating; the geometries must outlive it. Not thread-safe: one per pair and thread.
 class BodyPair {
  public:
+  /// The pair of a and b (borrowed), with cold warm starts; allocates nothing.
   BodyPair(const LinkGeometry& a, const LinkGeometry& b);
 
+  /// The first body, as given.
   const LinkGeometry& a() const noexcept { return *a_; }
+  /// The second body, as given.
   const LinkGeometry& b() const noexcept { return *b_; }
 
   /// True when the bodies (placed by the poses) are within q.padding of each other: meshesIntersect, warm.
@@ -58,6 +61,7 @@ class BodyPair {
   /// intersects() split in two: its rungs short of the triangles (screenMeshes, warm), then, for an Unsure
   /// pair, the triangles (meshesIntersectExactly). Together they answer as intersects() does.
   Screen screen(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, const IntersectQuery& q) noexcept;
+  /// The triangles' rung alone: meshesIntersectExactly on the two bodies (no warm start used or kept).
   bool intersectsExactly(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, double padding) const noexcept;
   /// A certified lower bound on the distance between the bodies (see BoundQuery); 0 for non-finite input or
   /// a narrow-phase failure.

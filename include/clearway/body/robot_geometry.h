@@ -19,7 +19,9 @@ class RobotGeometry {
   /// same collision elements (true for models made from one another by attachBodies/detachBodies).
   RobotGeometry(std::shared_ptr<const RobotModel> model, const RobotGeometry& reuse, const TreeBuildOptions& options = {});
 
+  /// The model the geometry was built from.
   const RobotModel& model() const noexcept { return *model_; }
+  /// The same model, shared (it lives as long as any holder of this pointer).
   const std::shared_ptr<const RobotModel>& modelPtr() const noexcept { return model_; }
   /// Link i's geometry, or null when the link has no collision element.
   const LinkGeometry* link(int i) const noexcept { return links_[i].get(); }

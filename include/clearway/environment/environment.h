@@ -50,17 +50,21 @@ OccupancyMap loadOctomap(const std::string& path, UnknownSpace unknown = Unknown
 
 /// One obstacle: a convex shape or a triangle mesh, placed in the world, optionally moving.
 struct Obstacle {
-  std::string name;
+  std::string name;                    ///< for Environment::obstacle(name) and messages; need not be unique
   Shape shape;                         ///< used when mesh is null
   std::shared_ptr<const LinkGeometry> mesh;  ///< a mesh obstacle's triangles, tree and hull (null for a shape)
   Pose pose;                           ///< at time 0
   Vec3 velocity = Vec3::Zero();        ///< m/s, world frame: the pose at time t is translated by t·velocity
+  /// True when velocity is not zero.
   bool moving() const noexcept { return velocity != Vec3::Zero(); }
 };
 
 /// Which part of the environment a link touched.
 struct EnvironmentHit {
+  ///@{
+  /// What was touched: nothing, an obstacle, or a voxel (a map's or a point's).
   enum class Kind { None, Obstacle, Voxel } kind = Kind::None;
+  ///@}
   int index = -1;  ///< a voxel of the map: its index into OccupancyMap::occupied (−1 for other hits)
   const Obstacle* obstacle = nullptr;  ///< the obstacle touched (valid while its environment lives)
   Aabb voxel;  ///< the voxel touched (a map's, or one made by withPoints)
@@ -92,12 +96,15 @@ class Environment {
   const Obstacle* obstacle(const std::string& name) const noexcept;
   /// The obstacles that move.
   const std::vector<std::shared_ptr<const Obstacle>>& movingObstacles() const noexcept { return moving_; }
+  /// The occupancy map, or null when there is none (valid while this environment or a copy lives).
   const OccupancyMap* map() const noexcept { return map_.get(); }
   /// Voxels made occupied by withPoints (beyond the map's own).
   int pointVoxelCount() const noexcept { return point_voxels_; }
+  /// True when nothing can be hit: no obstacle, no voxel of the map or of withPoints.
   bool empty() const noexcept {
     return static_.empty() && moving_.empty() && (!map_ || map_->occupied.empty());
   }
+  /// True when some obstacle moves (then the clearance grid is not consulted).
   bool hasMovingObstacles() const noexcept { return !moving_.empty(); }
   /// The static obstacles' and voxels' clearance grid (clearance_grid.h), once built, else null. While no
   /// obstacle moves, Scene::isFree reads it before the trees: a link inside balls it clears is free of

@@ -21,7 +21,7 @@ struct AttachedBody {
 };
 
 /// The model with each body added as a link (after the model's own, in order) under a fixed joint named
-/// "<name>_joint"; `meshes` holds the bodies' meshes, which their elements index. The state vector is
+/// "`<name>_joint`"; `meshes` holds the bodies' meshes, which their elements index. The state vector is
 /// unchanged. Pairs of a body with its touch links are disabled with reason "Touch". Throws
 /// std::invalid_argument for a name already in use, a link or touch link out of range, or a mesh index
 /// out of range.

@@ -30,36 +30,40 @@ int jointVariableCount(JointType type) noexcept;
 /// A joint whose value follows another's: value = multiplier · q[leader] + offset.
 struct Mimic {
   int joint = -1;  ///< the leader joint (itself not a mimic, one variable); -1 when the joint is not a mimic
-  double multiplier = 1.0;
-  double offset = 0.0;
+  double multiplier = 1.0;  ///< finite (RobotModel checks)
+  double offset = 0.0;      ///< rad or m, finite (RobotModel checks)
 };
 
+/// A joint of the kinematic tree, as read from the URDF (the frame, axis and limits in SI units).
 struct Joint {
-  std::string name;
-  JointType type = JointType::Fixed;
-  int parent_link = -1;
-  int child_link = -1;
-  /// The joint frame in the parent link's frame (the URDF <origin>).
+  std::string name;                   ///< unique within the robot
+  JointType type = JointType::Fixed;  ///< its URDF type (a mimic keeps its own)
+  int parent_link = -1;               ///< index into RobotModel::links()
+  int child_link = -1;                ///< index into RobotModel::links()
+  /// The joint frame in the parent link's frame (the URDF `<origin>`).
   Pose origin;
   /// Unit axis in the joint frame: rotation axis (revolute, continuous), direction of travel (prismatic),
   /// plane normal (planar). Unused for fixed and floating joints.
   Vec3 axis = Vec3::UnitX();
+  ///@{
   /// Position limits (rad or m) of revolute and prismatic joints; ±infinity for the other types.
   double lower = -std::numeric_limits<double>::infinity();
   double upper = std::numeric_limits<double>::infinity();
+  ///@}
   /// Velocity limit (rad/s or m/s); infinity when the URDF gives none.
   double velocity = std::numeric_limits<double>::infinity();
-  Mimic mimic;
+  Mimic mimic;  ///< the leader this joint follows (mimic.joint = -1: none)
   /// Index of the joint's first entry in q; -1 for fixed and mimic joints (they own no entry).
   /// Assigned by RobotModel in joint order.
   int first_variable = -1;
 
+  /// True when the joint follows a leader (and owns no entry of q).
   bool isMimic() const noexcept { return mimic.joint >= 0; }
 };
 
-/// One <collision> element of a link: a primitive or a triangle mesh, placed by origin in the link frame.
+/// One `<collision>` element of a link: a primitive or a triangle mesh, placed by origin in the link frame.
 struct CollisionElement {
-  /// The element frame in the link frame (the URDF <collision><origin>).
+  /// The element frame in the link frame (the URDF `<collision><origin>`).
   Pose origin;
   /// Box, Sphere, Cylinder or Capsule (URDF cylinders and capsules lie along local z); empty for a mesh.
   std::optional<Shape> primitive;
@@ -67,8 +71,9 @@ struct CollisionElement {
   int mesh = -1;
 };
 
+/// A link of the kinematic tree: its name, its parent joint and its collision geometry (link frame).
 struct Link {
-  std::string name;
+  std::string name;  ///< unique within the robot
   /// The joint whose child this link is; -1 for the root.
   int parent_joint = -1;
   /// Possibly several, possibly none (a link without collision geometry is never checked).
@@ -78,15 +83,19 @@ struct Link {
 /// One entry of the joint vector q.
 struct JointVariable {
   std::string name;  ///< the joint's name; planar and floating add "/x", "/y", "/theta", "/qx", ...
-  int joint = -1;
+  int joint = -1;    ///< the joint owning the entry, index into RobotModel::joints()
+  ///@{
   double lower = -std::numeric_limits<double>::infinity();  ///< ±infinity when unbounded
   double upper = std::numeric_limits<double>::infinity();
+  ///@}
 };
 
 /// A link pair never to be checked, with its SRDF reason ("Adjacent", "Never", "Default", "Always", ...).
 struct DisabledCollision {
-  int link_a = -1, link_b = -1;  ///< link_a < link_b
-  std::string reason;
+  ///@{
+  int link_a = -1, link_b = -1;  ///< link indices, link_a < link_b
+  ///@}
+  std::string reason;  ///< as the SRDF gives it (may be empty)
 };
 
 namespace detail {
@@ -107,6 +116,8 @@ struct KinematicStep {
 };
 }  // namespace detail
 
+/// A robot, checked and frozen: links in topological order, joints, the joint vector's variables, meshes
+/// and disabled pairs. Immutable, so one model may be shared by any number of threads.
 class RobotModel {
  public:
   /// Checks and freezes a robot. Links must be in topological order (link 0 the root, without parent
@@ -117,16 +128,24 @@ class RobotModel {
   RobotModel(std::string name, std::vector<Link> links, std::vector<Joint> joints, std::vector<TriangleMesh> meshes,
              std::vector<DisabledCollision> disabled = {}, std::vector<std::string> load_warnings = {});
 
+  /// The robot's name (the URDF's robot name).
   const std::string& name() const noexcept { return name_; }
+  /// The number of links (≥ 1).
   int linkCount() const noexcept { return static_cast<int>(links_.size()); }
+  /// The number of joints (fixed and mimic ones included).
   int jointCount() const noexcept { return static_cast<int>(joints_.size()); }
   /// The length of the joint vector q.
   int variableCount() const noexcept { return static_cast<int>(variables_.size()); }
 
+  /// The links in topological order (links()[0] is the root).
   const std::vector<Link>& links() const noexcept { return links_; }
+  /// The joints, each first_variable assigned.
   const std::vector<Joint>& joints() const noexcept { return joints_; }
+  /// The entries of q, in order.
   const std::vector<JointVariable>& variables() const noexcept { return variables_; }
+  /// Link i, 0 ≤ i < linkCount() (not checked).
   const Link& link(int i) const { return links_[i]; }
+  /// Joint i, 0 ≤ i < jointCount() (not checked).
   const Joint& joint(int i) const { return joints_[i]; }
   /// The parent link of link i (-1 for the root).
   int parentLink(int i) const { return links_[i].parent_joint < 0 ? -1 : joints_[links_[i].parent_joint].parent_link; }
@@ -138,9 +157,11 @@ class RobotModel {
   /// What the loader found worth telling ("FILE: ELEMENT: REASON"); callers print them.
   const std::vector<std::string>& loadWarnings() const noexcept { return load_warnings_; }
 
+  ///@{
   /// Index of the link / joint of that name, -1 if none. Hash lookups: for load time, not for queries.
   int linkIndex(const std::string& name) const;
   int jointIndex(const std::string& name) const;
+  ///@}
   /// Index in q of the variable of that name (a one-variable joint's name, or "joint/x" etc.), -1 if none.
   int variableIndex(const std::string& name) const;
   /// Link i's step of forward kinematics (computeLinkPose); step 0 is the root's.

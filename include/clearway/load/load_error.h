@@ -12,6 +12,7 @@ namespace clearway {
 /// (the element part is left out when the problem concerns the whole file).
 class LoadError : public std::runtime_error {
  public:
+  /// what() is format(file, element, reason); the three parts are kept as given.
   LoadError(std::string file, std::string element, std::string reason)
       : std::runtime_error(format(file, element, reason)),
         file_(std::move(file)),
@@ -36,7 +37,7 @@ class LoadError : public std::runtime_error {
   std::string file_, element_, reason_;
 };
 
-/// Input text as a message may quote it: control bytes as \xNN (a NUL would end the message), cut after
+/// Input text as a message may quote it: control bytes as `\xNN` (a NUL would end the message), cut after
 /// max_chars characters with "..." (a reader quoting the rest of a file must not make a megabyte message).
 inline std::string inputExcerpt(const std::string& text, std::size_t max_chars = 40) {
   static const char kHex[] = "0123456789ABCDEF";

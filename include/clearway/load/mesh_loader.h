@@ -12,8 +12,8 @@ namespace clearway {
 
 /// How mesh files are read.
 struct MeshOptions {
-  /// COLLADA: rotate the mesh so that the file's <up_axis> becomes z. Off by default, to load meshes as
-  /// ROS does (RViz, MoveIt): the coordinates as written, in the file's <unit>.
+  /// COLLADA: rotate the mesh so that the file's `<up_axis>` becomes z. Off by default, to load meshes as
+  /// ROS does (RViz, MoveIt): the coordinates as written, in the file's `<unit>`.
   bool honour_up_axis = false;
 };
 
@@ -21,10 +21,10 @@ struct MeshOptions {
 /// through Clearway's own reader, which refuses counts beyond the file's data) into one TriangleMesh:
 ///  - node transforms are applied and all meshes of the scene are merged; vertices at identical
 ///    positions are joined (within and across meshes), so shared edges are shared in the index list;
-///  - COLLADA (.dae, .zae): the <unit> is honoured; the <up_axis> is ignored as ROS, RViz and MoveIt
+///  - COLLADA (.dae, .zae): the `<unit>` is honoured; the `<up_axis>` is ignored as ROS, RViz and MoveIt
 ///    ignore it (the coordinates are the link's), unless options.honour_up_axis (then a Y_UP file is
 ///    rotated so that its y becomes z); a file that is not Z_UP gets a warning saying which was done;
-///  - then each vertex is multiplied componentwise by scale (the URDF <mesh scale>);
+///  - then each vertex is multiplied componentwise by scale (the URDF `<mesh scale>`);
 ///  - zero-area triangles (two equal corners, or a height below 1e-12 of the longest edge) are dropped
 ///    with a warning; points and lines in the file are ignored with a warning;
 ///  - warnings, each "PATH: REASON", also for a mesh that is not closed (an edge not shared by exactly
