@@ -16,6 +16,7 @@
 
 namespace clearway {
 
+/// How auditSelfCollision samples and classifies link pairs.
 struct AuditOptions {
   int samples = 10000;            ///< random configurations, uniform within the limits (continuous: ±π)
   std::uint64_t seed = 1;         ///< the same seed gives the same audit, whatever the thread count
@@ -29,7 +30,7 @@ struct AuditOptions {
   /// Threads to sample on, at most maxAuditThreads() (more are capped to it); fewer run when the system
   /// cannot start them all, with the same audit: it depends on the capped count alone.
   int threads = 2;
-  Tolerances tolerances = {};
+  Tolerances tolerances = {};     ///< the narrow phase's, for every collision and distance test
   /// Called from the calling thread with (samples done, samples in all) about every 1% of a run and once
   /// at the end; may be empty. For progress bars.
   std::function<void(int, int)> progress;
@@ -37,7 +38,9 @@ struct AuditOptions {
 
 /// One pair's verdict and evidence.
 struct PairAudit {
-  int a = -1, b = -1;
+  ///@{
+  int a = -1, b = -1;        ///< the pair's link indices, a < b
+  ///@}
   std::string reason;        ///< "Adjacent", "Default", "Always", "Never", or "" (must be checked)
   int samples = 0;           ///< configurations tested (0 for Adjacent pairs: nothing is measured)
   int colliding = 0;         ///< samples in collision (for a Default pair, away from the default configuration)
@@ -68,7 +71,7 @@ std::vector<PairAudit> auditSelfCollision(std::shared_ptr<const RobotGeometry> g
 /// disable_collisions of every audited pair replaced by one per pair that has a reason (link1 < link2,
 /// sorted by name), where the first replaced one stood or else at the end; every other element and
 /// comment is kept. Written through an XML printer, so any link name is well-formed. Throws
-/// std::invalid_argument when input_srdf is not XML with a <robot> root.
+/// std::invalid_argument when input_srdf is not XML with a `<robot>` root.
 std::string auditSrdf(const RobotModel& model, const std::vector<PairAudit>& audit, const std::string& input_srdf = "");
 
 }  // namespace clearway

@@ -25,6 +25,7 @@ class CollisionFilter {
   const std::string& reason(int a, int b) const noexcept;
   /// The checked pairs (a, b), a < b, sorted.
   std::vector<std::pair<int, int>> enabledPairs() const;
+  /// The number of links the filter covers (link indices run from 0 to linkCount() − 1).
   int linkCount() const noexcept { return n_; }
 
  private:

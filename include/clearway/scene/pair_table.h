@@ -25,19 +25,25 @@ namespace clearway {
 /// How finely a pair table is cut: cells per variable of the coarse grid, then at most this many (rounded
 /// down to a power of two) within an unsure coarse cell, reached by halving where still unsure.
 struct PairTableOptions {
+  ///@{
   int coarse_one = 64, fine_one = 16;   ///< a pair moved by one variable
+  ///@}
+  ///@{
   int coarse_two = 16, fine_two = 4;    ///< a pair moved by two
+  ///@}
   /// Cell centres checked at most, per table (each a distance query at load): a level of halving that
   /// would pass it is not begun, and its cells stay Unsure.
   long max_checks = 20000;
   /// No table for a pair whose probe (one coarse cell in 4 per variable) settles less than this share.
   double min_probe_share = 0.25;
+  ///@{
   /// Cells checked down to the triangles (the finest, near contact) at most, per table, and only for links
   /// of at most max_exact_triangles triangles each: past either, cells are checked on the hulls alone. A
   /// search among many triangles within a wide padding is what makes a table dear; counted, not timed, a
   /// table is the same on every machine (and so is which colliding pair a check reports).
   long max_exact_checks = 2000;
   int max_exact_triangles = 4096;
+  ///@}
   /// No cell is checked after this moment (the cells left stay Unsure). None by default: a deadline makes
   /// the tables, though never the verdicts, depend on the machine's speed.
   std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
@@ -46,8 +52,11 @@ struct PairTableOptions {
   PairTableOptions within(double seconds) const;
 };
 
+/// Certified verdicts of one self pair moved by one or two joint variables, per cell of those variables'
+/// values. Immutable once built; lookups are const and thread-safe.
 class PairTable {
  public:
+  /// A cell's verdict: Free or Colliding at every configuration in it, or Unsure (check the pair).
   enum class Verdict : std::uint8_t { Unsure, Free, Colliding };
 
   /// The table of links a and b (geometries ga, gb), checked with `padding` in `mode`; null when their

@@ -36,7 +36,11 @@ struct Effects {
 
 /// Why a state is not free.
 struct CollisionReport {
+  ///@{
+  /// None: free; Self: two robot links; Environment: a link and an obstacle or voxel; Invalid: not a
+  /// valid state (non-finite, out of bounds), no geometry looked at.
   enum class Kind { None, Self, Environment, Invalid } kind = Kind::None;
+  ///@}
   int link = -1;        ///< the robot link (the first of the pair for Self)
   int other_link = -1;  ///< Self: the second link
   EnvironmentHit hit;   ///< Environment: what the link touched
@@ -46,20 +50,20 @@ struct CollisionReport {
 struct SceneCounters {
   long long states = 0;         ///< isFree calls
   long long invalid_states = 0; ///< states rejected before any geometry (NaN, out of bounds)
-  long long self_pair_tests = 0;
-  EnvironmentCounters environment;
-  long long clearance_queries = 0;
+  long long self_pair_tests = 0;   ///< self link pairs tested (pairs a pair table clears are not counted)
+  EnvironmentCounters environment;  ///< the environment's work for these queries
+  long long clearance_queries = 0;  ///< clearance calls that computed (valid state, scene with clearance)
 };
 
 /// Per-thread scratch of scene queries. Made by Scene::makeContext; queries allocate nothing in it.
 struct SceneContext {
   std::vector<double> q;       ///< the full joint vector (group values, held values, defaults)
   std::vector<Pose> poses;     ///< world pose of every link
-  SelfCollisionContext self;
+  SelfCollisionContext self;   ///< the self-collision checker's scratch
   /// The environment link (an index into Scene::environmentLinks()) that last met an obstacle, −1: none.
   int env_last_hit = -1;
-  SceneCounters counters;
-  // Scene::areFree's: the kinematics over lanes of states, and each lane's joint vector and link poses.
+  SceneCounters counters;      ///< this context's work since it was made
+  /// Scene::areFree's kinematics over lanes of states (makeContext sets it).
   std::optional<KinematicLanes> lanes;
   std::vector<double> lane_q;    ///< KinematicLanes::kMaxLanes joint vectors
   std::vector<Pose> lane_poses;  ///< KinematicLanes::kMaxLanes sets of link poses
@@ -68,8 +72,10 @@ struct SceneContext {
 /// Everything a scene file says, after parsing and before loading anything (paths are absolute).
 struct SceneDescription {
   std::string file;  ///< the scene file ("" for one built in code); errors name it
-  std::string name;
-  std::string urdf, srdf;
+  std::string name;  ///< the scene's name (the file's `name:`)
+  ///@{
+  std::string urdf, srdf;  ///< the robot's files, absolute ("" for no SRDF)
+  ///@}
   /// Folders searched for the robot's package:// meshes (the file's `package_paths:`, absolute), after
   /// those the caller gives and before ROS_PACKAGE_PATH and AMENT_PREFIX_PATH.
   std::vector<std::string> package_paths;
@@ -81,26 +87,29 @@ struct SceneDescription {
   std::vector<std::pair<std::string, std::string>> allow;  ///< extra link pairs never checked
   double padding = 0.0;                                    ///< metres around every link
   std::string octomap;                                     ///< "" when none
-  UnknownSpace unknown = UnknownSpace::Free;
+  UnknownSpace unknown = UnknownSpace::Free;  ///< how the OctoMap's unknown cells count
+  /// An obstacle as the file gives it (`environment.obstacles` entry), before any mesh is read.
   struct ObstacleSpec {
-    std::string name;
-    Shape shape = Sphere(1.0);
+    std::string name;             ///< as Obstacle::name
+    Shape shape = Sphere(1.0);    ///< the shape (unused when mesh_file is set)
     std::string mesh_file;  ///< a mesh obstacle's file ("" for a shape)
-    Vec3 mesh_scale = Vec3::Ones();
-    Pose pose;
-    Vec3 velocity = Vec3::Zero();
+    Vec3 mesh_scale = Vec3::Ones();  ///< per-axis scale of the mesh's coordinates
+    Pose pose;                    ///< world frame (an attached body's: the link frame), at time 0
+    Vec3 velocity = Vec3::Zero();  ///< m/s, world frame (zero: static)
   };
-  std::vector<ObstacleSpec> obstacles;
+  std::vector<ObstacleSpec> obstacles;  ///< in file order
   /// A body fixed to a robot link (robot.attached): named, shaped and posed (relative to the link) as an
   /// obstacle is; it may touch its touch_links and its link. loadRobotGeometry makes each a link.
   struct AttachedSpec {
-    std::string link;
-    ObstacleSpec body;
-    std::vector<std::string> touch_links;
+    std::string link;                      ///< the robot link it is fixed to
+    ObstacleSpec body;                     ///< its name, geometry and pose in the link frame
+    std::vector<std::string> touch_links;  ///< robot links it may touch besides `link`
   };
-  std::vector<AttachedSpec> attached;
-  Effects effects;
-  std::vector<double> start, goal;  ///< empty when the file gives none
+  std::vector<AttachedSpec> attached;  ///< in file order
+  Effects effects;                     ///< the file's `checks:`
+  ///@{
+  std::vector<double> start, goal;  ///< states (group order); empty when the file gives none
+  ///@}
   std::vector<std::string> warnings;  ///< "file: key 'k': reason" for each input taken other than as given
 };
 
@@ -121,8 +130,8 @@ std::shared_ptr<const Environment> loadEnvironment(const SceneDescription& descr
 
 /// How a scene checks geometry (not part of the scene file: a choice of the caller).
 struct SceneOptions {
-  GeometryMode mode = GeometryMode::Mesh;
-  Tolerances tolerances;
+  GeometryMode mode = GeometryMode::Mesh;  ///< hulls only, or hulls then triangles (exact)
+  Tolerances tolerances;                   ///< the narrow phase's, for every query of the scene
   /// How robot and mesh files are read (package:// folders searched before the scene file's own; the
   /// COLLADA up axis).
   LoadOptions load;
@@ -133,6 +142,8 @@ struct SceneOptions {
   double pair_table_seconds = std::numeric_limits<double>::infinity();
 };
 
+/// A robot in its environment, asked whether states and segments are free. Immutable once built;
+/// const queries are thread-safe with one SceneContext per thread (or the per-thread overloads).
 class Scene {
  public:
   /// Loads the robot and environment a description names and checks that they fit together: every
@@ -162,30 +173,44 @@ class Scene {
   /// parseSceneFile + the constructor.
   static std::shared_ptr<const Scene> load(const std::string& path, const SceneOptions& options = {});
 
+  /// The description the scene was built from (withEnvironment keeps the first one's obstacles).
   const SceneDescription& description() const noexcept { return description_; }
+  /// description().name.
   const std::string& name() const noexcept { return description_.name; }
+  /// What the scene checks (description().effects).
   const Effects& effects() const noexcept { return description_.effects; }
+  /// The robot model, attached bodies included as links.
   const RobotModel& robot() const noexcept { return geometry_->model(); }
+  /// The robot's collision geometry, link by link.
   const RobotGeometry& geometry() const noexcept { return *geometry_; }
+  /// The same geometry, to share with another Scene of the same robot.
   const std::shared_ptr<const RobotGeometry>& geometryPtr() const noexcept { return geometry_; }
+  /// The obstacles and voxels the scene is checked against.
   const Environment& environment() const noexcept { return *environment_; }
   /// The environment, to share with another Scene over the same obstacles (another mode, say).
   const std::shared_ptr<const Environment>& environmentPtr() const noexcept { return environment_; }
+  /// The self-collision checker: the link pairs checked, with their pair tables.
   const SelfCollision& selfCollision() const noexcept { return self_; }
+  /// Which link pairs are never checked, and why.
   const CollisionFilter& filter() const noexcept { return filter_; }
+  /// The options the scene was built with.
   const SceneOptions& options() const noexcept { return options_; }
 
   /// The number of planned variables (the length of a state).
   int dimension() const noexcept { return static_cast<int>(group_variables_.size()); }
   /// Index in the robot's joint vector of each state entry.
   const std::vector<int>& groupVariables() const noexcept { return group_variables_; }
+  ///@{
   /// Limits of each state entry: the joint's, or the scene's robot.bounds (±infinity when unbounded). A
   /// state holds values within them (to kJointLimitTolerance) and within ±kMaxJointValue.
   double lower(int i) const noexcept { return lower_[i]; }
   double upper(int i) const noexcept { return upper_[i]; }
+  ///@}
+  ///@{
   /// The range a valid state's entry i lies in: the limits widened by kJointLimitTolerance, within ±kMaxJointValue.
   double validLower(int i) const noexcept { return valid_lower_[i]; }
   double validUpper(int i) const noexcept { return valid_upper_[i]; }
+  ///@}
   /// Links with geometry whose pose depends on the state (others never move, so self pairs among
   /// them never change; they still meet obstacles).
   const std::vector<int>& movingLinks() const noexcept { return moving_links_; }

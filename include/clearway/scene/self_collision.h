@@ -20,14 +20,17 @@ namespace clearway {
 
 /// Two links of one robot, a < b.
 struct LinkPair {
-  int a = -1, b = -1;
+  ///@{
+  int a = -1, b = -1;  ///< link indices
+  ///@}
+  /// True when both links are the same.
   bool operator==(const LinkPair& o) const noexcept { return a == o.a && b == o.b; }
 };
 
 /// How self-collision is checked.
 struct SelfCollisionOptions {
-  GeometryMode mode = GeometryMode::Mesh;
-  Tolerances tolerances;
+  GeometryMode mode = GeometryMode::Mesh;  ///< hulls only, or hulls then triangles (exact)
+  Tolerances tolerances;                   ///< the narrow phase's
   /// Metres added around each link (indexed by link; empty: none). A pair collides when its links are
   /// within padding[a] + padding[b]. Must be finite and ≥ 0.
   std::vector<double> link_padding;
@@ -37,7 +40,7 @@ struct SelfCollisionOptions {
   /// held[v], when finite: variable v never leaves this value in queries that pass the configuration (a
   /// joint the scene holds), so the tables treat its joint as fixed. Empty: every variable may move.
   std::vector<double> held;
-  PairTableOptions table_options;
+  PairTableOptions table_options;  ///< how finely each table is cut, and its work bounds
   /// Seconds all the tables may take to build (measured from the first); cells past it stay Unsure. None
   /// by default (table_options bounds their work by counts, the same on every machine).
   double table_seconds = std::numeric_limits<double>::infinity();
@@ -50,7 +53,7 @@ struct SelfCollisionContext {
   std::vector<int> unsure;       ///< pairs the cheap rungs left to the triangles (scratch of one query)
   std::vector<std::uint8_t> table_free;  ///< per pair: its table called it Free at this query's q (scratch)
   std::vector<std::uint8_t> bounds_apart;  ///< per pair: its bounding balls apart at this query's poses (scratch)
-  int last_hit = -1;
+  int last_hit = -1;  ///< the pair (index into pairs()) that last collided, tried first; -1: none
   long long pair_tests = 0;  ///< pairs that reached the narrow phase (bounding spheres not apart), cumulative
 };
 
@@ -62,9 +65,11 @@ class SelfCollision {
   SelfCollision(std::shared_ptr<const RobotGeometry> geometry, const CollisionFilter& filter,
                 SelfCollisionOptions options = {});
 
+  /// The robot's geometry (shared with the caller).
   const RobotGeometry& geometry() const noexcept { return *geometry_; }
   /// The pairs checked, sorted.
   const std::vector<LinkPair>& pairs() const noexcept { return pairs_; }
+  /// The options the checker was built with.
   const SelfCollisionOptions& options() const noexcept { return options_; }
   /// The padding of pair k (the sum of its links' paddings).
   double pairPadding(int k) const noexcept { return pair_padding_[k]; }

@@ -21,7 +21,7 @@ namespace clearway {
 
 /// One consistent state of a World, never changed once published.
 struct WorldSnapshot {
-  std::shared_ptr<const Scene> scene;
+  std::shared_ptr<const Scene> scene;            ///< the scene as of this version (never null)
   std::shared_ptr<const MotionChecker> motion;  ///< the scene's certified motion checker
   std::uint64_t version = 0;                    ///< 1 as built, one more per edit
 };

@@ -44,7 +44,7 @@ enum class PlanStatus {
 
 /// The path and the statistics `clearway plan` prints.
 struct PlanResult {
-  PlanStatus status = PlanStatus::NoPath;
+  PlanStatus status = PlanStatus::NoPath;  ///< how the query ended
   std::string message;      ///< why it is not Solved, one line naming what collides; empty when Solved
   std::string ompl_status;  ///< the planner's ompl::base::PlannerStatus as text ("Exact solution", "Timeout", ...)
   int dimension = 0;        ///< values per state
@@ -53,9 +53,15 @@ struct PlanResult {
   double length = 0.0;            ///< the path's length in OMPL's state space metric
   double solve_seconds = 0.0;     ///< wall time of the planner's solve
   double simplify_seconds = 0.0;  ///< wall time of the simplification (0 without it)
+  ///@{
   std::uint64_t state_checks = 0, motion_checks = 0;  ///< checker calls of the whole query
+  ///@}
+  ///@{
   double state_check_seconds = 0.0, motion_check_seconds = 0.0;  ///< time spent in them (all threads)
+  ///@}
+  ///@{
   std::uint64_t simplify_state_checks = 0, simplify_motion_checks = 0;  ///< the calls made by the simplifier
+  ///@}
   std::vector<std::size_t> uncertified_segments;  ///< NotCertified: the segments (i → i+1) not certified free
 
   /// True when status is Solved: path holds a certified path.
