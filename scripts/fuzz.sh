@@ -23,7 +23,7 @@ CC=clang CXX=clang++ cmake -S . -B "$BUILD" -DCLEARWAY_BUILD_FUZZERS=ON -DBUILD_
 cmake --build "$BUILD" -j2 --target clearway_fuzzers
 
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(urdf mesh_stl mesh_obj mesh_dae mesh_ply scene octomap query state_line motion_line bench_merge scene_attached)
+[ ${#targets[@]} -gt 0 ] || targets=(urdf mesh_stl mesh_obj mesh_dae mesh_ply scene octomap query state_line motion_line bench_merge scene_attached scene_edits)
 
 # Seeds of our own beyond fuzz/corpus/, by target (files as they are; the URDF target's SRDF after a
 # separator line).
