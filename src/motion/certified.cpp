@@ -139,20 +139,31 @@ struct MotionChecker::Sweep {
     return block;
   }
 
-  // Item k's contact distance on this segment.
-  double contactOf(int k) const noexcept {
-    return ctx.contact_stamp[k] == ctx.segment ? ctx.contact[k] : mc.options_.contact_distance;
+  // Item k's contact distance at s on this segment: contact_distance, or near an end closer than twice
+  // that, half the end's clearance growing by kContactGrowth of the item's motion bound per unit of s
+  // away from it (motion.h).
+  double contactOf(int k, double s) const noexcept {
+    const double c = mc.options_.contact_distance;
+    if (ctx.contact_stamp[k] != ctx.segment) return c;
+    const std::array<double, 2>& e = ctx.contact[k];
+    if (!(e[0] < c) && !(e[1] < c)) return c;
+    const double g = kContactGrowth * ctx.bound[k];  // (∞ for an unbounded motion: c away from the ends)
+    const auto grown = [&](double end, double ds) { return ds > 0.0 ? end + g * ds : end; };
+    return std::min({c, grown(e[0], s), grown(e[1], 1.0 - s)});
   }
 
-  // measure(), and when item k first comes within contact on this segment, its ends' clearances: where the
-  // nearer end is closer than twice the contact distance, the item's contact distance becomes half that
-  // end's clearance (never 0: an end that touches keeps it), and s is measured again. A state the
-  // validity checker accepts can then be left; the loops still end, each ball being at least that wide.
+  // measure(), and when item k first comes within contact on this segment, its ends' clearances: an end
+  // closer than twice the contact distance lowers the item's contact distance near it (contactOf; never
+  // to 0: an end that touches keeps it), and s is measured again. A state the validity checker accepts
+  // can then be left. The loops still end, each ball being at least contactOf / B wide, and near an end
+  // the balls grow geometrically (by about 2·kContactGrowth each), so an end a nanometre from contact
+  // costs a few hundred measurements, not a crawl of contact-sized steps along the obstacle.
   double measureItem(int k, double s, double need, CollisionReport& report) {
     const double d = measure(k, s, need, report);
-    if (!(d <= contactOf(k)) || ctx.contact_stamp[k] == ctx.segment) return d;
+    if (!(d <= contactOf(k, s)) || ctx.contact_stamp[k] == ctx.segment) return d;
+    const double c = mc.options_.contact_distance;
     ctx.contact_stamp[k] = ctx.segment;
-    ctx.contact[k] = mc.options_.contact_distance;
+    ctx.contact[k] = {c, c};
     const Item& it = mc.items_[k];
     if (it.last > it.first) return d;  // a group's members decide, each with its own ends
     // Only the verdict asked, and the state at s collides: the segment is not free whatever the ends'
@@ -160,9 +171,11 @@ struct MotionChecker::Sweep {
     // than measuring the ends near contact, which climbs to their triangles.
     if (verdict_only && stateCollides(s, report)) return d;
     const double e0 = endClearance(k, 0.0);
-    const double e = e0 > 0.0 ? std::min(e0, endClearance(k, 1.0)) : 0.0;
-    if (!(e > 0.0) || !(0.5 * e < ctx.contact[k])) return d;
-    ctx.contact[k] = 0.5 * e;
+    if (!(e0 > 0.0)) return d;  // an end that touches: every contact distance keeps it
+    const double e1 = endClearance(k, 1.0);
+    if (!(e1 > 0.0)) return d;
+    if (!(0.5 * std::min(e0, e1) < c)) return d;
+    ctx.contact[k] = {std::min(c, 0.5 * e0), std::min(c, 0.5 * e1)};
     return measure(k, s, need, report);
   }
 
@@ -203,7 +216,7 @@ struct MotionChecker::Sweep {
   double measure(int k, double s, double need, CollisionReport& report) {
     const Scene& sc = *mc.scene_;
     const Tolerances& tol = sc.options().tolerances;
-    const double contact = contactOf(k), relative = mc.options_.distance_relative_error;
+    const double contact = contactOf(k, s), relative = mc.options_.distance_relative_error;
     // Below the scene's contact distance (an end of the segment is that near), only distances decide: an
     // intersection test within it would count the narrow phase's band as contact.
     const bool lowered = contact < mc.options_.contact_distance;
@@ -328,7 +341,7 @@ struct MotionChecker::Sweep {
   double first(int k, double s, double half) {
     CollisionReport report;
     const double d = measureItem(k, s, ctx.bound[k] * half, report);
-    if (d > contactOf(k)) return reach(k, d, half);
+    if (d > contactOf(k, s)) return reach(k, d, half);
     if (verdict_only && mc.items_[k].last <= mc.items_[k].first) found(s, report);
     return -1.0;
   }
@@ -356,7 +369,7 @@ struct MotionChecker::Sweep {
       if (iv.a > hi || (hit && iv.a >= hi)) continue;
       const double m = 0.5 * (iv.a + hi);
       const double d = measureItem(k, m, ctx.bound[k] * 0.5 * (hi - iv.a), report);
-      if (d <= contactOf(k)) {
+      if (d <= contactOf(k, m)) {
         if (it.last > it.first) {  // a group within contact: its members take over here, exactly
           for (int member = it.first; member < it.last && !stop(); ++member) {
             ctx.bound[member] = mc.itemBound(member, ctx.dq.data(), ctx.obstacle_motion);
@@ -376,12 +389,12 @@ struct MotionChecker::Sweep {
         continue;
       }
       const double rad = reach(k, d, std::max(m - iv.a, hi - m));
-      // Left first (popped first), so that advancement starts clear of everything before it; a verdict
-      // takes the right first: the probe has found its states free, and planners' colliding segments
-      // mostly clip an obstacle shortly before a free end.
-      if (verdict_only && m - rad > iv.a) ctx.intervals.push_back({iv.a, m - rad, iv.witness});
+      // Left first (popped first), so that advancement starts clear of everything before it. A verdict
+      // keeps the same order: then it measures what the located check measures until a contact, so the
+      // two agree even where the contact distance grows along the segment (near an end), where another
+      // order's balls could miss a measurement within it that this order makes.
       if (m + rad < hi) ctx.intervals.push_back({m + rad, hi, m});
-      if (!verdict_only && m - rad > iv.a) ctx.intervals.push_back({iv.a, m - rad, iv.witness});
+      if (m - rad > iv.a) ctx.intervals.push_back({iv.a, m - rad, iv.witness});
     }
     ctx.intervals.resize(base);
   }
@@ -393,8 +406,7 @@ struct MotionChecker::Sweep {
     double s = a, prev = std::max(witness, 0.0), prev_d = 0.0;  // the clearance measured at prev (0: none)
     while (!capped) {
       const double d = measureItem(k, s, ctx.bound[k] * (until - s), report);
-      const double contact = contactOf(k);
-      if (d <= contact) {
+      if (d <= contactOf(k, s)) {
         if (!hit || s < limit) {
           limit = s;
           hit = true;
@@ -402,6 +414,7 @@ struct MotionChecker::Sweep {
           // The last parameter known free: past prev, as long as the step's bound still leaves half the
           // contact distance. (Both reaches come from bounds convex in the step and 0 at 0: the motion
           // over a fraction λ of the step is at most λ·prev_d.)
+          const double contact = contactOf(k, prev);  // (prev_d was beyond it)
           clear_before = prev_d > contact ? prev + (s - prev) * (1.0 - 0.5 * contact / prev_d) : prev;
           r.report = report;
         }
@@ -409,7 +422,7 @@ struct MotionChecker::Sweep {
       }
       prev = s;
       prev_d = d;
-      s += reach(k, d, until - s);  // at least contactOf(k) / B > 0: the loop ends
+      s += reach(k, d, until - s);  // at least contactOf(k, s) / B > 0: the loop ends
       if (!(s < until)) return false;
     }
     return false;
@@ -519,9 +532,8 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
       cover(k, 0.0, 1.0, -1.0);  // within contact in the middle: from the start, exactly
     } else {  // what the ball in the middle leaves, left first
       const double rad = ctx.first_reach[k];
-      if (sweep.verdict_only && mid + rad < sweep.limit) cover(k, mid + rad, 1.0, mid);  // (see Sweep::cover)
-      if (mid - rad > 0.0) cover(k, 0.0, mid - rad, -1.0);
-      if (!sweep.verdict_only && mid + rad < sweep.limit) cover(k, mid + rad, 1.0, mid);
+      if (mid - rad > 0.0) cover(k, 0.0, mid - rad, -1.0);  // (in every mode: see Sweep::cover)
+      if (mid + rad < sweep.limit) cover(k, mid + rad, 1.0, mid);
     }
   }
   if (sweep.capped) {

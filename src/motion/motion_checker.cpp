@@ -267,7 +267,7 @@ MotionContext MotionChecker::makeContext() const {
   c.safe_until.resize(items_.size());
   c.bound.resize(items_.size());
   c.first_reach.resize(items_.size());
-  c.contact.assign(items_.size(), options_.contact_distance);
+  c.contact.assign(items_.size(), {options_.contact_distance, options_.contact_distance});
   c.contact_stamp.assign(items_.size(), 0);
   c.split_slot.assign(env_begin_, 0);
   c.split_stamp.assign(env_begin_, 0);

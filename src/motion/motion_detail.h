@@ -21,9 +21,10 @@ struct Scratch {
   std::vector<double> safe_until;  // per item: where its coverage starts (Cast: where its shape cast reached)
   std::vector<double> bound;       // per item: its motion bound for this segment
   std::vector<double> first_reach; // per item: how far its first measurement (in the middle) clears, −1: none
-  // Per item: its contact distance on this segment, set when it first comes within contact_distance
-  // (contact_stamp[k] == segment); below contact_distance where an end of the segment is itself that near.
-  std::vector<double> contact;
+  // Per item: its contact distance at either end of this segment, set when it first comes within
+  // contact_distance (contact_stamp[k] == segment): half an end's clearance where that is below
+  // contact_distance (Sweep::contactOf grows it away from the end).
+  std::vector<std::array<double, 2>> contact;
   std::vector<std::uint64_t> contact_stamp;
   std::vector<BodyPair> pairs;  // per self item: its bodies and their warm starts (forgotten every segment)
   // Per environment item, its hull's GJK axes against each static obstacle, kept the same way (the

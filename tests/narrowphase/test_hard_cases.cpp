@@ -895,3 +895,63 @@ TEST(HardCases, ShapeCastsOfCylindersAndCones) {
   EXPECT_LE(gjkDistance(cone2, at(c.t), cyl2, pc).distance, 1e-10);
   EXPECT_GT(gjkDistance(cone2, at(c.t * (1 - 1e-8)), cyl2, pc).lower_bound, 0.0);
 }
+
+// One notion of contact: what gjkIntersect calls apart, gjkDistance proves apart (a certified lower bound
+// above 0), at any gap down to the rounding, so that a state the validity checker accepts has a clearance
+// a motion can start from. Faces, a vertex over an edge, triangles and curved shapes, sizes 1e-2 … 1e2,
+// 1e3 m from the origin or at it; gaps 1e-9 … 1e-14 of the size and the last gap intersect calls apart
+// (bisected). The lower bound never exceeds the gap (plus the inputs' rounding).
+TEST(HardCases, WhatIntersectCallsApartDistanceProvesApart) {
+  const Mat3 vertex_down = rotation(std::atan(std::sqrt(2.0)), Vec3(1, -1, 0));
+  int pairs = 0, at_rounding = 0;
+  for (const double L : {1e-2, 1.0, 1e2})
+    for (const double far : {0.0, 1e3}) {
+      const Vec3 origin = far * Vec3(0.6, -0.8, 0.3) + L * Vec3(0.3, 0.1, -0.2);
+      struct Case {
+        Shape a, b;
+        Mat3 rb;  // B's turn
+      };
+      const std::vector<Case> cases = {
+          {Box(Vec3(L, L, 0.5 * L)), Box(Vec3(0.5 * L, 0.5 * L, 0.5 * L)), Mat3::Identity()},
+          {Box(Vec3(L, L, 0.5 * L)), Box(Vec3(0.5 * L, 0.5 * L, 0.5 * L)), vertex_down},
+          {Triangle(Vec3(-L, -L, 0.5 * L), Vec3(L, -L, 0.5 * L), Vec3(0, L, 0.5 * L)),
+           Triangle(Vec3(-L, 0, 0.2 * L), Vec3(L, 0.1 * L, -0.3 * L), Vec3(0.2 * L, -0.7 * L, -0.3 * L)), Mat3::Identity()},
+          {Capsule(0.5 * L, L), Sphere(0.25 * L), Mat3::Identity()},
+          {Cylinder(0.5 * L, 0.5 * L), Box(Vec3(0.2 * L, 0.3 * L, 0.4 * L)), vertex_down},
+      };
+      // How far a shape reaches along the unit u from its origin (its core's support plus its radius).
+      const auto reach = [](const Shape& shape, const Vec3& u) {
+        return std::visit([&](const auto& s) { return u.dot(s.support(u)) + s.radius(); }, shape);
+      };
+      for (const Case& c : cases) {
+        // A's top at height 0 in the tilted frame; B's lowest point above it by the gap.
+        const double top = reach(c.a, Vec3::UnitZ()), lo = reach(c.b, c.rb.transpose() * -Vec3::UnitZ());
+        const Pose pa = posed(kTilt, origin - kTilt * Vec3(0, 0, top));
+        const auto placed = [&](double gap) { return posed(kTilt * c.rb, origin + kTilt * Vec3(0, 0, lo + gap)); };
+        std::vector<double> gaps;
+        for (int k = 9; k <= 14; ++k) gaps.push_back(L * std::pow(10.0, -k));
+        // The least gap intersect calls apart, to a relative 1e-3 (the band is ~1e-10 of A − B's size).
+        double in = 0.0, out = 1e-9 * (L + far);
+        ASSERT_FALSE(isIntersecting(c.a, pa, c.b, placed(out)));
+        while (out - in > 1e-3 * out) {
+          const double mid = 0.5 * (in + out);
+          (isIntersecting(c.a, pa, c.b, placed(mid)) ? in : out) = mid;
+        }
+        gaps.push_back(out);
+        for (const double gap : gaps) {
+          const Pose pb = placed(gap);
+          if (isIntersecting(c.a, pa, c.b, pb)) continue;
+          ++pairs;
+          at_rounding += gap == out;
+          const DistanceResult d = gjkDistance(c.a, pa, c.b, pb);
+          SCOPED_TRACE("L " + std::to_string(L) + " far " + std::to_string(far) + " gap " + std::to_string(gap));
+          expectSane(d);
+          EXPECT_GT(d.lower_bound, 0.0) << "intersect says apart, distance cannot prove it: " << statusName(d.status);
+          // The gap as placed carries the rounding of the poses (~1e-16 of the coordinates).
+          EXPECT_LE(d.lower_bound, gap + 1e-14 * (far + L));
+        }
+      }
+    }
+  std::printf("%d apart pairs, %d at the least gap intersect calls apart\n", pairs, at_rounding);
+  EXPECT_EQ(at_rounding, 30);  // every case, size and place
+}

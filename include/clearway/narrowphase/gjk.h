@@ -58,6 +58,20 @@ inline bool inSimplex(const Simplex& s, const Vec3& w) noexcept {
   return false;
 }
 
+// The closest point v of a reduced simplex, made true to rounding at any ‖v‖ (see gjkIntersect): three
+// points give it as the origin's projection on their plane, two as v orthogonal to their edge.
+inline void refineClosest(const Simplex& s, Vec3& v) noexcept {
+  if (s.n == 3) {
+    const Vec3 n = (s.p[1].w - s.p[0].w).cross(s.p[2].w - s.p[0].w);
+    const double nn = n.squaredNorm();
+    if (nn > 0.0) v = n * (n.dot(s.p[0].w) / nn);
+  } else if (s.n == 2) {
+    const Vec3 e = s.p[1].w - s.p[0].w;
+    const double ee = e.squaredNorm();
+    if (ee > 0.0) v -= e * (v.dot(e) / ee);
+  }
+}
+
 struct GjkCoreResult {
   Vec3 a, b;          // witnesses on the cores, A's frame
   double dist;        // ‖v‖: upper bound on the core distance
@@ -68,11 +82,33 @@ struct GjkCoreResult {
 
 }  // namespace detail
 
+/// How far below GJK's absolute band a distance query goes.
+struct CoreBand {
+  /// False: cores within tol.gjk_absolute of the simplex's size are Touching (distance 0). True: such a
+  /// query goes on with the rounding of its own computation as the band, as gjkIntersect does, and its
+  /// lower bound is certified to that rounding: what the intersection test calls apart, the distance
+  /// proves apart, so a state the validity checker accepts has a clearance a motion can start from.
+  bool to_rounding = false;
+  /// The L1 norm of the lengths whose rounding every step carries: the world translations the relative
+  /// pose was computed from, its translation and the radii (as gjkIntersect counts them).
+  double world = 0.0;
+  Vec3 b_origin = Vec3::Zero();  ///< B's origin in A's frame (B's support points are measured from it)
+};
+
+/// The rounding of one GJK step of a Minkowski difference: 32 ulps of the L1 lengths involved (the
+/// world translations, the support points and the relative pose's translation; a plane's height carries a
+/// few). Shared by gjkIntersect, which calls shapes apart beyond twice it, and the distance's rounding
+/// band, which subtracts it once: so both draw the line in one place, with room between them.
+inline double gjkRounding(double world, const Vec3& a, const Vec3& b_minus_t) noexcept {
+  constexpr double kUlps = 32 * std::numeric_limits<double>::epsilon();
+  return kUlps * (world + a.cwiseAbs().sum() + b_minus_t.cwiseAbs().sum());
+}
+
 /// Distance between the cores of a Minkowski difference, in A's frame (the building block of every query).
 /// When `final_simplex` is given it receives the last simplex (EPA starts from it).
 template <class MD>
-detail::GjkCoreResult gjkCoreDistance(const MD& md, const Tolerances& tol,
-                                      detail::Simplex* final_simplex = nullptr) noexcept {
+detail::GjkCoreResult gjkCoreDistance(const MD& md, const Tolerances& tol, detail::Simplex* final_simplex = nullptr,
+                                      CoreBand precision = {}) noexcept {
   using namespace detail;
   Simplex s;
   Vec3 dir = md.center();
@@ -83,12 +119,20 @@ detail::GjkCoreResult gjkCoreDistance(const MD& md, const Tolerances& tol,
   Vec3 v = s.p[0].w;
   double vv = v.squaredNorm();
   double lower = 0.0;
+  const double world = precision.world;
+  double rounding = precision.to_rounding ? gjkRounding(world, s.p[0].a, s.p[0].b - precision.b_origin) : 0.0;
+  bool in_band = false;  // (to_rounding) below gjk_absolute: the rounding is the band
   GjkCoreResult r{s.p[0].a, s.p[0].b, std::sqrt(vv), 0.0, Status::NotConverged, 0};
   for (int it = 1; it <= tol.gjk_max_iterations; ++it) {
     r.iterations = it;
     if (!(vv >= 0.0) || !std::isfinite(vv)) { r.status = Status::NotConverged; return r; }
-    if (vv <= tol.gjk_absolute * tol.gjk_absolute * simplexScale(s)) { r.status = Status::Touching; break; }
+    if (!in_band && vv <= tol.gjk_absolute * tol.gjk_absolute * simplexScale(s)) {
+      if (!precision.to_rounding) { r.status = Status::Touching; break; }
+      in_band = true;
+    }
+    if (in_band && vv <= rounding * rounding) { r.status = Status::Touching; break; }
     const SupportPoint p = md.support(-v);
+    if (precision.to_rounding) rounding = std::max(rounding, gjkRounding(world, p.a, p.b - precision.b_origin));
     const double vw = v.dot(p.w);
     if (vw > 0.0) lower = std::max(lower, vw / std::sqrt(vv));
     // ‖v‖ − v·w/‖v‖ ≤ ε‖v‖, multiplied through by ‖v‖ to avoid a square root.
@@ -96,7 +140,11 @@ detail::GjkCoreResult gjkCoreDistance(const MD& md, const Tolerances& tol,
     if (inSimplex(s, p.w)) { r.status = Status::RepeatedSupport; break; }
     s.p[s.n++] = p;
     const Simplex before = s;
-    const Vec3 v_next = reduceSimplex(s);
+    Vec3 v_next = reduceSimplex(s);
+    // Far below the simplex's size, v's direction is off by ~2⁻⁵³·size/‖v‖ (gjkIntersect explains the
+    // fix): the plane's normal, or v made orthogonal to the edge, keeps the lower bound true to rounding
+    // (from the step that reaches the band on: that step's v is the next one's direction).
+    if (precision.to_rounding) refineClosest(s, v_next);
     const double vv_next = v_next.squaredNorm();
     if (s.n == 4) { v = v_next; vv = 0.0; r.status = Status::Overlapping; break; }
     // ‖v‖ must strictly decrease in exact arithmetic; when rounding stops that, the previous simplex is
@@ -106,13 +154,19 @@ detail::GjkCoreResult gjkCoreDistance(const MD& md, const Tolerances& tol,
     vv = vv_next;
   }
   if (r.status == Status::NotConverged) return r;  // cap reached: no certificate
+  // Within the rounding band, a pair whose certified bound is not above the rounding is touching (its ‖v‖
+  // may sit a hair above 0 while the cores overlap).
+  if (in_band && r.status != Status::Overlapping && !(std::min(lower, std::sqrt(vv)) > rounding))
+    r.status = Status::Touching;
   if (final_simplex) *final_simplex = s;
   simplexWitnesses(s, r.a, r.b);
   // Touching means ‖v‖ is below rounding: the distance is 0 (tolerances.h). Reporting ‖v‖ instead made
   // mayCollide() false for pairs whose simplex merely passed near the origin while they overlapped deeply
   // (a 1e-3 box overlapping a 1e3 box's corner by 1e-4 came out "free" at 1.6e-13).
   r.dist = r.status == Status::Overlapping || r.status == Status::Touching ? 0.0 : std::sqrt(vv);
-  r.lower = r.status == Status::Overlapping || r.status == Status::Touching ? 0.0 : std::min(lower, r.dist);
+  // A plane's height is computed with the step's rounding: to_rounding subtracts it, so the bound is certified.
+  r.lower = r.status == Status::Overlapping || r.status == Status::Touching ? 0.0
+                                                                          : std::max(0.0, std::min(lower, r.dist) - rounding);
   return r;
 }
 
@@ -121,7 +175,8 @@ template <class A, class B>
 DistanceResult gjkDistance(const A& a, const Pose& pose_a, const B& b, const Pose& pose_b,
                            const Tolerances& tol = {}) noexcept {
   const MinkowskiDifference<A, B> md{a, b, relativePose(pose_a, pose_b)};
-  const detail::GjkCoreResult c = gjkCoreDistance(md, tol);
+  const double world = pose_a.t.cwiseAbs().sum() + pose_b.t.cwiseAbs().sum() + md.b_in_a.t.cwiseAbs().sum() + md.radius();
+  const detail::GjkCoreResult c = gjkCoreDistance(md, tol, nullptr, {true, world, md.b_in_a.t});
   DistanceResult r;
   r.status = c.status;
   r.iterations = c.iterations;
@@ -166,11 +221,13 @@ IntersectResult gjkIntersect(const A& a, const Pose& pose_a, const B& b, const P
   // a million times the rounding of coordinates near 1e3 (~1e-13). It ends GJK near contact; what decides
   // is the rounding of the whole computation relative to the shapes as given (the relative pose, the
   // support points, the dot products): a few ulps of every length involved, world translations
-  // included, and 64 ulps of their sum (L1 norms: no square roots, never smaller) is generous. A plane
+  // included, and 64 ulps of their sum (L1 norms: no square roots, never smaller; twice gjkRounding) is
+  // generous. A plane
   // clearing A − B by more than that separates them, and a pair that reaches the band goes on with the
   // rounding as its band (to the cap at most, where it counts as intersecting), so pairs 1e-10 apart
-  // are told from touching ones at any size ratio.
-  constexpr double kUlps = 64 * std::numeric_limits<double>::epsilon();
+  // are told from touching ones at any size ratio. Apart means clear by twice gjkRounding: a distance
+  // query certifies its bound with one subtracted (CoreBand), so what this test calls apart, a motion
+  // starting there can measure as apart (one notion of contact for states and motions).
   const double world = pose_a.t.cwiseAbs().sum() + pose_b.t.cwiseAbs().sum() + md.b_in_a.t.cwiseAbs().sum() + rsum;
   double rounding = 0.0;
   bool in_band = false;
@@ -178,10 +235,10 @@ IntersectResult gjkIntersect(const A& a, const Pose& pose_a, const B& b, const P
     r.iterations = it;
     const SupportPoint p = md.support(-v);
     const double vlen = std::sqrt(vv);
-    rounding = std::max(rounding, kUlps * (world + p.a.cwiseAbs().sum() + (p.b - md.b_in_a.t).cwiseAbs().sum()));
+    rounding = std::max(rounding, gjkRounding(world, p.a, p.b - md.b_in_a.t));
     // The band keeps exactly touching shapes (rounding either way) on the colliding side.
-    const double band = in_band ? rounding
-                                : std::max(rounding, tol.gjk_absolute * (std::sqrt(std::max(simplexScale(s), p.w.squaredNorm())) + rsum));
+    const double band = in_band ? 2.0 * rounding
+                                : std::max(2.0 * rounding, tol.gjk_absolute * (std::sqrt(std::max(simplexScale(s), p.w.squaredNorm())) + rsum));
     const double vw = v.dot(p.w);
     if (vw > (rsum + band) * vlen) {
       cache.axis = v;
@@ -194,7 +251,7 @@ IntersectResult gjkIntersect(const A& a, const Pose& pose_a, const B& b, const P
     if (s.n > 0 && (inSimplex(s, p.w) || vv - vw <= tol.gjk_relative * vv)) {
       // The distance is known to rounding (or to the tolerance): decide by the certified lower bound,
       // colliding when in doubt.
-      r.intersecting = !(lower > rsum + rounding);
+      r.intersecting = !(lower > rsum + 2.0 * rounding);
       r.status = inSimplex(s, p.w) ? Status::RepeatedSupport : Status::Converged;
       if (!r.intersecting) { cache.axis = v; cache.valid = true; }
       return r;
@@ -208,20 +265,12 @@ IntersectResult gjkIntersect(const A& a, const Pose& pose_a, const B& b, const P
     // plane, which its normal gives to rounding at any ‖v‖. Two: v must be orthogonal to the edge;
     // removing the along-edge error keeps support(−v) from swinging to a far endpoint (an error across
     // the edge only turns v inside the edge's normal cone, which leaves v·w unchanged).
-    if (s.n == 3) {
-      const Vec3 n = (s.p[1].w - s.p[0].w).cross(s.p[2].w - s.p[0].w);
-      const double nn = n.squaredNorm();
-      if (nn > 0.0) v_next = n * (n.dot(s.p[0].w) / nn);
-    } else if (s.n == 2) {
-      const Vec3 e = s.p[1].w - s.p[0].w;
-      const double ee = e.squaredNorm();
-      if (ee > 0.0) v_next -= e * (v_next.dot(e) / ee);
-    }
+    refineClosest(s, v_next);
     const double vv_next = v_next.squaredNorm();
     if (s.n == 4) { r.status = Status::Overlapping; return r; }
     if (vv_next <= (rsum + band) * (rsum + band)) {
       r.status = Status::Touching;
-      if (in_band || !(vv_next > (rsum + rounding) * (rsum + rounding))) return r;
+      if (in_band || !(vv_next > (rsum + 2.0 * rounding) * (rsum + 2.0 * rounding))) return r;
       in_band = true;  // within gjk_absolute: go on with the rounding as the band
     }
     if (!(vv_next < vv) && it > 1) { r.status = Status::NoProgress; return r; }  // intersecting, conservatively
