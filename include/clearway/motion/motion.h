@@ -41,10 +41,10 @@ class MotionBound {
   /// Points that move with link `anchor`, seen as one more link: the links that move as one (joined by
   /// joints the group does not move) merged, or a convex piece of a link; in the anchor's frame.
   struct Body {
-    int anchor = 0;
+    int anchor = 0;                    ///< the link the points move with (their frame is its frame)
     const ConvexHull* hull = nullptr;  ///< the points' hull
     Vec3 center = Vec3::Zero();        ///< a ball that contains them
-    double radius = 0.0;
+    double radius = 0.0;               ///< that ball's radius (metres)
   };
   /// A planar or floating joint's slides are bounded by the scene's limits of its x, y (and z) entries.
   /// Body k takes the link index scene.robot().linkCount() + k in every call below.
@@ -121,8 +121,9 @@ enum class MotionMode {
 /// crawled along an obstacle in steps of that size: 200,000 queries from a nanometre).
 inline constexpr double kContactGrowth = 1.0 / 16.0;
 
+/// How MotionChecker checks a segment: the mode, and each mode's accuracy and work bounds.
 struct MotionOptions {
-  MotionMode mode = MotionMode::Certified;
+  MotionMode mode = MotionMode::Certified;  ///< Certified, Sampled or Cast
   /// Certified: a pair closer than this (metres) counts as in contact; larger is faster near obstacles.
   /// Near an end of the segment that is itself nearer, the pair's contact distance is lower (half that
   /// end's clearance, growing away from it: kContactGrowth), so a free state can always be left (a free
@@ -146,13 +147,15 @@ struct MotionOptions {
 
 /// The verdict on a segment.
 struct MotionResult {
-  bool free = false;
+  bool free = false;  ///< true only when the whole segment is free (certified, or at every sample)
+  ///@{
   /// When not free: the segment parameter of the first contact found (certified: a state within
   /// contact_distance of touching there, and none touching before it; an invalid state: where the segment
   /// leaves the bounds), and the last parameter at which the state is known to be free (≤ first_contact;
   /// 0 when q0 itself collides).
   double first_contact = 0.0;
   double last_valid = 0.0;
+  ///@}
   CollisionReport report;   ///< what collided
   int steps = 0;            ///< parameters whose poses were computed (certified) or states checked (sampled)
   int distance_queries = 0; ///< pair or link distances computed (certified)
@@ -169,8 +172,11 @@ struct Scratch;  // motion_detail.h
 class MotionContext {
  public:
   MotionContext() noexcept;
+  ///@{
+  /// Takes the other context's scratch, leaving that one empty.
   MotionContext(MotionContext&&) noexcept;
   MotionContext& operator=(MotionContext&&) noexcept;
+  ///@}
   ~MotionContext();
 
  private:
@@ -190,9 +196,13 @@ class MotionChecker {
   /// only the obstacles' speed is read again; otherwise it is built as the constructor above builds it.
   MotionChecker(const MotionChecker& base, std::shared_ptr<const Scene> scene);
 
+  /// The scene whose segments are checked.
   const Scene& scene() const noexcept { return *scene_; }
+  /// The options the checker was built with.
   const MotionOptions& options() const noexcept { return options_; }
+  /// The motion bound of the scene's group, with the merged bodies.
   const MotionBound& bound() const noexcept { return bound_; }
+  /// A new scratch for check() on one thread (allocates; reuse it for every check of that thread).
   MotionContext makeContext() const;
 
   /// The verdict on q0 → q1 (each of scene().dimension() values). With locate_contact, a certified check

@@ -23,8 +23,8 @@ struct DistanceResult {
   Vec3 point_a = Vec3::Zero();  ///< closest point on A (world)
   Vec3 point_b = Vec3::Zero();  ///< closest point on B (world)
   Vec3 normal = Vec3::Zero();   ///< unit, from A towards B; zero when the cores overlap
-  Status status = Status::NotConverged;
-  int iterations = 0;
+  Status status = Status::NotConverged;  ///< why it stopped; isFailure(status): mayCollide() is true
+  int iterations = 0;           ///< GJK iterations run (≤ Tolerances::gjk_max_iterations)
   /// True when the shapes may touch: overlap, touching, or a query that failed (never "free" by accident).
   bool mayCollide() const noexcept { return isFailure(status) || distance <= 0.0; }
 };
@@ -32,15 +32,17 @@ struct DistanceResult {
 /// The separating axis found by the last intersection query of a pair, kept by the caller for the next one.
 struct SimplexCache {
   Vec3 axis = Vec3::Zero();  ///< in A's local frame, so it survives when both shapes move together
-  bool valid = false;
+  bool valid = false;        ///< false until a query found an axis: then the next one starts from it
+  ///@{
   std::int32_t hint_a = -1, hint_b = -1;  ///< where the support searches of A and B ended (hulls resume there)
+  ///@}
 };
 
 /// Result of an intersection query.
 struct IntersectResult {
   bool intersecting = true;  ///< true also when status is a failure: callers assume a collision
-  Status status = Status::NotConverged;
-  int iterations = 0;
+  Status status = Status::NotConverged;  ///< why it stopped (Separated: a separating axis was proven)
+  int iterations = 0;        ///< GJK iterations run (≤ Tolerances::gjk_max_iterations)
 };
 
 namespace detail {
