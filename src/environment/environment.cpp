@@ -12,6 +12,7 @@
 // bounding every coordinate of the query, so box culling never drops a pair that GJK (whose own band
 // is gjk_absolute times the pair's size) would call touching.
 #include <clearway/environment/environment.h>
+#include <clearway/load/input_limits.h>
 
 #include <clearway/narrowphase/epa.h>
 #include <clearway/narrowphase/ray_cast.h>
@@ -262,6 +263,14 @@ Environment Environment::withObstacle(Obstacle obstacle) const {
   if (!obstacle.pose.isFinite()) throw std::invalid_argument("environment: obstacle '" + name + "' has a non-finite pose");
   if (!obstacle.velocity.allFinite())
     throw std::invalid_argument("environment: obstacle '" + name + "' has a non-finite velocity");
+  // As in a scene file (load/input_limits.h): past kMaxInputLength the boxes and radii the culls sum
+  // overflow (a hull of points near 1e200 had an infinite radius, and a segment between two states
+  // inside it was certified free).
+  const Aabb box = obstacle.mesh ? placedBox(obstacle.mesh->hull(), obstacle.pose) : placedBox(obstacle.shape, obstacle.pose);
+  if (!(box.min.cwiseAbs().maxCoeff() <= kMaxInputLength) || !(box.max.cwiseAbs().maxCoeff() <= kMaxInputLength))
+    throw std::invalid_argument("environment: obstacle '" + name + "' reaches beyond " +
+                                std::to_string(static_cast<long long>(kMaxInputLength)) +
+                                " m, the largest length an input may give");
   auto shared = std::make_shared<const Obstacle>(std::move(obstacle));
   if (!shared->moving()) return withStatic(std::move(shared));
   Environment e = *this;

@@ -17,6 +17,7 @@
 #include <fstream>
 #include <random>
 #include <string>
+#include <tuple>
 #include <unistd.h>
 #include <vector>
 
@@ -864,4 +865,36 @@ TEST(Environment, LinkCastAgainstSampledDistances) {
 }
 
 }  // namespace
+}  // namespace clearway
+
+namespace clearway {
+
+// An obstacle added by an edit (Python's with_obstacle, World) may reach no farther than a scene file's
+// may (kMaxInputLength): a hull of points near 1e200 had an infinite radius, and the certified check then
+// called a segment between two states inside it free (fuzz_scene_edits). Refused, naming the obstacle;
+// one within the limit is added.
+TEST(Environment, EditedObstaclesBeyondTheLargestLengthAreRefused) {
+  const Environment empty;
+  const auto add = [&](const std::string& name, const Shape& shape, const Vec3& at) {
+    Obstacle o;
+    o.name = name;
+    o.shape = shape;
+    o.pose = Pose::translation(at);
+    return empty.withObstacle(std::move(o));
+  };
+  const std::vector<Vec3> huge = {Vec3(1e200, 0, 0), Vec3(-1e200, 1, 0), Vec3(0, 0, 1e200), Vec3(0, -1e200, -1)};
+  for (const auto& [name, shape, at] : std::vector<std::tuple<std::string, Shape, Vec3>>{
+           {"hull", ConvexHull(huge), Vec3::Zero()},
+           {"slab", Box(Vec3(2e6, 1, 1)), Vec3::Zero()},
+           {"far", Sphere(0.1), Vec3(0, 0, 1e7)}}) {
+    try {
+      add(name, shape, at);
+      ADD_FAILURE() << name << " was added";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("'" + name + "' reaches beyond 1000000 m"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(add("large", Box(Vec3(4e5, 1, 1)), Vec3(5e5, 0, 0)).obstacles().size(), 1u);
+}
+
 }  // namespace clearway
