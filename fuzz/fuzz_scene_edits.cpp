@@ -240,6 +240,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
           a.body.shape = shape(in);
           a.body.pose = pose(in);
           for (int k = in.ConsumeIntegralInRange(0, 3); k > 0; --k) a.touch_links.push_back(name(in, links));
+          if (std::getenv("CLEARWAY_FUZZ_TRACE"))
+            std::fprintf(stderr, "with_attached: %s on %s, bounding radius %s, at %s, rotation %s, touching %s\n",
+                         shapeTypeName(a.body.shape), a.link.c_str(), exact(boundingRadius(a.body.shape)).c_str(),
+                         exact(std::vector<double>{a.body.pose.t.x(), a.body.pose.t.y(), a.body.pose.t.z()}).c_str(),
+                         exact(std::vector<double>(a.body.pose.R.data(), a.body.pose.R.data() + 9)).c_str(),
+                         exact(a.touch_links).c_str());
           next = s.withAttached(a);
           change = Change::Adds;
           break;

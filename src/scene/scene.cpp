@@ -1,6 +1,7 @@
 #include <clearway/scene/scene.h>
 
 #include <clearway/body/enclosing.h>
+#include <clearway/body/link_geometry.h>
 
 #include <clearway/detail/per_thread.h>
 
@@ -335,6 +336,14 @@ std::shared_ptr<const Scene> Scene::withAttached(const SceneDescription::Attache
   b.link = link(spec.link);
   b.pose = spec.body.pose;
   for (const std::string& t : spec.touch_links) b.touch_links.push_back(link(t));
+  // As a scene file's lengths (load/input_limits.h): a body placed near 1e308 overflowed the link's pose,
+  // and a cast motion from a colliding state was called free.
+  const auto within = [](const Vec3& v) { return v.cwiseAbs().maxCoeff() <= kMaxInputLength; };
+  const Aabb box = spec.body.mesh_file.empty() ? placedBox(spec.body.shape, spec.body.pose) : Aabb{spec.body.pose.t, spec.body.pose.t};
+  if (!within(box.min) || !within(box.max))
+    throw std::invalid_argument("attach '" + inputExcerpt(name) + "': the body reaches beyond " +
+                                std::to_string(static_cast<long long>(kMaxInputLength)) +
+                                " m of its link, the largest length an input may give");
   std::vector<TriangleMesh> meshes;
   if (spec.body.mesh_file.empty()) {
     b.element.primitive = spec.body.shape;

@@ -130,6 +130,42 @@ TEST(Attached, TakingABodyOffTakesItsAllowedPairsOff) {
   EXPECT_FALSE(again->isFree(upright));
 }
 
+// Found by fuzz_scene_edits: an edit (Python's with_attached) placed a point 8.5e307 m from its link. The
+// link's pose overflowed: isFree called the state colliding, a cast motion of length zero from it free.
+// Bodies reaching beyond kMaxInputLength are refused, as a scene file's lengths are; one within it holds.
+TEST(Attached, EditedBodiesBeyondTheLargestLengthAreRefused) {
+  TempDir dir;
+  const auto bare = Scene::load(dir.write("bare.yaml", armScene("", kWall)));
+  const auto spec = [](Shape shape, const Vec3& at) {
+    SceneDescription::AttachedSpec a;
+    a.body.name = "far";
+    a.link = "forearm_link";
+    a.body.shape = std::move(shape);
+    a.body.pose = Pose::fromQuaternion(0, 0, 0, 1, at);
+    return a;
+  };
+  const std::pair<SceneDescription::AttachedSpec, const char*> refused[] = {
+      {spec(Point(Vec3(0.1, 0.2, 0.3)), Vec3(8.4716234799357126e307, -2.0596186621375958e307, 1.6)), "point near 1e308"},
+      {spec(Sphere(0.1), Vec3(0, 2e6, 0)), "sphere 2e6 m away"},
+      {spec(Box(Vec3(3e6, 0.1, 0.1)), Vec3::Zero()), "box 3e6 m long"},
+      {spec(Point(Vec3(0, 0, -1.5e6)), Vec3::Zero()), "point 1.5e6 m below its frame"},
+  };
+  for (const auto& [a, what] : refused) {
+    SCOPED_TRACE(what);
+    try {
+      bare->withAttached(a);
+      ADD_FAILURE() << "attached";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("attach 'far': the body reaches beyond 1000000 m"), std::string::npos) << e.what();
+    }
+  }
+  // Within the limit: a ball 900 km away touches nothing; a ball of radius 900 km holds the wall.
+  const auto far = bare->withAttached(spec(Sphere(0.05), Vec3(9e5, 0, 0)));
+  EXPECT_TRUE(far->isFree(std::vector<double>(6, 0.0)));
+  const auto huge = bare->withAttached(spec(Sphere(9e5), Vec3::Zero()));
+  EXPECT_FALSE(huge->isFree(std::vector<double>(6, 0.0)));
+}
+
 TEST(Attached, BadDeclarationsNameTheKey) {
   TempDir dir;
   struct Case {
