@@ -19,8 +19,10 @@
 #include <clearway/shape/support.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <mutex>
 #include <optional>
@@ -315,27 +317,47 @@ Environment Environment::withPoints(const std::vector<Vec3>& points, double reso
   if (resolution == 0.0 && map_) resolution = map_->resolution;
   if (!(resolution > 0.0) || !std::isfinite(resolution))
     throw std::invalid_argument("environment: points need a finite voxel size > 0 (the map's, or given)");
-  Environment e = *this;
+  // As a map's cells and an obstacle's extent (load/input_limits.h): a cell below kMinInputLength has no
+  // hull, and a point beyond kMaxInputLength no digit of a link's size.
+  if (resolution < kMinInputLength) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.17g m is below %g m", resolution, kMinInputLength);
+    throw std::invalid_argument(std::string("environment: a voxel size of ") + text + ", the smallest length computed with");
+  }
+  // Each point's cell, once: a cloud holds many points per voxel.
+  std::vector<Aabb> cells;
+  cells.reserve(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) {
     const Vec3& p = points[i];
     if (!p.allFinite()) throw std::invalid_argument("environment: point " + std::to_string(i) + " is not finite");
+    if (!(p.cwiseAbs().maxCoeff() + resolution <= kMaxInputLength))
+      throw std::invalid_argument("environment: point " + std::to_string(i) + "'s voxel reaches beyond " +
+                                  std::to_string(static_cast<long long>(kMaxInputLength)) +
+                                  " m, the largest length an input may give");
     const Vec3 lo = (p / resolution).array().floor() * resolution;
     Aabb cell = Aabb::fromMinMax(lo, lo + Vec3::Constant(resolution));
     cell.grow(p);  // (where rounding leaves the point just outside its cell, the cell grows to it)
-    const Vec3 c = cell.center();
-    bool held = false;
-    const Aabb probe = Aabb::ofPoint(c);
-    if (e.voxel_tree_)
-      e.voxel_tree_->query(probe, [&](std::int32_t v) { return held = e.map_->occupied[v].contains(cell); });
-    if (!held) e.static_.query(probe, [&](const Static& s, const Aabb&) { return held = s.voxel && s.obstacle->pose.t == c; });
-    if (held) continue;
-    auto voxel = std::make_shared<Obstacle>();
-    voxel->shape = Box(cell.halfExtents());
-    voxel->pose = Pose::translation(c);
-    const Aabb box = shapeWorldBox(voxel->shape, voxel->pose);
-    e.static_ = e.static_.inserted(box, Static{std::move(voxel), -1, true});
-    ++e.point_voxels_;
+    cells.push_back(cell);
   }
+  const auto corners = [](const Aabb& b) {
+    return std::array<double, 6>{b.min.x(), b.min.y(), b.min.z(), b.max.x(), b.max.y(), b.max.z()};
+  };
+  std::sort(cells.begin(), cells.end(), [&](const Aabb& a, const Aabb& b) { return corners(a) < corners(b); });
+  cells.erase(std::unique(cells.begin(), cells.end(), [&](const Aabb& a, const Aabb& b) { return corners(a) == corners(b); }),
+              cells.end());
+  std::vector<std::pair<Aabb, Static>> added;
+  for (const Aabb& cell : cells) {
+    bool held = false;
+    const Aabb probe = Aabb::ofPoint(cell.center());
+    if (voxel_tree_) voxel_tree_->query(probe, [&](std::int32_t v) { return held = map_->occupied[v].contains(cell); });
+    if (!held)
+      static_.query(probe, [&](const Static& s, const Aabb& box) { return held = s.voxel && corners(box) == corners(cell); });
+    if (!held) added.push_back({cell, Static{nullptr, -1, true}});
+  }
+  std::vector<Aabb>().swap(cells);
+  Environment e = *this;
+  e.point_voxels_ += static_cast<int>(added.size());
+  e.static_ = static_.insertedAll(std::move(added));
   e.rescale();
   return e;
 }
@@ -391,10 +413,10 @@ struct Environment::Item {
 
 template <class F>
 Environment::Walk Environment::forEachItem(const Reach& reach, double t, F&& visit) const {
-  const auto on_static = [&](const Static& s, const Aabb&) {
+  const auto on_static = [&](const Static& s, const Aabb& box) {
+    if (s.voxel) return visit(Item{EnvironmentHit::Kind::Voxel, -1, nullptr, &box, Pose::translation(box.center()), -1});
     const Obstacle& o = *s.obstacle;
-    return visit(Item{s.voxel ? EnvironmentHit::Kind::Voxel : EnvironmentHit::Kind::Obstacle, -1, &o, nullptr, o.pose,
-                      s.slot});
+    return visit(Item{EnvironmentHit::Kind::Obstacle, -1, &o, nullptr, o.pose, s.slot});
   };
   if (reach.box ? static_.query(*reach.box, on_static) : static_.forEachWithin(*reach.local, *reach.pose, *reach.limit, on_static))
     return Walk::Stopped;
@@ -463,9 +485,11 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
   int found = -1;
   EnvironmentHit found_obstacle;  // an obstacle (or a point voxel) touched
   const Walk walk = forEachItem(Reach::overlapping(query), t, [&](const Item& item) {
-    if (item.obstacle) {
+    if (item.index < 0) {  // an obstacle, or a voxel made by withPoints: on its own
       if (counters) ++counters->obstacle_tests;
-      if (!obstacleIntersects(*item.obstacle, item.pose, link, pose, tol, mode, padding)) return false;
+      if (item.obstacle ? !obstacleIntersects(*item.obstacle, item.pose, link, pose, tol, mode, padding)
+                        : !shapeIntersectsLink(Box(item.voxel->halfExtents()), item.pose, link, pose, tol, mode, padding))
+        return false;
       found_obstacle = item.hit();
       return true;
     }

@@ -356,6 +356,57 @@ TEST(VersionedAabbTree, BuildEqualsIncrementalInsertsAndRefusesBadBoxes) {
   EXPECT_EQ(Tree::build({}).size(), 0);
 }
 
+// insertedAll adds a batch as inserted() one by one would (the same keys, items and key order), whether it
+// inserts (a few items into many) or rebuilds (many into few); the version it came from is unchanged.
+TEST(VersionedAabbTree, InsertingABatchEqualsInsertingOneByOne) {
+  std::mt19937_64 rng(8);
+  for (const auto& [before, batch] : {std::pair<int, int>{600, 3}, {600, 400}, {0, 250}, {40, 0}}) {
+    SCOPED_TRACE(std::to_string(before) + " items, then " + std::to_string(batch));
+    Tree base;
+    LiveSet live;
+    for (int i = 0; i < before; ++i) {
+      Key key;
+      const Aabb box = randomBox(rng);
+      base = base.inserted(box, i, &key);
+      live.push_back({key, box, i});
+    }
+    std::vector<std::pair<Aabb, int>> items;
+    for (int i = 0; i < batch; ++i) items.push_back({randomBox(rng), before + i});
+    Tree one_by_one = base;
+    std::vector<Key> keys_one;
+    for (const auto& [box, id] : items) {
+      Key key;
+      one_by_one = one_by_one.inserted(box, id, &key);
+      keys_one.push_back(key);
+    }
+    std::vector<Key> keys;
+    const Tree all = base.insertedAll(items, &keys);
+    ASSERT_EQ(keys, keys_one);
+    ASSERT_EQ(all.size(), before + batch);
+    EXPECT_EQ(base.size(), before);
+    EXPECT_LE(all.height(), heightBound(all.size()));
+    std::vector<std::pair<int, Aabb>> a, b;
+    all.forEach([&](int id, const Aabb& box) { a.push_back({id, box}); });
+    one_by_one.forEach([&](int id, const Aabb& box) { b.push_back({id, box}); });
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      EXPECT_EQ(a[i].first, b[i].first);
+      EXPECT_EQ(a[i].second.min, b[i].second.min);
+      EXPECT_EQ(a[i].second.max, b[i].second.max);
+    }
+    for (int i = 0; i < batch; ++i) live.push_back({keys[i], items[i].first, items[i].second});
+    ASSERT_NO_FATAL_FAILURE(checkAgainstBruteForce(all, live, rng, 6, "batch"));
+    // Later versions number their items after the batch.
+    Key next;
+    all.inserted(Aabb::ofPoint(Vec3::Zero()), -1, &next);
+    for (const Key& k : keys) EXPECT_NE(k, next);
+  }
+  // A bad box anywhere in the batch: refused, nothing added.
+  const Tree one = Tree().inserted(Aabb::ofPoint(Vec3::Zero()), 0);
+  EXPECT_THROW(one.insertedAll({{Aabb::ofPoint(Vec3::Ones()), 1}, {Aabb(), 2}}), std::invalid_argument);
+  EXPECT_EQ(one.size(), 1);
+}
+
 TEST(VersionedAabbTree, KeysFollowTheCoordinateOrder) {
   // Along each axis, with the other coordinates equal, the Morton order is the order of the coordinate
   // (negative and positive, tiny and huge); −0.0 and +0.0 tie, and the serial breaks the tie.

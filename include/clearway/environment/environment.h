@@ -138,8 +138,10 @@ class Environment {
   Environment withObstacleMoved(const std::string& name, const Pose& pose) const;
   /// This world with the voxel holding each point occupied: voxels of edge `resolution` on OctoMap's grid
   /// (cell k spans [k·res, (k+1)·res) per axis), the map's resolution when 0. Points in voxels already
-  /// occupied (by the map or earlier points) add nothing; O(log n) per new voxel. Non-finite points are
-  /// refused: std::invalid_argument naming the first, as for a resolution ≤ 0 (or 0 without a map).
+  /// occupied (by the map or earlier points) add nothing; O(m log m) for m points, plus O(log n) per new
+  /// voxel or one O(n) rebuild when that is less. Refused with std::invalid_argument naming the first: a
+  /// non-finite point or one whose voxel reaches beyond kMaxInputLength; likewise a resolution below
+  /// kMinInputLength or not finite (or 0 without a map).
   Environment withPoints(const std::vector<Vec3>& points, double resolution = 0.0) const;
   /// This world with another occupancy map (a changed .bt); the obstacles and point voxels are shared.
   Environment withMap(std::shared_ptr<const OccupancyMap> map) const;
@@ -208,9 +210,10 @@ class Environment {
   template <class F>
   Walk forEachItem(const Reach& reach, double t, F&& visit) const;
 
-  // A static obstacle in the tree, with its warm-start slot; or a voxel made by withPoints (slot −1).
+  // A static obstacle in the tree, with its warm-start slot; or a voxel made by withPoints: no obstacle,
+  // slot −1, the item's box its cell (a cloud's million voxels, each a small node and nothing more).
   struct Static {
-    std::shared_ptr<const Obstacle> obstacle;
+    std::shared_ptr<const Obstacle> obstacle;  // null for a voxel
     int slot = -1;
     bool voxel = false;
   };

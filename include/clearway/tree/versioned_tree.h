@@ -150,6 +150,42 @@ class VersionedAabbTree {
     return t;
   }
 
+  /// This tree with every (box, value) of `items` added, as inserted() one by one would add them (the
+  /// same keys, in input order, to *keys when given), in O(m log n) or, when that is more, by one
+  /// rebuild in O(n + m log m) that shares no node with this version. Throws as inserted() does, adding
+  /// nothing.
+  VersionedAabbTree insertedAll(std::vector<std::pair<Aabb, T>> items, std::vector<Key>* keys = nullptr) const {
+    const std::size_t m = items.size(), n = static_cast<std::size_t>(size());
+    for (const auto& item : items) checkBox(item.first);
+    std::vector<Key> made;
+    made.reserve(m);
+    for (std::size_t i = 0; i < m; ++i) made.push_back(keyOf(items[i].first, next_serial_ + i));
+    VersionedAabbTree t;
+    t.next_serial_ = next_serial_ + m;
+    // An insertion copies a root-to-leaf path: about height() nodes, where a rebuild makes n + m.
+    if (m * static_cast<std::size_t>(std::max(1, height())) < n + m) {
+      t.items_ = items_;
+      for (std::size_t i = 0; i < m; ++i) t.items_ = t.items_.inserted(made[i], Item{items[i].first, std::move(items[i].second)});
+    } else {
+      std::vector<std::pair<Key, Item>> added;
+      added.reserve(m);
+      for (std::size_t i = 0; i < m; ++i) added.push_back({made[i], Item{items[i].first, std::move(items[i].second)}});
+      std::sort(added.begin(), added.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+      std::vector<std::pair<Key, Item>> all;
+      all.reserve(n + m);
+      auto next = added.begin();
+      items_.forEach([&](const Key& k, const Item& item) {
+        for (; next != added.end() && next->first < k; ++next) all.push_back(std::move(*next));
+        all.push_back({k, item});
+      });
+      for (; next != added.end(); ++next) all.push_back(std::move(*next));
+      std::vector<std::pair<Key, Item>>().swap(added);  // (a large batch's peak memory: one copy, not two)
+      t.items_ = Avl::fromSorted(std::move(all));
+    }
+    if (keys) *keys = std::move(made);
+    return t;
+  }
+
   /// This tree without the item of `key`; *found (when given) says whether it was there. A missing key
   /// gives a copy of this tree (the same nodes).
   VersionedAabbTree erased(const Key& key, bool* found = nullptr) const {
