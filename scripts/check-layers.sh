@@ -3,7 +3,8 @@
 # include only itself and the stages before it. Reads every `#include <clearway/STAGE/...>` (and the
 # plugin's, the tool's and the Python module's) and fails, naming file, line and both stages, when one
 # points up the pipeline or names a stage not listed here. Headers at include/clearway/ itself (math.h,
-# tolerances.h) and detail/ are below every stage.
+# tolerances.h) and detail/ are below every stage. It also refuses a bare 1e-9 or 1e-12 in code (see
+# the end).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -60,7 +61,18 @@ while IFS= read -r file; do
   fi
 done < <(find include/clearway src plugins/ompl python -type f \( -name '*.h' -o -name '*.cpp' \) | sort)
 
+# No bare margin: a literal 1e-9 or 1e-12 in code (not in a comment or a string) must name what it is,
+# as a constant (`constexpr double kName = 1e-9;`), or read include/clearway/detail/margins.h.
+margins=0
+while IFS= read -r hit; do
+  echo "check-layers: $hit: a bare margin; use include/clearway/detail/margins.h or a named constant"
+  margins=$((margins + 1))
+  status=1
+done < <(find include/clearway src plugins/ompl python -type f \( -name '*.h' -o -name '*.cpp' \) ! -path '*/detail/margins.h' -print0 |
+  xargs -0 grep -nE '1e-(9|12)\b' | sed -E 's#//.*$##; s#"([^"\\]|\\.)*"#""#g' |
+  grep -E ':[0-9]+:.*\b1e-(9|12)\b' | grep -vE ':[0-9]+:[[:space:]]*(static )?constexpr double k[A-Za-z0-9_]* = 1e-(9|12);' || true)
+
 if [ $status -eq 0 ]; then
-  echo "check-layers: $checked includes, all down the pipeline (${stages[*]})"
+  echo "check-layers: $checked includes, all down the pipeline (${stages[*]}); no bare margin"
 fi
 exit $status

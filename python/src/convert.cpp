@@ -70,7 +70,8 @@ Pose toPose(const py::handle& pose, const std::string& name) {
   // The test of the query files' "R": orthonormal within 1e-9 in every entry of RᵀR − I, det > 0.
   const double off = (p.R.transpose() * p.R - Mat3::Identity()).cwiseAbs().maxCoeff();
   char buf[64];
-  if (!(off <= 1e-9)) {
+  constexpr double kOrthonormal = 1e-9;
+  if (!(off <= kOrthonormal)) {
     std::snprintf(buf, sizeof buf, "%.3g", off);
     throw py::value_error(name + " is not a rotation: max |R^T R - I| = " + buf + " exceeds 1e-9");
   }

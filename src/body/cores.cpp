@@ -6,6 +6,7 @@
 // connected, it lies inside. Primitives are solids, and their cores are inscribed balls.
 #include <clearway/body/link_geometry.h>
 
+#include <clearway/detail/margins.h>
 #include <clearway/narrowphase/simplex.h>
 
 #include <algorithm>
@@ -46,7 +47,7 @@ double triangleDistance(const Triangle& t, const Vec3& p) noexcept {
 }
 
 // A ball's margin: far above the rounding of the distances (a few ulps of the link's size).
-double margin(double size) noexcept { return 1e-9 * (1.0 + size); }
+double margin(double size) noexcept { return margins::kSlack * (1.0 + size); }
 
 // Point-to-shape distance for the shapes coreMeetsShape decides (p in the shape's frame); NaN otherwise.
 struct PointDistance {
@@ -139,7 +140,7 @@ void LinkGeometry::findCores() {
   for (const Primitive& p : primitives_) {
     std::vector<Ball> balls;
     std::visit(InscribedBalls{p.pose, balls}, p.shape);
-    for (Ball& b : balls) candidates.push_back({b.center, b.radius * (1.0 - 1e-12) - m});
+    for (Ball& b : balls) candidates.push_back({b.center, b.radius * (1.0 - margins::kRounding) - m});
   }
   std::sort(candidates.begin(), candidates.end(), [](const Ball& x, const Ball& y) { return x.radius > y.radius; });
   for (const Ball& c : candidates) {

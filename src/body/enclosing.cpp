@@ -1,5 +1,6 @@
 // The enclosing layer (enclosing.h): balls placed once per link, compared per pair.
 #include <clearway/body/enclosing.h>
+#include <clearway/detail/margins.h>
 
 #include <algorithm>
 #include <cmath>
@@ -80,7 +81,7 @@ bool EnclosingBalls::apart(int a, int b, double padding, const Tolerances& tol, 
   const Link& lb = links_[b];
   if (la.count == 0 || lb.count == 0 || !poses_) return false;  // (never placed: nothing proved)
   // As spheresApart in link_geometry.cpp: the band grows with the coordinates' size; a NaN compares false.
-  const double band = std::max(tol.gjk_absolute, 64.0 * std::numeric_limits<double>::epsilon());
+  const double band = margins::narrowBand(tol.gjk_absolute);
   const auto ballsApart = [&](int i, int j) {
     const double reach = radii_[i] + radii_[j] + padding;
     const double limit = reach + band * (norms_[i] + norms_[j] + reach);

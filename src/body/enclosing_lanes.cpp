@@ -1,6 +1,7 @@
 // EnclosingBalls::boundsApart in SIMD lanes, compiled once per target by Highway's foreach_target.h: the
 // bounding-ball test of many link pairs at once, the first rung of every self-collision query.
 #include <clearway/body/enclosing.h>
+#include <clearway/detail/margins.h>
 
 #include <algorithm>
 #include <cstddef>
@@ -70,7 +71,7 @@ void EnclosingBalls::boundsApart(const std::int64_t* a, const std::int64_t* b, c
     std::fill(out, out + n, std::uint8_t{0});
     return;
   }
-  const double band = std::max(tol.gjk_absolute, 64.0 * std::numeric_limits<double>::epsilon());
+  const double band = margins::narrowBand(tol.gjk_absolute);
   HWY_DYNAMIC_DISPATCH(BoundsApart)(bound_x_.data(), bound_y_.data(), bound_z_.data(), bound_r_.data(),
                                     bound_norm_.data(), a, b, padding, n, band, out);
 }

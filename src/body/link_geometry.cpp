@@ -8,6 +8,7 @@
 // discard pairs certainly farther apart than slack (the band dwarfs their rounding); what they keep,
 // GJK decides within its own band, which is at most this one.
 #include <clearway/body/link_geometry.h>
+#include <clearway/detail/margins.h>
 
 #include <algorithm>
 #include <array>
@@ -53,7 +54,7 @@ const UnitBall& circumscribedUnitBall() {
       b.points.emplace_back(r * std::cos(golden * i), r * std::sin(golden * i), z);
     }
     // The hull's nearest face plane to the centre: scaling by its inverse pushes every face out to
-    // distance ≥ 1, and the factor 1 + 1e-9 covers the rounding of the planes.
+    // distance ≥ 1, and the factor kBeyond covers the rounding of the planes.
     const ConvexHull hull(b.points);
     double nearest = std::numeric_limits<double>::infinity();
     for (const auto& t : hull.triangles()) {
@@ -61,7 +62,7 @@ const UnitBall& circumscribedUnitBall() {
       const Vec3 n = (hull.vertices()[t[1]] - p0).cross(hull.vertices()[t[2]] - p0).normalized();
       nearest = std::min(nearest, std::abs(n.dot(p0)));
     }
-    const double scale = (1.0 + 1e-9) / nearest;
+    const double scale = margins::kBeyond / nearest;
     for (Vec3& p : b.points) p *= scale;
     return b;
   }();
@@ -79,7 +80,7 @@ struct HullPoints {
     for (const Vec3& u : circumscribedUnitBall().points) out.push_back(pose * (c + r * u));
   }
   void circle(double z, double r) const {
-    const double R = r / std::cos(kPi / kCirclePoints) * (1.0 + 1e-12);
+    const double R = r / std::cos(kPi / kCirclePoints) * (1.0 + margins::kRounding);
     for (int i = 0; i < kCirclePoints; ++i) {
       const double phi = 2.0 * kPi * i / kCirclePoints;
       out.push_back(pose * Vec3(R * std::cos(phi), R * std::sin(phi), z));
@@ -244,7 +245,7 @@ Aabb localBox(const Shape& shape) noexcept {
 bool spheresApart(const Vec3& ca, double ra, const Vec3& cb, double rb, double padding, const Tolerances& tol) noexcept {
   const double reach = ra + rb + padding;
   const double scale = ca.norm() + cb.norm() + reach;
-  const double limit = reach + std::max(tol.gjk_absolute, 64.0 * std::numeric_limits<double>::epsilon()) * scale;
+  const double limit = reach + margins::narrowBand(tol.gjk_absolute) * scale;
   return (ca - cb).squaredNorm() > limit * limit;
 }
 
@@ -265,7 +266,7 @@ LinkGeometry::LinkGeometry(std::vector<Triangle> triangles, std::vector<Primitiv
   sphere_center_ = bounds_.center();
   for (const Vec3& v : hull_.vertices()) sphere_radius_ = std::max(sphere_radius_, (v - sphere_center_).norm());
   // Rounding of the norms (relative) and of the centre (relative to the coordinates).
-  sphere_radius_ = sphere_radius_ * (1.0 + 1e-12) + 1e-12 * bounding_radius_;
+  sphere_radius_ = margins::roundedUp(sphere_radius_, bounding_radius_);
   buildParts();
   findSolids();
   findCores();
@@ -278,7 +279,7 @@ void LinkGeometry::buildParts() {
     for (const Vec3& v : hull.vertices()) box.grow(v);
     double radius = 0.0;
     for (const Vec3& v : hull.vertices()) radius = std::max(radius, (v - box.center()).norm());
-    parts_.push_back({std::move(hull), box.center(), radius * (1.0 + 1e-12) + 1e-12 * bounding_radius_});
+    parts_.push_back({std::move(hull), box.center(), margins::roundedUp(radius, bounding_radius_)});
   };
   // The tree's top nodes split the triangles spatially; descending level by level keeps the parts even.
   if (!tree_.empty()) {
@@ -610,7 +611,7 @@ DistanceResult meshDistance(const LinkGeometry& a, const Pose& pose_a, const Lin
     // pair passing them is first projected on two axes, each gap a lower bound on its distance: the
     // line through the centroids (tight for small triangles far apart) and the normal of the best pair
     // so far (tight for surfaces facing each other). GJK runs only when neither reaches the cutoff.
-    const double rounding = 1e-12 * (a.boundingRadius() + b.boundingRadius() + b_in_a.t.norm());
+    const double rounding = margins::kRounding * (a.boundingRadius() + b.boundingRadius() + b_in_a.t.norm());
     stop = forEachPairWithin(a.tree(), b.tree(), b_in_a, m.cutoff, [&](std::int32_t i, std::int32_t j) {
       if (m.cutoff < std::numeric_limits<double>::infinity()) {
         const Vec3* va = ta[i].v;

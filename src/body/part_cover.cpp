@@ -13,6 +13,7 @@
 // all: a part's farthest vertex lies on its ball, and the cells around it straddle that ball's boundary at
 // every size, so without growth the split would never end there.
 #include <clearway/body/link_geometry.h>
+#include <clearway/detail/margins.h>
 
 #include <algorithm>
 #include <cmath>
@@ -33,7 +34,7 @@ constexpr long kMaxCells = 1L << 18;
 bool LinkGeometry::ballsHoldSolids(const std::vector<Ball>& balls, double margin) const {
   if (solid_boxes_.empty()) return true;
   if (!(margin > 0.0) || !std::isfinite(margin)) return false;
-  const double rounding = 1e-9 * (1.0 + bounding_radius_);  // far above the few ulps of each distance
+  const double rounding = margins::kSlack * (1.0 + bounding_radius_);  // far above the few ulps of each distance
   const double smallest = 0.25 * margin;                     // the bottom cells' half diagonal
   long cells = 0;
   std::vector<Aabb> stack;

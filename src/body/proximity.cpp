@@ -1,6 +1,7 @@
 // BodyPair: the proximity ladder of two bodies, written once.
 #include <clearway/body/proximity.h>
 
+#include <clearway/detail/margins.h>
 #include <clearway/narrowphase/epa.h>
 
 #include <algorithm>
@@ -65,7 +66,7 @@ double BodyPair::lowerBound(const Pose& pose_a, const Pose& pose_b, const Tolera
   if (q.within >= 0.0 && meshesIntersect(a, pose_a, b, pose_b, tol, GeometryMode::Mesh, q.within)) return 0.0;
   const DistanceResult m = meshDistance(a, pose_a, b, pose_b, tol, q.relative, std::min(q.enough, q.near));
   if (isFailure(m.status)) return 0.0;
-  return q.within >= 0.0 ? std::max(m.lower_bound, q.within * (1.0 + 1e-9)) : m.lower_bound;
+  return q.within >= 0.0 ? std::max(m.lower_bound, q.within * margins::kBeyond) : m.lower_bound;
 }
 
 double BodyPair::penetration(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol,

@@ -20,6 +20,7 @@
 // twice or not at all: such a ray is dropped and the next of a fixed set of directions is tried; when all
 // are dropped, the point counts as inside (never "outside" by accident).
 #include <clearway/body/link_geometry.h>
+#include <clearway/detail/margins.h>
 
 #include <algorithm>
 #include <cmath>
@@ -44,8 +45,8 @@ const Vec3& rayDirection(int i) noexcept {
 
 // Relative margins (of the barycentric weights, and of a plane's tilt to the ray) below which a crossing
 // is not decided by rounding; far above double's rounding of the triple products involved.
-constexpr double kEdgeMargin = 1e-9;
-constexpr double kParallelMargin = 1e-9;
+constexpr double kEdgeMargin = margins::kSlack;
+constexpr double kParallelMargin = margins::kSlack;
 // A shell's signed volume below this fraction of the sum of its tetrahedra's absolute volumes gives it no
 // winding (a sheet seen from both sides); far above the rounding of the sum.
 constexpr double kFlatVolume = 1e-6;
@@ -245,7 +246,7 @@ void LinkGeometry::findSolids() {
 
 bool LinkGeometry::rayCrossings(int s, int skip, const Vec3& p, const Vec3& dir, int& winding) const noexcept {
   const Vec3 inv(1.0 / dir.x(), 1.0 / dir.y(), 1.0 / dir.z());
-  const double grow = 1e-9 * (1.0 + p.cwiseAbs().maxCoeff() + bounding_radius_);  // (boxes' rounding)
+  const double grow = margins::kSlack * (1.0 + p.cwiseAbs().maxCoeff() + bounding_radius_);  // (boxes' rounding)
   const auto reaches = [&](const Aabb& box) {
     double lo = 0.0, hi = std::numeric_limits<double>::infinity();
     for (int i = 0; i < 3; ++i) {
@@ -293,7 +294,7 @@ bool LinkGeometry::rayCrossings(int s, int skip, const Vec3& p, const Vec3& dir,
       const double la = wa / sum, lb = wb / sum, lc = wc / sum;
       if (la < -kEdgeMargin || lb < -kEdgeMargin || lc < -kEdgeMargin) continue;  // the line misses it
       const double along = normal.dot(a) / sum;  // the ray parameter of the plane
-      const double near = 1e-12 * (a.norm() + b.norm() + c.norm());
+      const double near = margins::kRounding * (a.norm() + b.norm() + c.norm());
       if (along < -near) continue;  // behind p
       if (along <= near) return false;  // p on the triangle (touching) or next to it
       if (la <= kEdgeMargin || lb <= kEdgeMargin || lc <= kEdgeMargin) return false;  // at an edge or vertex
@@ -305,7 +306,7 @@ bool LinkGeometry::rayCrossings(int s, int skip, const Vec3& p, const Vec3& dir,
 
 int LinkGeometry::insideAlong(const Vec3& p, int r) const noexcept {
   const Vec3& dir = rayDirection(r);
-  const double grow = 1e-9 * (1.0 + bounding_radius_);
+  const double grow = margins::kSlack * (1.0 + bounding_radius_);
   bool undecided = false, wound = false;
   for (int s = 0; s < solidCount(); ++s) {
     const Aabb& box = solid_boxes_[s];

@@ -184,7 +184,8 @@ Mat3 rotationFromMatrix(const json& v, const std::string& path) {
   for (int i = 0; i < 3; ++i) R.row(i) = vec3(v[i], index(path, i)).transpose();
   const double off = (R.transpose() * R - Mat3::Identity()).cwiseAbs().maxCoeff();
   const double det = R.determinant();
-  if (!(off <= 1e-9))
+  constexpr double kOrthonormal = 1e-9;
+  if (!(off <= kOrthonormal))
     fail(path + " is not a rotation: max |R^T R - I| = " + json(off).dump() + " exceeds 1e-9");
   if (!(det > 0.0)) fail(path + " is not a rotation: det = " + json(det).dump() + " (a reflection)");
   return R;

@@ -1,5 +1,7 @@
 #include <clearway/environment/clearance_grid.h>
 
+#include <clearway/detail/margins.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -42,7 +44,7 @@ ClearanceGrid::ClearanceGrid(const std::vector<Aabb>& boxes, int max_cells) {
   const double e_max = e.maxCoeff();
   const double scale = std::max(bounds_.min.cwiseAbs().maxCoeff(), bounds_.max.cwiseAbs().maxCoeff());
   // Boxes near the doubles' end (extents that overflow): no cells, every point reads the boxes' box.
-  slack_ = 1e-9 * (1.0 + scale);
+  slack_ = margins::kSlack * (1.0 + scale);
   if (!(scale < 1e300) || !std::isfinite(e_max)) return;
   // The finest cells within the budget. Exits: h starts at no less than e_max / 1024 and grows by a
   // quarter per step, so within 32 steps h ≥ e_max, where at most 6³ cells remain (≤ 1000 ≤ max_cells).
@@ -59,7 +61,7 @@ ClearanceGrid::ClearanceGrid(const std::vector<Aabb>& boxes, int max_cells) {
   h_ = h;
   inv_h_ = 1.0 / h;
   origin_ = bounds_.min - Vec3::Constant(kPad * h);
-  slack_ = 1e-9 * (1.0 + scale + kPad * h);
+  slack_ = margins::kSlack * (1.0 + scale + kPad * h);
 
   const std::size_t total = static_cast<std::size_t>(n_[0]) * n_[1] * n_[2];
   std::vector<std::int32_t> a(total, kCap), b(total);
@@ -97,13 +99,13 @@ ClearanceGrid::ClearanceGrid(const std::vector<Aabb>& boxes, int max_cells) {
   for (int z = 0; z < n_[2]; ++z) pass(&a[z * sz], &b[z * sz], n_[1], sy, n_[0]);
   for (int y = 0; y < n_[1]; ++y) pass(&b[y * sy], &a[y * sy], n_[2], sz, n_[0]);
 
-  // h·√D less the half diagonal, each widened by a relative 1e-12 (far beyond the few roundings here),
+  // h·√D less the half diagonal, each widened by margins::kRounding (far beyond the few roundings here),
   // then rounded down to a float.
-  const double half_diagonal = h * (std::sqrt(3.0) / 2.0) * (1.0 + 1e-12);
+  const double half_diagonal = h * (std::sqrt(3.0) / 2.0) * (1.0 + margins::kRounding);
   float of[kCap + 1];  // the stored bound for each D
   constexpr double kFloatMax = std::numeric_limits<float>::max();
   for (int d = 0; d <= kCap; ++d) {
-    const double v = h * std::sqrt(static_cast<double>(d)) * (1.0 - 1e-12) - half_diagonal;
+    const double v = h * std::sqrt(static_cast<double>(d)) * (1.0 - margins::kRounding) - half_diagonal;
     // (Beyond the floats' range, the nearest float below: the largest one, or −∞.)
     float f = v >= kFloatMax ? std::numeric_limits<float>::max()
               : v <= -kFloatMax ? -std::numeric_limits<float>::infinity()

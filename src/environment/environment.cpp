@@ -14,6 +14,7 @@
 #include <clearway/environment/environment.h>
 #include <clearway/load/input_limits.h>
 
+#include <clearway/detail/margins.h>
 #include <clearway/narrowphase/epa.h>
 #include <clearway/narrowphase/ray_cast.h>
 #include <clearway/shape/support.h>
@@ -38,7 +39,7 @@ namespace {
 Aabb shapeWorldBox(const Shape& shape, const Pose& pose) noexcept {
   const Aabb box = placedBox(shape, pose);
   const double scale = box.min.cwiseAbs().cwiseMax(box.max.cwiseAbs()).maxCoeff();
-  return box.inflated(16.0 * std::numeric_limits<double>::epsilon() * scale);
+  return box.inflated(margins::boxRounding(scale));
 }
 
 Aabb obstacleBox(const Obstacle& o, const Pose& pose) noexcept {
@@ -64,8 +65,7 @@ double maxAbs(const Aabb& b) noexcept {
 // The radius of the link's bounding ball placed by `pose` (centre pose · sphereCenter()), grown by the
 // rounding of that product (R·c + t rounds by a few ulps of |c| + |t|).
 double ballReach(const LinkGeometry& link, const Pose& pose) noexcept {
-  return link.sphereRadius() * (1.0 + 1e-12) +
-         8.0 * std::numeric_limits<double>::epsilon() * (link.sphereCenter().norm() + pose.t.norm());
+  return link.sphereRadius() * (1.0 + margins::kRounding) + margins::placedRounding(link.sphereCenter().norm(), pose.t.norm());
 }
 
 bool obstacleIntersects(const Obstacle& o, const Pose& pose_o, const LinkGeometry& link, const Pose& pose,
@@ -542,7 +542,7 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
   // GJK; then the link's primitives against the voxels near them.
   found = -1;
   // A core of the link meeting an occupied voxel settles it without the triangle search.
-  const double core_margin = 1e-9 * (1.0 + scale_ + extent);
+  const double core_margin = margins::kSlack * (1.0 + scale_ + extent);
   for (const LinkGeometry::Ball& core : link.cores()) {
     const Vec3 c = pose * core.center;
     const double r = core.radius - core_margin;
@@ -661,7 +661,7 @@ double Environment::hullLowerBound(const LinkGeometry& link, const Pose& pose, c
       const Vec3 c = pose_o.R.transpose() * (centre - pose_o.t);
       const Vec3 gap = (c.cwiseAbs() - shape.half).cwiseMax(0.0);
       const double margin =
-          1e-9 * (1.0 + c.cwiseAbs().maxCoeff() + pose_o.t.cwiseAbs().maxCoeff() + centre.cwiseAbs().maxCoeff());
+          margins::kSlack * (1.0 + c.cwiseAbs().maxCoeff() + pose_o.t.cwiseAbs().maxCoeff() + centre.cwiseAbs().maxCoeff());
       // (Only below 1e150: a norm that overflowed would skip a box nearer than an infinite bound.)
       if (lower < 1e150 && gap.norm() - reach - margin >= lower) return false;
     }
@@ -705,7 +705,7 @@ double Environment::lowerBound(const LinkGeometry& link, const Pose& pose, const
   if (q.within >= 0.0 && linkIntersects(link, pose, tol, GeometryMode::Mesh, q.within, t, hit, counters)) return 0.0;
   const DistanceResult m = linkDistance(link, pose, tol, std::min(q.enough, q.near), t, q.relative, counters);
   if (isFailure(m.status)) return 0.0;
-  return q.within >= 0.0 ? std::max(m.lower_bound, q.within * (1.0 + 1e-9)) : m.lower_bound;
+  return q.within >= 0.0 ? std::max(m.lower_bound, q.within * margins::kBeyond) : m.lower_bound;
 }
 
 double Environment::linkCast(const LinkGeometry& link, const Pose& pose, const Vec3& velocity, double margin,

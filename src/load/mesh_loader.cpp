@@ -85,7 +85,8 @@ UpAxis colladaUpAxis(const Mat3& rotation) {
   Mat3 z_to_y, x_to_y;  // assimp's: (x, y, z) ↦ (x, z, −y) for Z_UP, (−y, x, z) for X_UP
   z_to_y << 1, 0, 0, 0, 0, 1, 0, -1, 0;
   x_to_y << 0, -1, 0, 1, 0, 0, 0, 0, 1;
-  auto near = [&](const Mat3& m) { return (rotation - m).cwiseAbs().maxCoeff() < 1e-9; };
+  constexpr double kSameEntry = 1e-9;  // assimp's matrices are exact: this only absorbs float storage
+  auto near = [&](const Mat3& m) { return (rotation - m).cwiseAbs().maxCoeff() < kSameEntry; };
   if (near(z_to_y)) return UpAxis::Z;
   if (near(Mat3::Identity())) return UpAxis::Y;
   if (near(x_to_y)) return UpAxis::X;

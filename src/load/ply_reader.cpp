@@ -21,6 +21,10 @@
 namespace clearway::detail {
 namespace {
 
+// A turn smaller than this fraction of its two edges' product counts as straight (rounding of float
+// corners), when telling convex polygons and crossing edges.
+constexpr double kStraight = 1e-12;
+
 enum class Type { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64, None };
 
 Type typeNamed(const std::string& t) {
@@ -462,14 +466,14 @@ class Reader {
     const double turn = normal[axis] > 0 ? 1.0 : -1.0;
     std::vector<std::array<double, 2>> points(ring.size());
     for (std::size_t k = 0; k < ring.size(); ++k) points[k] = {at(ring[k])[u], turn * at(ring[k])[v]};
-    // Convex up to rounding: a turn below 1e-12 of its edges' product is straight (corners along a
+    // Convex up to rounding: a turn below kStraight of its edges' product is straight (corners along a
     // slanted edge, written in floats).
     bool convex = true;
     for (std::size_t k = 0; k < ring.size() && convex; ++k) {
       const std::size_t a = k, b = (k + 1) % ring.size(), c = (k + 2) % ring.size();
       const double cross = (points[b][0] - points[a][0]) * (points[c][1] - points[a][1]) -
                            (points[b][1] - points[a][1]) * (points[c][0] - points[a][0]);
-      convex = cross >= -1e-12 * (at(ring[b]) - at(ring[a])).norm() * (at(ring[c]) - at(ring[b])).norm();
+      convex = cross >= -kStraight * (at(ring[b]) - at(ring[a])).norm() * (at(ring[c]) - at(ring[b])).norm();
     }
     if (convex) return fan(ring);
     const double budget = kClipWork * static_cast<double>(bytes_.size()) + 1e6;
@@ -603,7 +607,7 @@ EarClip clipEars(const std::vector<std::array<double, 2>>& points, bool exact, d
           const Point x = {k & 1 ? node.hi[0] : node.lo[0], k & 2 ? node.hi[1] : node.lo[1]};
           const double reach =
               std::abs(x[0] - p[0]) + std::abs(x[1] - p[1]) + (node.hi[0] - node.lo[0]) + (node.hi[1] - node.lo[1]);
-          beyond = turn(p, q, x) < -1e-12 * edge * reach;
+          beyond = turn(p, q, x) < -kStraight * edge * reach;
         }
         if (beyond) return true;
       }

@@ -2,6 +2,7 @@
 // mode's shape casts ahead of it.
 #include <clearway/motion/motion.h>
 
+#include <clearway/detail/margins.h>
 #include <clearway/kinematics/forward_kinematics.h>
 #include <clearway/narrowphase/gjk.h>
 #include <clearway/narrowphase/ray_cast.h>
@@ -63,7 +64,6 @@ void MotionChecker::castAhead(const double* q0, const double* q1, double t0, int
 // advancement alone would use, and the first contact is exact all the same.
 struct MotionChecker::Sweep {
   // A clearance proven beyond the contact distance (the search said "not within it"), in contact distances.
-  static constexpr double kBeyond = 1.0 + 1e-9;
   // Once the convex bounds are within contact, how far (in contact distances) the exact geometry is
   // measured: near fine meshes, a search farther out visits a great many triangles.
   static constexpr double kNear = 8.0;
@@ -267,7 +267,7 @@ struct MotionChecker::Sweep {
         // relative error the distance's lower bound was allowed.
         if (!found)
           sc.environment().linkIntersects(*it.ga, pa, tol, sc.options().mode,
-                                          it.padding + (contact + 1e-9) * (1.0 + relative), t, &hit);
+                                          it.padding + (contact + margins::kSlack) * (1.0 + relative), t, &hit);
         report.hit = hit;
       }
     }
@@ -294,7 +294,7 @@ struct MotionChecker::Sweep {
     const double p = u.dot(pa.t) + u_a.dot(it.ga->hull().support(u_a, hint_a));
     const double q = u.dot(pb.t) + u_b.dot(it.gb->hull().support(-u_b, hint_b));
     // Rounding: each term is a dot product of coordinates of a few metres at most.
-    const double slack = it.padding + 1e-12 * (1.0 + std::abs(p) + std::abs(q));
+    const double slack = it.padding + margins::kRounding * (1.0 + std::abs(p) + std::abs(q));
     for (std::size_t i = 0; i < parts_a.size(); ++i)  // (d first in max(): a NaN plane leaves d)
       clear_a[i] = std::max(d, q - std::min(p, u.dot(pa * parts_a[i].center) + parts_a[i].radius) - slack);
     for (std::size_t j = 0; j < parts_b.size(); ++j)

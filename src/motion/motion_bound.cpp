@@ -1,6 +1,8 @@
 // MotionBound: the per-link and per-pair coefficients of the motion bound, static and from the axes now.
 #include <clearway/motion/motion.h>
 
+#include <clearway/detail/margins.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -172,7 +174,7 @@ MotionBound::Tables::Tables(const Scene& scene, const std::vector<Body>& bodies)
         const Vec3 w = v - o;
         r = std::max(r, (w - w.dot(u) * u).norm());
       }
-    return r * (1.0 + 1e-12) + 1e-12 * (hull ? radius_[link] + o.norm() : 0.0);  // rounding
+    return margins::roundedUp(r, hull ? radius_[link] + o.norm() : 0.0);
   };
   {
     SceneContext ctx = scene.makeContext();
@@ -189,7 +191,7 @@ MotionBound::Tables::Tables(const Scene& scene, const std::vector<Body>& bodies)
       if (!still(j) || joint.parent_link < 0 || joint.child_link < 0) continue;
       // Held where the reference state has it (a held planar or floating joint has no limits to bound it).
       const double offset = relativePose(ctx.poses[joint.parent_link], ctx.poses[joint.child_link]).t.norm();
-      for (const int e : elements_of[j]) step_[e] = e == elements_of[j].front() ? offset * (1.0 + 1e-12) : 0.0;
+      for (const int e : elements_of[j]) step_[e] = e == elements_of[j].front() ? offset * (1.0 + margins::kRounding) : 0.0;
     }
     for (int e = 0; e < elements; ++e) {
       const Joint& joint = model.joint(joint_of_[e]);
@@ -349,7 +351,7 @@ void MotionBound::Tables::addBounds(int link, std::size_t from, const double* dq
   t.accel += accel;
   // Rounding: the field's terms can cancel, so their sum's error is absolute, a few ulps of Σ |w_k|·(R_k + ρ)
   // at most; 1e-12 of it is far above.
-  t.speed += velocity.norm() + omega.norm() * rho + 1e-12 * size;
+  t.speed += velocity.norm() + omega.norm() * rho + margins::kRounding * size;
 }
 
 double MotionBound::Tables::linkStep(int link, const double* dq, const Pose* poses, double d, double extra) const noexcept {
@@ -363,7 +365,7 @@ double MotionBound::Tables::linkStep(int link, const double* dq, const Pose* pos
 double MotionBound::Tables::TwistBound::solve(double d) const noexcept {
   if (!(d > 0.0)) return 0.0;
   // Rounding of the sums of products of metres and radians, and of the root below: relative, and far above it.
-  constexpr double kMargin = 1.0 + 1e-9;
+  constexpr double kMargin = margins::kBeyond;
   const double v0 = speed * kMargin, a = accel * kMargin;
   const double root = v0 + std::sqrt(v0 * v0 + 2.0 * a * d);
   if (!(root > 0.0)) return root == 0.0 ? INFINITY : 0.0;  // nothing moves; NaN proves nothing

@@ -303,7 +303,8 @@ void MotionChecker::interpolate(const double* q0, const double* q1, double s, do
     alignedUnit(q0 + k, q1 + k, a, b);
     const double angle = std::acos(std::clamp(a.dot(b), -1.0, 1.0));
     // Slerp; nearly equal ends interpolate linearly (then renormalized), where sin(angle) loses digits.
-    Eigen::Vector4d q = angle > 1e-9 ? Eigen::Vector4d((std::sin((1 - s) * angle) * a + std::sin(s * angle) * b) / std::sin(angle))
+    constexpr double kLinearBelow = 1e-9;  // rad
+    Eigen::Vector4d q = angle > kLinearBelow ? Eigen::Vector4d((std::sin((1 - s) * angle) * a + std::sin(s * angle) * b) / std::sin(angle))
                                      : Eigen::Vector4d(a + s * (b - a));
     q.normalize();
     for (int c = 0; c < 4; ++c) out[k + c] = q[c];

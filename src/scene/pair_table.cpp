@@ -1,6 +1,7 @@
 #include <clearway/scene/pair_table.h>
 
 #include <clearway/body/proximity.h>
+#include <clearway/detail/margins.h>
 
 #include <algorithm>
 #include <cmath>
@@ -24,7 +25,7 @@ constexpr double kPi = 3.14159265358979323846;
 // Added to every cell's half-width (radians or metres): far above the rounding of a value's cell
 // coordinate and of reducing a turn to [−π, π] with the double 2π (below 1e-13 for values up to
 // kMaxTurn, beyond which a turn is not looked up).
-constexpr double kValueSlack = 1e-9;
+constexpr double kValueSlack = margins::kSlack;
 constexpr double kMaxTurn = 1e3;
 
 // A joint of the chain that the table's variables move.
@@ -78,7 +79,7 @@ struct Builder {
     for (std::size_t i = k + 1; i < moved.size(); ++i) below = below * jointMotion(*moved[i].joint, x[i]) * fixed[i + 1];
     double r = 0.0;
     for (const Vec3& v : down.hull().vertices()) r = std::max(r, axisDistance(below * v, moved[k].joint->axis));
-    return r * (1.0 + 1e-9) + 1e-12;
+    return r * margins::kBeyond + margins::kRounding;
   }
 
   // The verdict for the cell centred at x with half-widths h; for an Unsure one, when `witness` is given,
@@ -94,13 +95,13 @@ struct Builder {
     double delta = 0.0;
     for (std::size_t k = 0; k < moved.size(); ++k) {
       const double r = k + 1 == moved.size() ? reach_last : reach(k, x);
-      delta += (h[k] * (1.0 + 1e-9) + kValueSlack) * r;
+      delta += (h[k] * margins::kBeyond + kValueSlack) * r;
     }
     const Pose t = relative(x);
     if (!t.isFinite() || !std::isfinite(delta)) return PairTable::Verdict::Unsure;
     // The rounding of this pose against the one forward kinematics computes, and of the bounds below.
     const double scale = up.boundingRadius() + down.boundingRadius() + t.t.norm();
-    const double margin = 1e-9 + 1e-7 * scale;
+    const double margin = margins::kSlack + 1e-7 * scale;
     for (const LinkGeometry::Ball& a : up.cores())
       for (const LinkGeometry::Ball& b : down.cores())
         if ((a.center - t * b.center).norm() + delta + margin < a.radius + b.radius) return PairTable::Verdict::Colliding;
@@ -219,11 +220,11 @@ std::unique_ptr<const PairTable> PairTable::build(const RobotModel& model, int a
       cur = cur * jointMotion(j, j.isMimic() ? j.mimic.multiplier * value + j.mimic.offset : value);
       continue;
     }
-    if (j.isMimic() || leader < 0 || bld.moved.size() == 2 || std::abs(j.axis.norm() - 1.0) > 1e-9) return nullptr;
+    if (j.isMimic() || leader < 0 || bld.moved.size() == 2 || std::abs(j.axis.norm() - 1.0) > margins::kSlack) return nullptr;
     const JointVariable& v = model.variables()[leader];
     Moved m{&j, leader, false, v.lower, v.upper};
     if (turns && !(v.upper - v.lower < 2.0 * kPi)) m = {&j, leader, true, -kPi, kPi};
-    if (!(m.hi - m.lo > 1e-9) || !std::isfinite(m.hi - m.lo)) return nullptr;
+    if (!(m.hi - m.lo > margins::kSlack) || !std::isfinite(m.hi - m.lo)) return nullptr;
     bld.fixed.push_back(cur);
     bld.moved.push_back(m);
     cur = Pose::identity();

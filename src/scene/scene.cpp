@@ -213,7 +213,8 @@ void Scene::init() {
     if (taken[leader.first_variable])
       fail(key, "joint '" + joint.name + "' mimics '" + leader.name + "', which is in the group");
     const double follows = joint.mimic.multiplier * base_q_[leader.first_variable] + joint.mimic.offset;
-    if (std::abs(follows - value) > 1e-9 * std::max(1.0, std::abs(value)))
+    constexpr double kSameValue = 1e-9;  // relative, or absolute below 1
+    if (std::abs(follows - value) > kSameValue * std::max(1.0, std::abs(value)))
       fail(key, "joint '" + joint.name + "' mimics '" + leader.name + "' and so is " + std::to_string(follows) +
                     ", not " + std::to_string(value));
   }

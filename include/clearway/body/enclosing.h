@@ -5,6 +5,7 @@
 // other. Placing once per link instead of once per pair is what makes it cheap for robots with many
 // checked pairs; only pairs it cannot clear go on to the hulls and the triangles (proximity.h).
 #include <clearway/body/robot_geometry.h>
+#include <clearway/detail/margins.h>
 #include <clearway/tolerances.h>
 
 #include <cstdint>
@@ -54,10 +55,9 @@ class EnclosingBalls {
     Link& l = links_[i];
     if (k > 0 && l.parts_at != placement_) placeParts(i);
     const int at = l.first + k;
-    // R·c + t rounds by a few ulps of |c| + |t| per coordinate, and |t| ≤ |R·c + t| + |c|: 16 ulps of
-    // 2|c| + |R·c + t| is more than that.
-    const double rounding = 16.0 * std::numeric_limits<double>::epsilon() * (2.0 * local_norms_[at] + norms_[at]);
-    return {centers_[at], radii_[at] * (1.0 + 1e-12) + rounding};
+    // (|t| ≤ |R·c + t| + |c| bounds the translation's norm.)
+    const double rounding = margins::placedRounding(local_norms_[at], local_norms_[at] + norms_[at]);
+    return {centers_[at], radii_[at] * (1.0 + margins::kRounding) + rounding};
   }
 
  private:

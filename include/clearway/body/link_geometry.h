@@ -17,6 +17,7 @@
 // throughout: touching counts as intersecting.
 //
 // Every query answers in the frames of the poses given; a LinkGeometry itself is in the link frame.
+#include <clearway/detail/margins.h>
 #include <clearway/kinematics/robot_model.h>
 #include <clearway/shape/triangle_mesh.h>
 #include <clearway/narrowphase/gjk.h>
@@ -190,7 +191,7 @@ Aabb placedBox(const Shape& shape, const Pose& pose) noexcept;
 /// bodies this near touching (tol.gjk_absolute of their size, never below 64 ulps), so a cull by boxes or
 /// axes must keep at least this much.
 inline double narrowBand(double scale, const Tolerances& tol) noexcept {
-  return std::max(tol.gjk_absolute, 64.0 * std::numeric_limits<double>::epsilon()) * scale;
+  return margins::narrowBand(tol.gjk_absolute) * scale;
 }
 
 /// True when a piece of one link lies inside a closed mesh of the other (b placed in a's frame by b_in_a).

@@ -12,6 +12,7 @@
 // d² + the last pass's value over a window of kWindow cells), each pass capped at (kWindow + 1)²: no more
 // than its exact value, so neither is D. Then |c − x| ≥ h·√D − h√3/2, stored rounded down; and for a
 // query point p, |p − x| ≥ stored(c) − |p − c| for whichever cell c it reads.
+#include <clearway/detail/margins.h>
 #include <clearway/math.h>
 #include <clearway/tree/aabb.h>
 
@@ -36,7 +37,7 @@ class ClearanceGrid {
   /// nothing (and a p with a NaN or an infinity gives 0).
   /// (Inlined into the per-link loops that call it: a call costs as much as the look-up.)
   [[gnu::always_inline]] double lowerBound(const Vec3& p) const noexcept {
-    const double slack = slack_ + 1e-9 * p.cwiseAbs().maxCoeff();
+    const double slack = slack_ + margins::kSlack * p.cwiseAbs().maxCoeff();
     int i[3];
     for (int k = 0; k < 3; ++k) {
       const double f = (p[k] - origin_[k]) * inv_h_;

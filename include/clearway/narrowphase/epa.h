@@ -4,6 +4,7 @@
 // Objects" (GDC 2001), and the hybrid approach of the seeds (002): while only the skins overlap,
 // GJK's closest points of the cores already give depth and normal; EPA is for deep overlaps.
 // The polytope lives in fixed arrays (no allocation); every loop is bounded by the capacity.
+#include <clearway/detail/margins.h>
 #include <clearway/narrowphase/gjk.h>
 
 namespace clearway {
@@ -86,7 +87,7 @@ detail::EpaCoreResult epaCore(const MD& md, detail::Simplex s, const Tolerances&
   using namespace detail;
   double scale = simplexScale(s);
   for (int i = 0; i < s.n; ++i) scale = std::max(scale, s.p[i].w.squaredNorm());
-  const double eps = 1e-12 * std::sqrt(std::max(scale, md.center().squaredNorm()) + 1e-300);
+  const double eps = margins::kRounding * std::sqrt(std::max(scale, md.center().squaredNorm()) + 1e-300);
   // Prefer directions pointing from A's centre to B's, so flat cases get a sensible normal.
   const Vec3 toward_b = -md.center();
   auto oriented = [&](Vec3 n) { return n.dot(toward_b) < 0.0 ? Vec3(-n) : n; };

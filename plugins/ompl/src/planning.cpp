@@ -228,8 +228,8 @@ PlanResult plan(const std::shared_ptr<const Scene>& scene_ptr, const PlanRequest
     const CheckerCounters& mc = checking.motion->counters();
     result.state_checks = vc.states.load();
     result.motion_checks = mc.motions.load();
-    result.state_check_seconds = 1e-9 * static_cast<double>(vc.nanoseconds.load());
-    result.motion_check_seconds = 1e-9 * static_cast<double>(mc.nanoseconds.load());
+    result.state_check_seconds = static_cast<double>(vc.nanoseconds.load()) / 1e9;
+    result.motion_check_seconds = static_cast<double>(mc.nanoseconds.load()) / 1e9;
   };
   if (status != ob::PlannerStatus::EXACT_SOLUTION) {
     counters();
