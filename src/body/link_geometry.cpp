@@ -9,6 +9,7 @@
 // GJK decides within its own band, which is at most this one.
 #include <clearway/body/link_geometry.h>
 #include <clearway/detail/margins.h>
+#include <clearway/tree/oriented_box_test.h>
 
 #include <algorithm>
 #include <array>

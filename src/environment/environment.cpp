@@ -18,6 +18,7 @@
 #include <clearway/narrowphase/epa.h>
 #include <clearway/narrowphase/ray_cast.h>
 #include <clearway/shape/support.h>
+#include <clearway/tree/oriented_box_test.h>
 
 #include <algorithm>
 #include <array>

@@ -1,8 +1,10 @@
 // The scene file (docs/scene-format.md): YAML in, a SceneDescription out, every error naming the
 // file and the key. Strict: an unknown key is an error, because a misspelt `padding` silently ignored
 // is a collision silently missed.
+#include <clearway/scene/scene_file.h>
+
 #include <clearway/load/input_limits.h>
-#include <clearway/scene/scene.h>
+#include <clearway/load/load_error.h>
 
 #include "load/mesh_uri.h"
 
