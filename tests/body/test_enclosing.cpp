@@ -11,7 +11,7 @@
 #include <hwy/targets.h>
 
 #include "forced_target.h"
-#include "mesh_reference.h"
+#include "tree/mesh_reference.h"
 
 #include <cmath>
 #include <cstdint>
