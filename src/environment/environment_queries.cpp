@@ -1,0 +1,528 @@
+// Environment's link queries: a link against the obstacles and voxels near it (the store is environment.cpp).
+//
+// A link is first reduced to its world box (the box of its hull's box placed by the pose), which picks
+// the candidates from each tree. Candidates then meet tests from cheapest to dearest: for voxels the
+// link's box as an oriented box (6 face axes), then GJK against the link's hull (one warm-started
+// cache for all voxels of a query: every voxel is axis-aligned, so the last separating axis is a good
+// start for the next), and only in Mesh mode, when the hull touches voxels, the triangles. When more
+// than a few voxels pass the hull, the voxel tree and the link's triangle tree are descended together
+// (world frame against link frame), which tests each voxel only against the triangles near it.
+//
+// Slack: boxes are grown by padding + band, band = 4·max(gjk_absolute, 64 ulps)·scale with scale
+// bounding every coordinate of the query, so box culling never drops a pair that GJK (whose own band
+// is gjk_absolute times the pair's size) would call touching.
+#include <clearway/environment/environment.h>
+
+#include <clearway/detail/margins.h>
+#include <clearway/narrowphase/epa.h>
+#include <clearway/narrowphase/ray_cast.h>
+#include <clearway/shape/support.h>
+#include <clearway/tree/oriented_box_test.h>
+
+#include "environment_boxes.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <type_traits>
+#include <utility>
+
+namespace clearway {
+namespace {
+
+using environment_detail::maxAbs;
+using environment_detail::obstacleBox;
+using environment_detail::shapeWorldBox;
+
+// f applied to the obstacle as a convex shape: a mesh obstacle's hull, or its primitive.
+template <class F>
+decltype(auto) onConvex(const Obstacle& o, F&& f) {
+  return o.mesh ? f(o.mesh->hull()) : std::visit(f, o.shape);
+}
+
+Pose poseAt(const Obstacle& o, double t) noexcept {
+  Pose p = o.pose;
+  if (o.moving()) p.t += t * o.velocity;
+  return p;
+}
+
+// The radius of the link's bounding ball placed by `pose` (centre pose · sphereCenter()), grown by the
+// rounding of that product (R·c + t rounds by a few ulps of |c| + |t|).
+double ballReach(const LinkGeometry& link, const Pose& pose) noexcept {
+  return link.sphereRadius() * (1.0 + margins::kRounding) + margins::placedRounding(link.sphereCenter().norm(), pose.t.norm());
+}
+
+bool obstacleIntersects(const Obstacle& o, const Pose& pose_o, const LinkGeometry& link, const Pose& pose,
+                        const Tolerances& tol, GeometryMode mode, double padding) noexcept {
+  return o.mesh ? meshesIntersect(*o.mesh, pose_o, link, pose, tol, mode, padding)
+                : shapeIntersectsLink(o.shape, pose_o, link, pose, tol, mode, padding);
+}
+
+// Voxels passing the hull test that the Mesh mode checks one by one (each against the triangles near
+// it); beyond this many, descending the two trees together is cheaper than a triangle-tree query each.
+constexpr int kFewVoxels = 4;
+
+// The running minimum of Environment::linkDistance, with the link as A.
+struct NearestSearch {
+  DistanceResult best;
+  double lower = std::numeric_limits<double>::infinity();  // min of the evaluated items' lower bounds
+  double limit;   // items certainly farther than this are skipped: min(cutoff, best / (1 + e))
+  double shrink;
+  bool failed = false;
+
+  NearestSearch(double cutoff, double relative_error) : limit(cutoff), shrink(1.0 / (1.0 + relative_error)) {
+    best.distance = cutoff;
+    best.lower_bound = cutoff;
+    best.status = Status::Separated;
+  }
+  // Returns true when the search can stop (contact, or a failure).
+  bool add(const DistanceResult& r) {
+    best.iterations += r.iterations;
+    if (isFailure(r.status)) {
+      failed = true;
+      return true;
+    }
+    lower = std::min(lower, r.lower_bound);
+    if (r.distance < best.distance) {
+      const int iterations = best.iterations;
+      best = r;
+      best.iterations = iterations;
+      limit = std::min(limit, r.distance * shrink);
+    }
+    return best.distance <= 0.0;
+  }
+};
+
+// A distance with A and B exchanged.
+DistanceResult swapped(DistanceResult r) noexcept {
+  std::swap(r.point_a, r.point_b);
+  r.normal = -r.normal;
+  return r;
+}
+
+}  // namespace
+
+// Which items a query visits: those whose boxes overlap a world box, or those within `limit` of the link's
+// box as an oriented box (the limit is read again before each item: a nearest search lowers it).
+struct Environment::Reach {
+  const Aabb* box = nullptr;    // overlap
+  const Aabb* local = nullptr;  // within: the link's box in its frame, placed by *pose
+  const Pose* pose = nullptr;
+  double* limit = nullptr;
+
+  static Reach overlapping(const Aabb& world_box) noexcept {
+    Reach r;
+    r.box = &world_box;
+    return r;
+  }
+  static Reach within(const Aabb& local_box, const Pose& pose, double& limit) noexcept {
+    Reach r;
+    r.local = &local_box;
+    r.pose = &pose;
+    r.limit = &limit;
+    return r;
+  }
+};
+
+// One item near the link: an obstacle where it is at the query's time, a voxel made by withPoints (as a box
+// obstacle), or a voxel of the map.
+struct Environment::Item {
+  EnvironmentHit::Kind kind;
+  int index;                   // a map voxel's index, else −1
+  const Obstacle* obstacle;    // null for a map voxel
+  const Aabb* voxel;           // a map voxel, else null
+  Pose pose;                   // the obstacle's at the query's time, or the voxel's centre
+  int warm;                    // a static obstacle's warm-start slot, else −1
+
+  Aabb box() const noexcept { return obstacle ? obstacleBox(*obstacle, pose) : *voxel; }
+  // f applied to the item as a convex shape: a mesh obstacle's hull, a primitive, a voxel's box.
+  template <class F>
+  decltype(auto) convex(F&& f) const {
+    return obstacle ? onConvex(*obstacle, f) : f(Box(voxel->halfExtents()));
+  }
+  // What a hit on it reports.
+  EnvironmentHit hit() const noexcept {
+    EnvironmentHit h;
+    h.kind = kind;
+    h.index = index;
+    if (kind == EnvironmentHit::Kind::Obstacle) h.obstacle = obstacle;
+    else h.voxel = box();
+    return h;
+  }
+};
+
+template <class F>
+Environment::Walk Environment::forEachItem(const Reach& reach, double t, F&& visit) const {
+  const auto on_static = [&](const Static& s, const Aabb& box) {
+    if (s.voxel) return visit(Item{EnvironmentHit::Kind::Voxel, -1, nullptr, &box, Pose::translation(box.center()), -1});
+    const Obstacle& o = *s.obstacle;
+    return visit(Item{EnvironmentHit::Kind::Obstacle, -1, &o, nullptr, o.pose, s.slot});
+  };
+  if (reach.box ? static_.query(*reach.box, on_static) : static_.forEachWithin(*reach.local, *reach.pose, *reach.limit, on_static))
+    return Walk::Stopped;
+  // Moving obstacles are few by nature: each box is placed at t and tested on its own.
+  const Aabb link_box = reach.box ? Aabb() : transformed(*reach.local, *reach.pose);
+  for (const auto& o : moving_) {
+    const Item item{EnvironmentHit::Kind::Obstacle, -1, o.get(), nullptr, poseAt(*o, t), -1};
+    if (!item.pose.isFinite()) return Walk::Invalid;
+    const Aabb box = item.box();
+    if (reach.box ? !overlaps(box, *reach.box) : !(boxDistance(box, link_box) <= *reach.limit)) continue;
+    if (visit(item)) return Walk::Stopped;
+  }
+  if (!voxel_tree_) return Walk::Done;
+  const std::vector<Aabb>& voxels = map_->occupied;
+  const auto on_voxel = [&](std::int32_t v) {
+    return visit(Item{EnvironmentHit::Kind::Voxel, v, nullptr, &voxels[v], Pose::translation(voxels[v].center()), -1});
+  };
+  return (reach.box ? voxel_tree_->query(*reach.box, on_voxel)
+                    : voxel_tree_->forEachWithin(*reach.local, *reach.pose, *reach.limit, on_voxel))
+             ? Walk::Stopped
+             : Walk::Done;
+}
+
+bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, GeometryMode mode,
+                                 double padding, double t, EnvironmentHit* hit,
+                                 EnvironmentCounters* counters) const noexcept {
+  if (hit) *hit = EnvironmentHit{};
+  if (!pose.isFinite() || !(padding >= 0.0) || !std::isfinite(padding) || !std::isfinite(t)) return true;
+  const auto report = [&](const EnvironmentHit& h) {
+    if (hit) *hit = h;
+    return true;
+  };
+  const std::vector<Aabb>* map_voxels = map_ ? &map_->occupied : nullptr;
+  const auto voxelHit = [&](int v) {
+    EnvironmentHit h;
+    h.kind = EnvironmentHit::Kind::Voxel;
+    h.index = v;
+    h.voxel = (*map_voxels)[v];
+    return report(h);
+  };
+  // The box of the link's bounding ball: a dozen operations where placing its box costs ten times more,
+  // and as tight for most links (R·c + t rounds by a few ulps of |c| + |t|).
+  const Vec3 centre = pose * link.sphereCenter();
+  const double reach = ballReach(link, pose);
+  const Aabb link_box = Aabb::fromCenterHalf(centre, Vec3::Constant(reach));
+  // (max |centre_i| + reach is the box's largest coordinate: rounding to nearest is monotone and symmetric.)
+  const double extent = std::max({std::abs(centre.x()), std::abs(centre.y()), std::abs(centre.z())}) + reach;
+  const double slack = linkSlack(padding, extent, tol);
+  const Aabb query = link_box.inflated(slack);
+  // Most links of a state overlap no item's box at all: the trees alone say so, before the culls and hull
+  // tests below are set up (which cost more than the walk). Moving obstacles take the full path.
+  if (moving_.empty()) {
+    countQuery();  // (Scene::isFree reads the grid, once built, before it calls here)
+    const auto any = [](const auto&...) { return true; };
+    if (!static_.query(query, any) && !(voxel_tree_ && voxel_tree_->query(query, any))) return false;
+  }
+
+  // The link's box as an oriented box in the world (A = world, B = the link frame): the voxels' first cull,
+  // set up at the first voxel (most links near obstacles meet none).
+  std::optional<detail::OrientedBoxTest> obb;
+  detail::OrientedBoxTest::PlacedB placed_link;
+  SimplexCache cache;  // one for all voxels: they are axis-aligned, so the last separating axis starts the next well
+  int passed[kFewVoxels];
+  int n_passed = 0;
+  bool many = false;
+  int found = -1;
+  EnvironmentHit found_obstacle;  // an obstacle (or a point voxel) touched
+  const Walk walk = forEachItem(Reach::overlapping(query), t, [&](const Item& item) {
+    if (item.index < 0) {  // an obstacle, or a voxel made by withPoints: on its own
+      if (counters) ++counters->obstacle_tests;
+      if (item.obstacle ? !obstacleIntersects(*item.obstacle, item.pose, link, pose, tol, mode, padding)
+                        : !shapeIntersectsLink(Box(item.voxel->halfExtents()), item.pose, link, pose, tol, mode, padding))
+        return false;
+      found_obstacle = item.hit();
+      return true;
+    }
+    double c[3], h[3];
+    detail::OrientedBoxTest::centerHalf(*item.voxel, c, h);
+    if (!obb) {
+      obb.emplace(pose, slack, scale_ + extent);
+      placed_link = obb->place(link.bounds());
+    }
+    if (obb->separated<false>(c, h, placed_link)) return false;
+    if (counters) ++counters->voxel_tests;
+    if (!shapeIntersectsLink(Box(Vec3(h[0], h[1], h[2])), Pose::translation(Vec3(c[0], c[1], c[2])), link, pose, tol,
+                             GeometryMode::Hull, padding, &cache))
+      return false;
+    if (mode == GeometryMode::Hull || n_passed == kFewVoxels) {
+      found = item.index;
+      many = mode == GeometryMode::Mesh;
+      return true;
+    }
+    passed[n_passed++] = item.index;
+    return false;
+  });
+  if (walk == Walk::Invalid) {  // a moving obstacle out of reach of the doubles: touching, never free
+    for (const auto& o : moving_)
+      if (!poseAt(*o, t).isFinite()) {
+        EnvironmentHit h;
+        h.kind = EnvironmentHit::Kind::Obstacle;
+        h.obstacle = o.get();
+        return report(h);
+      }
+  }
+  if (found_obstacle.kind != EnvironmentHit::Kind::None) return report(found_obstacle);
+  if (!voxel_tree_) return false;
+  const AabbTree& voxel_tree = *voxel_tree_;
+  const std::vector<Aabb>& voxels = map_->occupied;
+  if (mode == GeometryMode::Hull) return found >= 0 ? voxelHit(found) : false;
+
+  if (!many) {
+    for (int k = 0; k < n_passed; ++k) {
+      const Aabb& b = voxels[passed[k]];
+      if (counters) ++counters->voxel_tests;
+      if (shapeIntersectsLink(Box(b.halfExtents()), Pose::translation(b.center()), link, pose, tol, GeometryMode::Mesh,
+                              padding, &cache))
+        return voxelHit(passed[k]);
+    }
+    return false;
+  }
+
+  // Many voxels inside the hull: voxel tree (world) against triangle tree (link frame), then box–triangle
+  // GJK; then the link's primitives against the voxels near them.
+  found = -1;
+  // A core of the link meeting an occupied voxel settles it without the triangle search.
+  const double core_margin = margins::kSlack * (1.0 + scale_ + extent);
+  for (const LinkGeometry::Ball& core : link.cores()) {
+    const Vec3 c = pose * core.center;
+    const double r = core.radius - core_margin;
+    if (!(r > 0.0)) continue;
+    voxel_tree.query(Aabb::fromCenterHalf(c, Vec3::Constant(r)), [&](std::int32_t v) {
+      const Aabb& b = voxels[v];
+      if (((c - b.center()).cwiseAbs() - b.halfExtents()).cwiseMax(0.0).norm() >= r) return false;
+      found = v;
+      return true;
+    });
+    if (found >= 0) return voxelHit(found);
+  }
+  const std::vector<Triangle>& tris = link.triangles();
+  forEachOverlap(
+      voxel_tree, link.tree(), pose,
+      [&](std::int32_t v, std::int32_t j) {
+        if (counters) ++counters->voxel_tests;
+        const Aabb& b = voxels[v];
+        const Box box(b.halfExtents());
+        SimplexCache pair_cache;
+        if (!gjkIntersect(Margin<Box>{box, padding}, Pose::translation(b.center()), tris[j], pose, tol, pair_cache)
+                 .intersecting)
+          return false;
+        found = v;
+        return true;
+      },
+      slack);
+  if (found >= 0) return voxelHit(found);
+  for (const LinkGeometry::Primitive& p : link.primitives()) {
+    const Pose pose_p = pose * p.pose;
+    voxel_tree.query(shapeWorldBox(p.shape, pose_p).inflated(slack), [&](std::int32_t v) {
+      if (counters) ++counters->voxel_tests;
+      const Aabb& b = voxels[v];
+      const Box box(b.halfExtents());
+      SimplexCache pair_cache;
+      const bool touching = std::visit(
+          [&](const auto& s) {
+            return gjkIntersect(Margin<Box>{box, padding}, Pose::translation(b.center()), s, pose_p, tol, pair_cache)
+                .intersecting;
+          },
+          p.shape);
+      if (touching) found = v;
+      return touching;
+    });
+    if (found >= 0) return voxelHit(found);
+  }
+  // No surface touches a voxel: one may still lie inside a closed mesh of the link.
+  if (link.solidCount() > 0) {
+    const Pose to_link = pose.inverse();
+    voxel_tree.query(query, [&](std::int32_t v) {
+      if (!link.containsPoint(to_link * voxels[v].center())) return false;
+      found = v;
+      return true;
+    });
+    if (found >= 0) return voxelHit(found);
+  }
+  return false;
+}
+
+DistanceResult Environment::linkDistance(const LinkGeometry& link, const Pose& pose, const Tolerances& tol,
+                                         double cutoff, double t, double relative_error,
+                                         EnvironmentCounters* counters, GeometryMode mode) const noexcept {
+  if (!pose.isFinite() || !std::isfinite(t) || !(cutoff >= 0.0) || !(relative_error >= 0.0) ||
+      !std::isfinite(relative_error)) {
+    DistanceResult r;
+    r.status = Status::InvalidInput;
+    return r;
+  }
+  NearestSearch search(cutoff, relative_error);
+
+  // One item: the hull's lower bound first (one GJK), the exact geometry only when it may be nearer. The
+  // link's box as an oriented box sees items much nearer than its world box admits.
+  const Walk walk = forEachItem(Reach::within(link.bounds(), pose, search.limit), t, [&](const Item& item) {
+    const DistanceResult hull = item.convex([&](const auto& s) { return gjkDistance(link.hull(), pose, s, item.pose, tol); });
+    if (!isFailure(hull.status) && hull.lower_bound >= search.limit) return false;
+    if (mode == GeometryMode::Hull) return search.add(hull);
+    if (counters) ++counters->distance_tests;
+    if (item.obstacle && item.obstacle->mesh)
+      return search.add(meshDistance(link, pose, *item.obstacle->mesh, item.pose, tol, relative_error));
+    // (The obstacle's own shape by reference: a copy of a hull would allocate per item.)
+    if (item.obstacle)
+      return search.add(swapped(shapeLinkDistance(item.obstacle->shape, item.pose, link, pose, tol, relative_error)));
+    return search.add(swapped(shapeLinkDistance(Box(item.voxel->halfExtents()), item.pose, link, pose, tol, relative_error)));
+  });
+  if (walk == Walk::Invalid) search.failed = true;
+
+  DistanceResult r = search.best;
+  if (search.failed) {
+    r.status = Status::NotConverged;
+    r.distance = 0.0;
+    r.lower_bound = 0.0;
+    return r;
+  }
+  // Every item not evaluated was at least the final limit away.
+  r.lower_bound = std::min({search.lower, search.limit, r.distance});
+  return r;
+}
+
+double Environment::hullLowerBound(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, double enough,
+                                   double relative, double t, EnvironmentCounters* counters,
+                                   SimplexCache* warm, bool by_parts) const noexcept {
+  if (!pose.isFinite() || !std::isfinite(t) || !(enough >= 0.0) || !(relative >= 0.0) || !std::isfinite(relative))
+    return 0.0;
+  // (No clearance grid here: it exists only once enough queries were asked, and a bound it settled could
+  // differ from the GJKs' within their relative error, so a segment's verdict would depend on history.)
+  const Vec3 centre = pose * link.sphereCenter();
+  const double reach = ballReach(link, pose);
+  double lower = enough;  // the least bound so far: items certainly beyond it cannot lower it
+  const auto measure = [&](const auto& shape, const Pose& pose_o, SimplexCache* cache) {
+    using S = std::decay_t<decltype(shape)>;
+    if constexpr (std::is_same_v<S, Box>) {
+      // The link's bounding ball (which holds its hull and its parts) against the box, in the box's frame:
+      // a box it shows beyond the bound so far cannot lower it, for a dozen operations where GJK costs
+      // hundreds.
+      // (The margin is far above the few roundings of the distance.)
+      const Vec3 c = pose_o.R.transpose() * (centre - pose_o.t);
+      const Vec3 gap = (c.cwiseAbs() - shape.half).cwiseMax(0.0);
+      const double margin =
+          margins::kSlack * (1.0 + c.cwiseAbs().maxCoeff() + pose_o.t.cwiseAbs().maxCoeff() + centre.cwiseAbs().maxCoeff());
+      // (Only below 1e150: a norm that overflowed would skip a box nearer than an infinite bound.)
+      if (lower < 1e150 && gap.norm() - reach - margin >= lower) return false;
+    }
+    SimplexCache cold;
+    if (by_parts) {  // (cold starts: callers ask only when the hull has come within contact)
+      for (const LinkGeometry::Part& part : link.parts()) {
+        cold = SimplexCache{};
+        lower = std::min(lower, gjkLowerBound(part.hull, pose, shape, pose_o, tol, cold, lower, relative));
+        if (!(lower > 0.0)) return true;
+      }
+      // The parts cover the link's surfaces, not a closed mesh's inside, where the item may lie.
+      // (The core's support point is a point of the item.)
+      if (link.solidCount() > 0 && link.containsPoint(relativePose(pose, pose_o) * shape.support(Vec3::UnitX()))) {
+        lower = 0.0;
+        return true;
+      }
+      return false;
+    }
+    lower = std::min(lower, gjkLowerBound(link.hull(), pose, shape, pose_o, tol, cache ? *cache : cold, lower, relative));
+    return !(lower > 0.0);
+  };
+  const Walk walk = forEachItem(Reach::within(link.bounds(), pose, lower), t, [&](const Item& item) {
+    if (!item.obstacle && counters) ++counters->voxel_tests;  // (as linkDistance counts: voxel hull tests)
+    SimplexCache* cache = warm && item.warm >= 0 ? warm + item.warm : nullptr;
+    return item.convex([&](const auto& s) { return measure(s, item.pose, cache); });
+  });
+  if (walk == Walk::Invalid) return 0.0;
+  return lower >= 0.0 ? lower : 0.0;  // (NaN: 0)
+}
+
+double Environment::lowerBound(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, const BoundQuery& q,
+                               double t, SimplexCache* warm, EnvironmentHit* hit,
+                               EnvironmentCounters* counters) const noexcept {
+  if (hit) *hit = EnvironmentHit{};
+  const double climb = q.climb >= 0.0 ? q.climb : q.enough;
+  double lower = hullLowerBound(link, pose, tol, q.enough, q.relative, t, counters, warm);
+  if (!(lower <= climb) || q.mode == GeometryMode::Hull) return lower;
+  // (The bound so far second in max(): a NaN leaves it.)
+  lower = std::max(hullLowerBound(link, pose, tol, q.enough, q.relative, t, counters, nullptr, true), lower);
+  if (!(lower <= climb)) return lower;
+  if (q.within >= 0.0 && linkIntersects(link, pose, tol, GeometryMode::Mesh, q.within, t, hit, counters)) return 0.0;
+  const DistanceResult m = linkDistance(link, pose, tol, std::min(q.enough, q.near), t, q.relative, counters);
+  if (isFailure(m.status)) return 0.0;
+  return q.within >= 0.0 ? std::max(m.lower_bound, q.within * margins::kBeyond) : m.lower_bound;
+}
+
+double Environment::linkCast(const LinkGeometry& link, const Pose& pose, const Vec3& velocity, double margin,
+                             const Tolerances& tol, double max_s, double t,
+                             EnvironmentCounters* counters) const noexcept {
+  constexpr double kNone = std::numeric_limits<double>::infinity();
+  if (!pose.isFinite() || !velocity.allFinite() || !(margin >= 0.0) || !std::isfinite(margin) || !std::isfinite(t) ||
+      !(max_s >= 0.0) || !std::isfinite(max_s))
+    return 0.0;
+  const Aabb start = transformed(link.bounds(), pose).inflated(margin);
+  Aabb swept = start;
+  swept.min += (max_s * velocity).cwiseMin(Vec3::Zero());
+  swept.max += (max_s * velocity).cwiseMax(Vec3::Zero());
+  const double band = cullBand(scale_ + maxAbs(swept), tol);
+  swept = swept.inflated(band);
+  const Margin<ConvexHull> grown{link.hull(), margin};
+  double first = kNone;
+  // One candidate: the slab test of the moving box against its box first (the s interval where they
+  // overlap), then the cast, only as far as the earliest hit so far.
+  const auto visit = [&](const Aabb& box, const auto& shape, const Pose& pose_o) {
+    const double limit = std::min(first, max_s);
+    double enter = 0.0, leave = limit;
+    for (int i = 0; i < 3 && enter <= leave; ++i) {
+      const double lo = box.min[i] - band - start.max[i], hi = box.max[i] + band - start.min[i];  // overlap: lo ≤ s·v ≤ hi
+      const double v = velocity[i];
+      if (v == 0.0) {
+        if (lo > 0.0 || hi < 0.0) return;
+      } else {
+        const double a = lo / v, b = hi / v;
+        enter = std::max(enter, std::min(a, b));
+        leave = std::min(leave, std::max(a, b));
+      }
+    }
+    if (!(enter <= leave)) return;
+    if (counters) ++counters->cast_tests;
+    const CastResult c = gjkShapeCast(grown, pose, velocity, shape, pose_o, limit, tol);
+    if (c.hit) first = std::min(first, std::max(0.0, c.t));
+  };
+  const Walk walk = forEachItem(Reach::overlapping(swept), t, [&](const Item& item) {
+    item.convex([&](const auto& shape) { visit(item.box(), shape, item.pose); });
+    return false;
+  });
+  if (walk == Walk::Invalid) return 0.0;
+  return first <= max_s ? first : kNone;
+}
+
+double Environment::linkPenetration(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, double padding,
+                                    double t, EnvironmentCounters* counters) const noexcept {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (!pose.isFinite() || !(padding >= 0.0) || !std::isfinite(padding) || !std::isfinite(t)) return nan;
+  const Aabb link_box = transformed(link.bounds(), pose).inflated(padding);
+  double deepest = 0.0;
+  bool failed = false;
+  // One touching item: the hull's depth into it (EPA runs only here).
+  const auto depth = [&](const auto& shape, const Pose& pose_s) {
+    if (counters) ++counters->penetration_tests;
+    const PenetrationResult r = epaPenetration(link.hull(), pose, shape, pose_s, tol);
+    if (isFailure(r.status)) failed = true;
+    deepest = std::max(deepest, padding - r.signed_distance);  // padded links may touch with the hull apart
+  };
+  const Walk walk = forEachItem(Reach::overlapping(link_box), t, [&](const Item& item) {
+    const Obstacle* o = item.obstacle;
+    if (o && o->mesh) {
+      if (meshesIntersect(link, pose, *o->mesh, item.pose, tol, GeometryMode::Mesh, padding)) depth(o->mesh->hull(), item.pose);
+      return false;
+    }
+    const auto visit = [&](const Shape& shape) {  // (by reference: a copied hull would allocate)
+      if (shapeIntersectsLink(shape, item.pose, link, pose, tol, GeometryMode::Mesh, padding))
+        std::visit([&](const auto& s) { depth(s, item.pose); }, shape);
+    };
+    if (o) visit(o->shape);
+    else visit(Box(item.voxel->halfExtents()));
+    return false;
+  });
+  if (walk == Walk::Invalid) return nan;
+  return failed ? nan : deepest;
+}
+
+}  // namespace clearway
