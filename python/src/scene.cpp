@@ -332,7 +332,8 @@ void bindScene(py::module_& m) {
            },
            py::arg("points"), py::arg("resolution") = 0.0,
            "This scene with the voxel holding each of the (N, 3) points occupied (edge `resolution` on OctoMap's grid; "
-           "0: the map's), as a new Scene. Free space is not cleared.")
+           "0: the map's), as a new Scene. Free space is not cleared. Raises ValueError for a point not finite or whose "
+           "voxel reaches beyond 1e6 m, or a resolution below 1e-9 m.")
       .def("with_attached",
            [](const PyScene& s, const std::string& name, const std::string& link, const PyShape& shape,
               const py::object& pose, const std::vector<std::string>& touch_links) {
@@ -348,7 +349,8 @@ void bindScene(py::module_& m) {
            py::arg("name"), py::arg("link"), py::arg("shape"), py::arg("pose") = py::none(),
            py::arg("touch_links") = std::vector<std::string>{},
            "This scene with a body (shape, placed by pose in the link's frame) attached to `link`, which it may touch, "
-           "as may its touch_links (MoveIt's); a new Scene. ValueError for an unknown link or a name in use.")
+           "as may its touch_links (MoveIt's); a new Scene. ValueError for an unknown link, a name in use, or a body "
+           "reaching beyond 1e6 m of its link.")
       .def("without_attached",
            [](const PyScene& s, const std::string& name) {
              py::gil_scoped_release release;

@@ -1,3 +1,5 @@
+// Building a scene: the robot and environment a description names, init (the group, holds, bounds, filter,
+// self checker, pair tables), and edits that make new scenes. Asking it is scene_queries.cpp.
 #include <clearway/scene/scene.h>
 
 #include <clearway/body/enclosing.h>
@@ -11,6 +13,8 @@
 #include <clearway/load/mesh_loader.h>
 #include <clearway/load/robot_loader.h>
 
+#include "exact_text.h"
+
 #include <algorithm>
 #include <atomic>
 #include <charconv>
@@ -19,14 +23,7 @@
 #include <stdexcept>
 
 namespace clearway {
-
 namespace {
-
-// The shortest text that reads back as x: a value 1e-10 past a limit must not print as the limit.
-std::string exactText(double x) {
-  char buffer[32];
-  return std::string(buffer, std::to_chars(buffer, buffer + sizeof buffer, x).ptr);
-}
 
 // The self checker before init() makes the scene's own: without tables, which would be built twice.
 SelfCollisionOptions placeholderOptions() {
@@ -36,6 +33,8 @@ SelfCollisionOptions placeholderOptions() {
 }
 
 }  // namespace
+
+using scene_detail::exactText;
 
 std::shared_ptr<const RobotGeometry> loadRobotGeometry(const SceneDescription& d, const LoadOptions& options) {
   LoadOptions load = options;
@@ -383,347 +382,6 @@ std::shared_ptr<const Scene> Scene::withEnvironment(std::shared_ptr<const Enviro
   scene->environment_ = environment ? std::move(environment) : std::make_shared<const Environment>();
   scene->initEnvironment();
   return scene;
-}
-
-SceneContext Scene::makeContext() const {
-  SceneContext c;
-  c.q = base_q_;
-  c.poses.resize(robot().linkCount());
-  c.self = self_.makeContext();
-  c.lanes.emplace(robot());
-  c.lane_q.reserve(base_q_.size() * KinematicLanes::kMaxLanes);
-  for (int l = 0; l < KinematicLanes::kMaxLanes; ++l) c.lane_q.insert(c.lane_q.end(), base_q_.begin(), base_q_.end());
-  c.lane_poses.resize(static_cast<std::size_t>(robot().linkCount()) * KinematicLanes::kMaxLanes);
-  return c;
-}
-
-void Scene::computePoses(const double* state, SceneContext& ctx) const noexcept {
-  for (std::size_t i = 0; i < group_variables_.size(); ++i) ctx.q[group_variables_[i]] = state[i];
-  computeLinkPoses(robot(), ctx.q.data(), ctx.poses.data());
-}
-
-bool Scene::validState(const double* state, std::string* why) const {
-  const RobotModel& model = robot();
-  for (std::size_t i = 0; i < group_variables_.size(); ++i) {
-    const JointVariable& var = model.variables()[group_variables_[i]];
-    const double x = state[i];
-    const double lo = lower_[i], hi = upper_[i];
-    if (!std::isfinite(x)) {
-      if (why) *why = "state[" + std::to_string(i) + "] (" + var.name + ") is not finite";
-      return false;
-    }
-    if (std::abs(x) > kMaxJointValue) {
-      if (why)
-        *why = "state[" + std::to_string(i) + "] (" + var.name + ") = " + exactText(x) +
-               " is beyond ±1e6, the largest joint value a state may hold";
-      return false;
-    }
-    if (x < lo - kJointLimitTolerance || x > hi + kJointLimitTolerance) {
-      if (why)
-        *why = "state[" + std::to_string(i) + "] (" + var.name + ") = " + exactText(x) + " is outside [" +
-               exactText(lo) + ", " + exactText(hi) + "] by more than " + exactText(kJointLimitTolerance);
-      return false;
-    }
-  }
-  for (const int i : quaternions_)
-    if (!rotates(state + i)) {
-      if (why)
-        *why = "state[" + std::to_string(i) + ".." + std::to_string(i + 3) + "] (" + model.variables()[group_variables_[i]].name +
-               " ...) is a zero quaternion (its squares add up to 0): it names no rotation";
-      return false;
-    }
-  return true;
-}
-
-bool Scene::withinBounds(const double* state) const noexcept {
-  for (std::size_t i = 0; i < group_variables_.size(); ++i) {
-    // Written so that a NaN fails.
-    if (!(state[i] >= valid_lower_[i] && state[i] <= valid_upper_[i])) return false;
-  }
-  for (const int i : quaternions_)
-    if (!rotates(state + i)) return false;
-  return true;
-}
-
-bool Scene::isFree(const double* state, SceneContext& ctx, CollisionReport* report, double t) const noexcept {
-  ++ctx.counters.states;
-  CollisionReport local;
-  CollisionReport& r = report ? *report : local;
-  r = CollisionReport{};
-  // (A context of another scene's robot, such as a World's before an attach, does not fit: refused.)
-  if (!withinBounds(state) || !withinTime(t) || ctx.poses.size() != static_cast<std::size_t>(robot().linkCount())) {
-    ++ctx.counters.invalid_states;
-    r.kind = CollisionReport::Kind::Invalid;
-    return false;
-  }
-  if (static_collision_.kind != CollisionReport::Kind::None) {
-    r = static_collision_;
-    return false;
-  }
-  const Effects& fx = description_.effects;
-  if (!fx.self && !fx.environment) return true;
-  computePoses(state, ctx);
-  return posedFree(ctx.poses.data(), ctx.q.data(), ctx, r, t);
-}
-
-bool Scene::posedFree(const Pose* poses, const double* q, SceneContext& ctx, CollisionReport& r,
-                      double t) const noexcept {
-  bool balls_placed = false;
-  return environmentFree(poses, ctx, r, t, balls_placed) && selfFree(poses, q, ctx, r, balls_placed);
-}
-
-bool Scene::environmentFree(const Pose* poses, SceneContext& ctx, CollisionReport& r, double t,
-                            bool& balls_placed) const noexcept {
-  const Effects& fx = description_.effects;
-  if (fx.environment && !environment_->empty()) {
-    const double time = fx.moving ? t : 0.0;
-    // Once the environment has its clearance grid, the enclosing balls (placed after the lead link for
-    // the self check too) clear most links with a look-up each: the bounding ball, else every part's ball
-    // (whose union holds the link, the inside of its closed meshes included, but not its hull).
-    const Environment& env = *environment_;
-    EnclosingBalls& balls = ctx.self.balls;
-    const ClearanceGrid* grid = nullptr;
-    const auto cleared = [&](int i) {
-      const int n = balls.ballCount(i);
-      if (n == 0) return false;
-      const EnclosingBalls::Placed bound = balls.placed(i, 0);
-      const double slack = env.linkSlack(link_padding_[i], bound.center.cwiseAbs().maxCoeff() + bound.radius,
-                                         options_.tolerances);
-      if (grid->lowerBound(bound.center) > bound.radius + slack) return true;
-      // (Not in Hull mode, where linkIntersects tests the hull, which the parts' balls need not hold. Nor for
-      // closed meshes, which they hold only grown: on the shared robots, whose links are all closed, the
-      // parts cleared too few links to pay for their look-ups, +3.8% instructions on box_panda's states.)
-      if (n == 1 || options_.mode != GeometryMode::Mesh || geometry_->link(i)->solidCount() > 0) return false;
-      for (int k = 1; k < n; ++k) {
-        const EnclosingBalls::Placed part = balls.placed(i, k);
-        if (!(grid->lowerBound(part.center) > part.radius + slack)) return false;
-      }
-      return true;
-    };
-    const auto hits = [&](int k) {
-      const int i = env_links_[k];
-      if (grid && cleared(i)) {
-        ++ctx.counters.environment.grid_clears;
-        return false;
-      }
-      EnvironmentHit hit;
-      if (!environment_->linkIntersects(*geometry_->link(i), poses[i], options_.tolerances, options_.mode,
-                                        link_padding_[i], time, &hit, &ctx.counters.environment))
-        return false;
-      r.kind = CollisionReport::Kind::Environment;
-      r.link = i;
-      r.hit = hit;
-      ctx.env_last_hit = k;
-      return true;
-    };
-    // The link that met an obstacle last goes first: a planner's next state is near its last, and the links
-    // before it in order would each be tested for nothing. Each link is still tested once at most.
-    const int n = static_cast<int>(env_links_.size());
-    const int lead = ctx.env_last_hit >= 0 && ctx.env_last_hit < n ? ctx.env_last_hit : -1;
-    if (lead >= 0 && hits(lead)) return false;  // (before the balls are placed: it probably still collides)
-    grid = env.hasMovingObstacles() ? nullptr : env.clearanceGrid();
-    if (grid && !(balls_placed = self_.placeBalls(poses, ctx.self))) grid = nullptr;
-    for (int k = 0; k < n; ++k)
-      if (k != lead && hits(k)) return false;
-  }
-  return true;
-}
-
-bool Scene::selfFree(const Pose* poses, const double* q, SceneContext& ctx, CollisionReport& r,
-                     bool balls_placed) const noexcept {
-  const Effects& fx = description_.effects;
-  if (fx.self) {
-    const long long before = ctx.self.pair_tests;
-    const LinkPair* hit = self_.firstCollision(poses, ctx.self, q, balls_placed);
-    ctx.counters.self_pair_tests += ctx.self.pair_tests - before;
-    if (hit) {
-      r.kind = CollisionReport::Kind::Self;
-      r.link = hit->a;
-      r.other_link = hit->b;
-      return false;
-    }
-  }
-  return true;
-}
-
-bool Scene::lanesFit(const SceneContext& ctx) const noexcept {
-  const RobotModel& model = robot();
-  return ctx.lanes && ctx.lanes->madeFor(model) && ctx.poses.size() == static_cast<std::size_t>(model.linkCount());
-}
-
-void Scene::toLane(const double* state, int lane, SceneContext& ctx, const double** lane_q, Pose** lane_poses) const noexcept {
-  const RobotModel& model = robot();
-  double* q = ctx.lane_q.data() + static_cast<std::ptrdiff_t>(lane) * model.variableCount();
-  for (std::size_t i = 0; i < group_variables_.size(); ++i) q[group_variables_[i]] = state[i];
-  lane_q[lane] = q;
-  lane_poses[lane] = ctx.lane_poses.data() + static_cast<std::ptrdiff_t>(lane) * model.linkCount();
-}
-
-int Scene::anyCollides(const double* states, int count, SceneContext& ctx, CollisionReport* report,
-                       const double* times) const noexcept {
-  CollisionReport local;
-  CollisionReport& r = report ? *report : local;
-  r = CollisionReport{};
-  const int dim = dimension();
-  const auto state = [&](int s) { return states + static_cast<std::ptrdiff_t>(s) * dim; };
-  const auto time = [&](int s) { return times ? times[s] : 0.0; };
-  // A context made for another robot (or before lanes existed) takes the states one at a time.
-  if (!lanesFit(ctx)) {
-    for (int s = 0; s < count; ++s)
-      if (!isFree(state(s), ctx, &r, time(s))) return s;
-    return -1;
-  }
-  const Effects& fx = description_.effects;
-  const double* lane_q[KinematicLanes::kMaxLanes];
-  Pose* lane_poses[KinematicLanes::kMaxLanes];
-  // In chunks of as many states as the lanes' scratch holds: every environment check of a chunk, then every
-  // self check, each pass in the order given.
-  for (int first = 0; first < count; first += KinematicLanes::kMaxLanes) {
-    const int n = std::min(count - first, KinematicLanes::kMaxLanes);
-    for (int l = 0; l < n; ++l) {
-      const double* x = state(first + l);
-      ++ctx.counters.states;
-      if (!withinBounds(x) || !withinTime(time(first + l))) {
-        ++ctx.counters.invalid_states;
-        r.kind = CollisionReport::Kind::Invalid;
-        return first + l;
-      }
-      if (static_collision_.kind != CollisionReport::Kind::None) {
-        r = static_collision_;
-        return first + l;
-      }
-      toLane(x, l, ctx, lane_q, lane_poses);
-    }
-    if (!fx.self && !fx.environment) continue;
-    ctx.lanes->compute(lane_q, n, lane_poses);
-    for (int l = 0; l < n; ++l) {
-      bool balls_placed = false;
-      if (!environmentFree(lane_poses[l], ctx, r, time(first + l), balls_placed)) return first + l;
-    }
-    // (The balls were placed for another state's grid look-ups: the self check places its own.)
-    for (int l = 0; l < n; ++l)
-      if (!selfFree(lane_poses[l], lane_q[l], ctx, r, false)) return first + l;
-  }
-  return -1;
-}
-
-void Scene::areFree(const double* states, int count, SceneContext& ctx, bool* free, double t) const noexcept {
-  const int dim = dimension();
-  // A context made for another robot (or before lanes existed) takes the states one at a time.
-  if (!lanesFit(ctx)) {
-    for (int s = 0; s < count; ++s) free[s] = isFree(states + static_cast<std::ptrdiff_t>(s) * dim, ctx, nullptr, t);
-    return;
-  }
-  const Effects& fx = description_.effects;
-  const int width = std::min(KinematicLanes::width(), KinematicLanes::kMaxLanes);
-  const double* lane_q[KinematicLanes::kMaxLanes];
-  Pose* lane_poses[KinematicLanes::kMaxLanes];
-  int pending[KinematicLanes::kMaxLanes];  // the states in the lanes
-  int n = 0;
-  const auto flush = [&] {
-    ctx.lanes->compute(lane_q, n, lane_poses);
-    for (int l = 0; l < n; ++l) {
-      CollisionReport r;
-      free[pending[l]] = posedFree(lane_poses[l], lane_q[l], ctx, r, t);
-    }
-    n = 0;
-  };
-  for (int s = 0; s < count; ++s) {
-    const double* state = states + static_cast<std::ptrdiff_t>(s) * dim;
-    ++ctx.counters.states;
-    if (!withinBounds(state) || !withinTime(t)) {
-      ++ctx.counters.invalid_states;
-      free[s] = false;
-      continue;
-    }
-    if (static_collision_.kind != CollisionReport::Kind::None || (!fx.self && !fx.environment)) {
-      free[s] = static_collision_.kind == CollisionReport::Kind::None;
-      continue;
-    }
-    toLane(state, n, ctx, lane_q, lane_poses);
-    pending[n++] = s;
-    if (n == width) flush();
-  }
-  if (n > 0) flush();
-}
-
-bool Scene::isFree(const std::vector<double>& state, CollisionReport* report, double t) const {
-  if (static_cast<int>(state.size()) != dimension()) {
-    if (report) {
-      *report = CollisionReport{};
-      report->kind = CollisionReport::Kind::Invalid;
-    }
-    return false;
-  }
-  return isFree(state.data(), threadContext(), report, t);
-}
-
-SceneContext& Scene::threadContext() const {
-  // Keyed by serial, not address: a new scene at a freed scene's address must not inherit its caches.
-  return detail::perThread<SceneContext>(scratch_owner_, [this] { return makeContext(); });
-}
-
-double Scene::clearance(const double* state, SceneContext& ctx, double* lower_bound, double t) const noexcept {
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  const Effects& fx = description_.effects;
-  if (!fx.clearance) return nan;
-  if (!withinBounds(state) || !withinTime(t) || ctx.poses.size() != static_cast<std::size_t>(robot().linkCount())) return nan;
-  ++ctx.counters.clearance_queries;
-  computePoses(state, ctx);
-  // Distances first; EPA only when something touches (then the value is minus the deepest penetration).
-  const bool env = fx.environment && !environment_->empty();
-  double best = env ? static_clearance_ : std::numeric_limits<double>::infinity();
-  double lower = env ? static_clearance_lower_ : best;
-  const double time = fx.moving ? t : 0.0;
-  if (env && best > 0.0) {
-    for (int i : env_links_) {
-      const DistanceResult d = environment_->linkDistance(*geometry_->link(i), ctx.poses[i], options_.tolerances,
-                                                          best + link_padding_[i], time, 0.0, &ctx.counters.environment);
-      if (isFailure(d.status)) return nan;
-      best = std::min(best, std::max(0.0, d.distance - link_padding_[i]));
-      lower = std::min(lower, std::max(0.0, d.lower_bound - link_padding_[i]));
-      if (best == 0.0) break;
-    }
-  }
-  if (fx.self && best > 0.0) {
-    const DistanceResult d = self_.minimumDistance(ctx.poses.data());
-    if (isFailure(d.status)) return nan;
-    best = std::min(best, d.distance);
-    lower = std::min(lower, d.lower_bound);
-  }
-  if (best == 0.0) {
-    double deepest = 0.0;
-    if (env)
-      for (int i : geometry_->geometricLinks()) {
-        const double p = environment_->linkPenetration(*geometry_->link(i), ctx.poses[i], options_.tolerances,
-                                                       link_padding_[i], time, &ctx.counters.environment);
-        if (std::isnan(p)) return nan;
-        deepest = std::max(deepest, p);
-      }
-    if (fx.self) {
-      const double p = self_.penetration(ctx.poses.data(), ctx.self);
-      if (std::isnan(p)) return nan;
-      deepest = std::max(deepest, p);
-    }
-    best = lower = -deepest;
-  }
-  if (lower_bound) *lower_bound = lower;
-  return best;
-}
-
-std::string Scene::describe(const CollisionReport& r) const {
-  const RobotModel& model = robot();
-  switch (r.kind) {
-    case CollisionReport::Kind::None: return "free";
-    case CollisionReport::Kind::Invalid: return "invalid state";
-    case CollisionReport::Kind::Self: return model.link(r.link).name + " " + model.link(r.other_link).name;
-    case CollisionReport::Kind::Environment:
-      if (r.hit.kind == EnvironmentHit::Kind::Obstacle)
-        return model.link(r.link).name + " " + (r.hit.obstacle ? r.hit.obstacle->name : std::string("?"));
-      if (r.hit.kind == EnvironmentHit::Kind::Voxel) return model.link(r.link).name + " octomap";
-      return model.link(r.link).name + " environment";
-  }
-  return "?";
 }
 
 }  // namespace clearway

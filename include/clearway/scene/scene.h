@@ -101,7 +101,7 @@ class Scene {
   /// This scene with a body attached to a robot link, as a scene file's robot.attached entry attaches it
   /// (a mesh read from body.body.mesh_file with `load`): a new robot that shares every other link's
   /// geometry. Throws std::invalid_argument for an unknown link or touch link, a name a link already has,
-  /// or a mesh that cannot be read.
+  /// a body reaching beyond kMaxInputLength of its link, or a mesh that cannot be read.
   std::shared_ptr<const Scene> withAttached(const SceneDescription::AttachedSpec& body, const LoadOptions& load = {}) const;
   /// This scene without the named attached body (one attached by withAttached or by the scene file), and
   /// without the allowed pairs (robot.allow) that name it. Throws std::invalid_argument when no attached
