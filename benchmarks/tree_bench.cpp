@@ -19,7 +19,7 @@
 #include <clearway/kinematics/forward_kinematics.h>
 #include <clearway/load/robot_loader.h>
 #include <clearway/load/mesh_loader.h>
-#include <clearway/body/link_geometry.h>
+#include <clearway/body/proximity.h>
 
 #include <algorithm>
 #include <cstdio>

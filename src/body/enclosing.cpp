@@ -80,7 +80,7 @@ bool EnclosingBalls::apart(int a, int b, double padding, const Tolerances& tol, 
   const Link& la = links_[a];
   const Link& lb = links_[b];
   if (la.count == 0 || lb.count == 0 || !poses_) return false;  // (never placed: nothing proved)
-  // As spheresApart in link_queries.cpp: the band grows with the coordinates' size; a NaN compares false.
+  // As spheresApart in proximity.cpp: the band grows with the coordinates' size; a NaN compares false.
   const double band = margins::narrowBand(tol.gjk_absolute);
   const auto ballsApart = [&](int i, int j) {
     const double reach = radii_[i] + radii_[j] + padding;

@@ -1,5 +1,5 @@
-// LinkGeometry: construction (triangles, tree, hull, convex parts, solids, cores). The link-level
-// queries are in link_queries.cpp, the triangle–triangle separating-axis test in triangle_sat.cpp.
+// LinkGeometry: construction (triangles, tree, hull, convex parts, solids, cores). The proximity
+// ladder is in proximity.cpp, the triangle–triangle separating-axis test in triangle_sat.cpp.
 #include <clearway/body/link_geometry.h>
 #include <clearway/detail/margins.h>
 #include <clearway/tree/oriented_box_test.h>
@@ -220,5 +220,9 @@ std::vector<LinkGeometry::Primitive> elementPrimitives(const std::vector<Collisi
 LinkGeometry::LinkGeometry(const std::vector<CollisionElement>& elements, const std::vector<TriangleMesh>& meshes,
                            const TreeBuildOptions& options)
     : LinkGeometry(elementTriangles(elements, meshes), elementPrimitives(elements), options) {}
+
+Aabb placedBox(const Shape& shape, const Pose& pose) noexcept {
+  return std::visit([&](const auto& s) { return placedBox(s, pose); }, shape);
+}
 
 }  // namespace clearway

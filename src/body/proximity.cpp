@@ -1,14 +1,461 @@
-// BodyPair: the proximity ladder of two bodies, written once.
+// The proximity ladder (proximity.h): its rungs, the link-level queries of intersection, screening, bounds
+// and distances between links and convex shapes, and BodyPair, which climbs them. Every query runs in
+// the frame of its first link (A): B's tree is seen through b_in_a, primitives are placed in A's frame,
+// and only the final witnesses go back to the world frame.
+//
+// Tolerance bookkeeping: a pair counts as intersecting when its distance is at most
+//   slack = padding + band,   band = max(tol.gjk_absolute, 64 ulps) · scale,
+// scale bounding every coordinate of the pair in A's frame. Box tests and the triangle SAT only
+// discard pairs certainly farther apart than slack (the band dwarfs their rounding); what they keep,
+// GJK decides within its own band, which is at most this one.
 #include <clearway/body/proximity.h>
 
 #include <clearway/detail/margins.h>
 #include <clearway/narrowphase/epa.h>
+#include <clearway/tree/oriented_box_test.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <string>
+#include <type_traits>
+#include <utility>
 
 namespace clearway {
+namespace {
+
+// ---- Query helpers ----------------------------------------------------------------------------------
+
+// Triangle of A (A's frame) against triangle of B (B's frame, placed by b_in_a): the SAT discards
+// pairs certainly apart; GJK decides the rest (and pads).
+bool trianglePairIntersects(const Triangle& ta, const Triangle& tb, const Pose& b_in_a, const Tolerances& tol,
+                            double padding, double slack) noexcept {
+  const Vec3 vb[3] = {b_in_a * tb.v[0], b_in_a * tb.v[1], b_in_a * tb.v[2]};
+  if (detail::trianglesSeparated(ta.v, vb, slack)) return false;
+  SimplexCache cache;
+  return gjkIntersect(Margin<Triangle>{ta, padding}, Pose::identity(), tb, b_in_a, tol, cache).intersecting;
+}
+
+// A convex shape placed in the link's frame by `shape_in_link` against the link's triangles.
+template <class S>
+bool shapeIntersectsTriangles(const S& s, const Pose& shape_in_link, const LinkGeometry& link, const Tolerances& tol,
+                              double padding, double slack) noexcept {
+  if (link.triangles().empty()) return false;
+  // Nodes are tested against the shape's world box (cheap) and then against its own box as an oriented
+  // box (SAT lite; full SAT for single triangles): a large primitive turned against the link's frame,
+  // such as a pedestal beside an arm, would otherwise reach every triangle its world box covers.
+  const Aabb box = placedBox(s, shape_in_link).inflated(slack);
+  const Aabb own = placedBox(s, Pose::identity()).inflated(slack);
+  const double scale = link.boundingRadius() + shape_in_link.t.norm() + own.min.cwiseAbs().cwiseMax(own.max.cwiseAbs()).norm();
+  const detail::OrientedBoxTest test(shape_in_link, 0.0, scale);
+  const detail::OrientedBoxTest::PlacedB placed = test.place(own);
+  const std::vector<Triangle>& tris = link.triangles();
+  const AabbTree& tree = link.tree();
+  const auto apart = [&](const Aabb& node, auto full) {
+    if (!overlaps(node, box)) return true;
+    double c[3], h[3];
+    detail::OrientedBoxTest::centerHalf(node, c, h);
+    return test.separated<decltype(full)::value>(c, h, placed);
+  };
+  std::int32_t stack[AabbTree::kMaxDepth + 1];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const AabbTree::Node& n = tree.nodes()[stack[--top]];
+    if (apart(n.box, std::false_type{})) continue;
+    if (!n.isLeaf()) {
+      stack[top++] = n.first + 1;
+      stack[top++] = n.first;
+      continue;
+    }
+    for (std::int32_t slot = n.first; slot < n.first + n.count; ++slot) {
+      if (apart(tree.slotBoxes()[slot], std::true_type{})) continue;
+      SimplexCache cache;
+      if (gjkIntersect(Margin<S>{s, padding}, shape_in_link, tris[tree.items()[slot]], Pose::identity(), tol, cache)
+              .intersecting)
+        return true;
+    }
+  }
+  return false;
+}
+
+bool shapeIntersectsTriangles(const Shape& s, const Pose& shape_in_link, const LinkGeometry& link, const Tolerances& tol,
+                              double padding, double slack) noexcept {
+  return std::visit([&](const auto& c) { return shapeIntersectsTriangles(c, shape_in_link, link, tol, padding, slack); },
+                    s);
+}
+
+bool shapesIntersect(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, const Tolerances& tol,
+                     double padding) noexcept {
+  return std::visit(
+      [&](const auto& sa, const auto& sb) {
+        using SA = std::decay_t<decltype(sa)>;
+        SimplexCache cache;
+        return gjkIntersect(Margin<SA>{sa, padding}, pa, sb, pb, tol, cache).intersecting;
+      },
+      a, b);
+}
+
+// The exact part of a Mesh-mode test, in A's frame.
+bool exactIntersect(const LinkGeometry& a, const LinkGeometry& b, const Pose& b_in_a, const Tolerances& tol,
+                    double padding, double slack, TrianglePair* witness = nullptr) noexcept {
+  const std::vector<Triangle>& ta = a.triangles();
+  const std::vector<Triangle>& tb = b.triangles();
+  if (!ta.empty() && !tb.empty() &&
+      forEachOverlap(a.tree(), b.tree(), b_in_a,
+                     [&](std::int32_t i, std::int32_t j) {
+                       if (!trianglePairIntersects(ta[i], tb[j], b_in_a, tol, padding, slack)) return false;
+                       if (witness) *witness = {i, j};
+                       return true;
+                     },
+                     slack))
+    return true;
+  if (!a.primitives().empty() || !b.primitives().empty()) {
+    const Pose a_in_b = b_in_a.inverse();
+    for (const auto& p : a.primitives())
+      if (shapeIntersectsTriangles(p.shape, a_in_b * p.pose, b, tol, padding, slack)) return true;
+    for (const auto& p : b.primitives())
+      if (shapeIntersectsTriangles(p.shape, b_in_a * p.pose, a, tol, padding, slack)) return true;
+    for (const auto& p : a.primitives())
+      for (const auto& q : b.primitives())
+        if (shapesIntersect(p.shape, p.pose, q.shape, b_in_a * q.pose, tol, padding)) return true;
+  }
+  return false;
+}
+
+bool validPadding(double padding) noexcept { return padding >= 0.0 && std::isfinite(padding); }
+
+// A box containing the shape, in its own frame (exact for boxes, spheres, capsules, cylinders and cones).
+Aabb localBox(const Shape& shape) noexcept {
+  return std::visit(
+      [](const auto& s) -> Aabb {
+        using S = std::decay_t<decltype(s)>;
+        if constexpr (std::is_same_v<S, Box>) return Aabb::fromCenterHalf(Vec3::Zero(), s.half);
+        else if constexpr (std::is_same_v<S, Sphere>) return Aabb::fromCenterHalf(Vec3::Zero(), Vec3::Constant(s.r));
+        else if constexpr (std::is_same_v<S, Capsule> || std::is_same_v<S, Cylinder> || std::is_same_v<S, Cone>) {
+          return Aabb::fromCenterHalf(Vec3::Zero(), Vec3(s.r, s.r, s.h + s.radius()));
+        } else {
+          return placedBox(s, Pose::identity());
+        }
+      },
+      shape);
+}
+
+// True when the bounding spheres (centres given in one frame) are farther apart than the padding and
+// the band (of the pair's scale, as in the exact tests).
+bool spheresApart(const Vec3& ca, double ra, const Vec3& cb, double rb, double padding, const Tolerances& tol) noexcept {
+  const double reach = ra + rb + padding;
+  const double scale = ca.norm() + cb.norm() + reach;
+  const double limit = reach + margins::narrowBand(tol.gjk_absolute) * scale;
+  return (ca - cb).squaredNorm() > limit * limit;
+}
+
+}  // namespace
+
+// ---- Queries ------------------------------------------------------------------------------------------
+
+namespace {
+double partsBound(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                  const Tolerances& tol, double enough, double relative, SimplexCache* caches) noexcept;
+}  // namespace
+
+double partsLowerBound(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                       const Tolerances& tol, double enough, double relative, SimplexCache* caches) noexcept {
+  if (!pose_a.isFinite() || !pose_b.isFinite() || !(enough >= 0.0)) return 0.0;  // (a NaN `enough` too)
+  const double d = partsBound(a, pose_a, b, pose_b, tol, enough, relative, caches);
+  // The parts cover the surfaces, not a closed mesh's inside: a piece in there is 0 away.
+  if (d > 0.0 && (a.solidCount() > 0 || b.solidCount() > 0) && linkContained(a, b, relativePose(pose_a, pose_b)))
+    return 0.0;
+  return d;
+}
+
+namespace {
+double partsBound(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                  const Tolerances& tol, double enough, double relative, SimplexCache* caches) noexcept {
+  double best = enough;  // any bound at or above `enough` serves as well as the distance
+  const int na = static_cast<int>(a.parts().size()), nb = static_cast<int>(b.parts().size());
+  const auto gjk = [&](int i, int j, double balls) {
+    SimplexCache scratch;
+    SimplexCache& cache = caches ? caches[i * nb + j] : scratch;
+    best = std::min(best, std::max(balls, gjkLowerBound(a.parts()[i].hull, pose_a, b.parts()[j].hull, pose_b, tol,
+                                                        cache, best, relative)));
+  };
+  const auto balls = [&](int i, int j) {
+    return (pose_a * a.parts()[i].center - pose_b * b.parts()[j].center).norm() - a.parts()[i].radius -
+           b.parts()[j].radius;
+  };
+  constexpr int kPairs = LinkGeometry::kMaxParts * LinkGeometry::kMaxParts;
+  if (na * nb > kPairs) {  // (links with many primitives, which add a part each: every pair in turn)
+    for (int i = 0; i < na; ++i) {
+      for (int j = 0; j < nb; ++j) {
+        const double x = balls(i, j);
+        if (x >= best) continue;
+        gjk(i, j, x);
+        if (!(best > 0.0)) return 0.0;
+      }
+    }
+    return best;
+  }
+  // Nearest balls first: the first pair's distance is then usually the answer, and each later pair
+  // stops its GJK as soon as it is proved farther, or is never started once the balls are.
+  std::array<std::pair<double, int>, kPairs> near;
+  int count = 0;
+  for (int i = 0; i < na; ++i) {
+    for (int j = 0; j < nb; ++j) {
+      const double x = balls(i, j);
+      // (A NaN, which finite poses do not give, would break the sort: it goes first and GJK decides.)
+      if (!(x >= best)) near[count++] = {std::isnan(x) ? -std::numeric_limits<double>::infinity() : x, i * nb + j};
+    }
+  }
+  std::sort(near.begin(), near.begin() + count, [](const auto& x, const auto& y) { return x.first < y.first; });
+  for (int k = 0; k < count && near[k].first < best; ++k) {
+    gjk(near[k].second / nb, near[k].second % nb, near[k].first);
+    if (!(best > 0.0)) return 0.0;
+  }
+  return best;
+}
+}  // namespace
+
+Screen screenMeshes(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                    const Tolerances& tol, GeometryMode mode, double padding, SimplexCache* hull_cache) noexcept {
+  if (!pose_a.isFinite() || !pose_b.isFinite() || !validPadding(padding)) return Screen::Touching;
+  // Conservative filters from cheapest to dearest: bounding spheres, the boxes of the hulls as oriented
+  // boxes (6 face axes), the hulls (GJK), the cores.
+  if (spheresApart(pose_a * a.sphereCenter(), a.sphereRadius(), pose_b * b.sphereCenter(), b.sphereRadius(), padding,
+                   tol))
+    return Screen::Apart;
+  const Pose b_in_a = relativePose(pose_a, pose_b);
+  const double scale = a.boundingRadius() + b.boundingRadius() + b_in_a.t.norm();
+  const double slack = padding + narrowBand(scale + padding, tol);
+  if (detail::OrientedBoxTest(b_in_a, slack, scale).separated<false>(a.bounds(), b.bounds())) return Screen::Apart;
+  SimplexCache scratch;
+  SimplexCache& cache = hull_cache ? *hull_cache : scratch;
+  const IntersectResult hulls = gjkIntersect(Margin<ConvexHull>{a.hull(), padding}, pose_a, b.hull(), pose_b, tol, cache);
+  if (!hulls.intersecting) return Screen::Apart;
+  if (mode == GeometryMode::Hull) return Screen::Touching;
+  // Overlapping cores settle deep contacts before the triangle search, which is slowest exactly there.
+  if (coresOverlap(a, b, b_in_a)) return Screen::Touching;
+  return Screen::Unsure;
+}
+
+bool meshesIntersectExactly(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                            const Tolerances& tol, double padding) noexcept {
+  return meshesIntersectExactly(a, pose_a, b, pose_b, tol, padding, nullptr);
+}
+
+bool meshesIntersectExactly(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                            const Tolerances& tol, double padding, TrianglePair* witness) noexcept {
+  if (witness) *witness = {};
+  if (!pose_a.isFinite() || !pose_b.isFinite() || !validPadding(padding)) return true;
+  const Pose b_in_a = relativePose(pose_a, pose_b);
+  const double scale = a.boundingRadius() + b.boundingRadius() + b_in_a.t.norm();
+  const double slack = padding + narrowBand(scale + padding, tol);
+  return exactIntersect(a, b, b_in_a, tol, padding, slack, witness) || linkContained(a, b, b_in_a);
+}
+
+bool trianglesTouch(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                    TrianglePair w, const Tolerances& tol, double padding) noexcept {
+  if (!w.valid() || w.a >= static_cast<std::int32_t>(a.triangles().size()) ||
+      w.b >= static_cast<std::int32_t>(b.triangles().size()) || !validPadding(padding))
+    return false;
+  const Pose b_in_a = relativePose(pose_a, pose_b);
+  const double scale = a.boundingRadius() + b.boundingRadius() + b_in_a.t.norm();
+  const double slack = padding + narrowBand(scale + padding, tol);
+  // (Non-finite poses fail the box test inside: false, which proves nothing.)
+  return b_in_a.isFinite() && trianglePairIntersects(a.triangles()[w.a], b.triangles()[w.b], b_in_a, tol, padding, slack);
+}
+
+bool meshesIntersect(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                     const Tolerances& tol, GeometryMode mode, double padding, SimplexCache* hull_cache) noexcept {
+  const Screen s = screenMeshes(a, pose_a, b, pose_b, tol, mode, padding, hull_cache);
+  if (s != Screen::Unsure) return s == Screen::Touching;
+  return meshesIntersectExactly(a, pose_a, b, pose_b, tol, padding);
+}
+
+bool shapeIntersectsLink(const Shape& shape, const Pose& pose_shape, const LinkGeometry& link, const Pose& pose_link,
+                         const Tolerances& tol, GeometryMode mode, double padding, SimplexCache* hull_cache) noexcept {
+  if (!pose_shape.isFinite() || !pose_link.isFinite() || !validPadding(padding)) return true;
+  if (spheresApart(pose_shape.t, boundingRadius(shape), pose_link * link.sphereCenter(), link.sphereRadius(), padding,
+                   tol))
+    return false;
+  // The shape's own box against the link's box, both oriented (15 axes): obstacles are mostly boxes, often
+  // turned, so this clears most of what their world boxes let through, at a third of a GJK call.
+  const Pose shape_in_link = relativePose(pose_link, pose_shape);
+  const double scale = link.boundingRadius() + shape_in_link.t.norm() + boundingRadius(shape);
+  const double slack = padding + narrowBand(scale + padding, tol);
+  if (detail::OrientedBoxTest(shape_in_link, slack, scale).separated<true>(link.bounds(), localBox(shape))) return false;
+  // A core (inside the link, so inside its hull) that meets the shape settles a contact in either mode, for
+  // a few point distances where the hulls' GJK and the triangles cost far more: a link in an obstacle.
+  if (coreMeetsShape(shape, shape_in_link, link)) return true;
+  SimplexCache scratch;
+  SimplexCache& cache = hull_cache ? *hull_cache : scratch;
+  const bool hulls = std::visit(
+      [&](const auto& s) {
+        using S = std::decay_t<decltype(s)>;
+        return gjkIntersect(Margin<S>{s, padding}, pose_shape, link.hull(), pose_link, tol, cache).intersecting;
+      },
+      shape);
+  if (!hulls) return false;
+  if (mode == GeometryMode::Hull) return true;
+  if (shapeIntersectsTriangles(shape, shape_in_link, link, tol, padding, slack)) return true;
+  for (const auto& p : link.primitives())
+    if (shapesIntersect(shape, shape_in_link, p.shape, p.pose, tol, padding)) return true;
+  return shapeInsideLink(shape, shape_in_link, link);
+}
+
+namespace {
+
+// The running minimum of a distance query, in A's frame.
+struct DistanceMin {
+  DistanceResult best;
+  // Pairs certainly farther than this are skipped: the caller's limit, then best.distance / (1 + relative_error).
+  double cutoff = std::numeric_limits<double>::infinity();
+  double shrink = 1.0;
+  bool failed = false;
+
+  explicit DistanceMin(double relative_error, double limit = std::numeric_limits<double>::infinity())
+      : cutoff(limit), shrink(1.0 / (1.0 + relative_error)) {
+    best.distance = limit;
+    best.lower_bound = limit;
+    best.status = Status::Separated;
+  }
+  // The result in the world, given the frame the search ran in: a failure carries no certificate, and
+  // pairs skipped were at least the final cutoff apart (with a relative error, below the distance).
+  DistanceResult finish(const Pose& frame) const {
+    DistanceResult r = best;
+    if (failed) {
+      r.status = Status::NotConverged;
+      r.distance = 0.0;
+      r.lower_bound = 0.0;
+      return r;
+    }
+    r.lower_bound = std::min({r.lower_bound, r.distance, cutoff});
+    r.point_a = frame * r.point_a;
+    r.point_b = frame * r.point_b;
+    r.normal = frame.R * r.normal;
+    return r;
+  }
+  // One body lies inside the other's closed mesh: they overlap (no witness points on the surfaces).
+  void inside() {
+    best.distance = best.lower_bound = 0.0;
+    best.status = Status::Overlapping;
+    best.normal = Vec3::Zero();
+    cutoff = 0.0;
+  }
+  // Returns true when the search can stop (an overlap, or a failure).
+  bool add(const DistanceResult& r) {
+    best.iterations += r.iterations;
+    if (isFailure(r.status)) {
+      failed = true;
+      return true;
+    }
+    best.lower_bound = std::min(best.lower_bound, r.lower_bound);
+    if (r.distance < best.distance) {
+      const int iterations = best.iterations;
+      const double lower = best.lower_bound;
+      best = r;
+      best.iterations = iterations;
+      best.lower_bound = lower;
+      cutoff = r.distance * shrink;
+    }
+    return best.distance <= 0.0;
+  }
+};
+
+// How far apart two triangles are along the unit axis u (from a's side towards b's): their projections'
+// gap, a lower bound on their distance (negative when the projections overlap).
+double projectedGap(const Vec3 a[3], const Vec3 b[3], const Vec3& u) noexcept {
+  const double a0 = u.dot(a[0]), a1 = u.dot(a[1]), a2 = u.dot(a[2]);
+  const double b0 = u.dot(b[0]), b1 = u.dot(b[1]), b2 = u.dot(b[2]);
+  return std::max(std::min({b0, b1, b2}) - std::max({a0, a1, a2}), std::min({a0, a1, a2}) - std::max({b0, b1, b2}));
+}
+
+template <class S>
+void shapeTrianglesDistance(const S& s, const Pose& shape_in_link, const LinkGeometry& link, const Tolerances& tol,
+                            DistanceMin& m, bool shape_is_a, const Pose& link_in_a) {
+  if (link.triangles().empty()) return;
+  const std::vector<Triangle>& tris = link.triangles();
+  // The tree is in the link's frame; the results go to A's frame (identity when the shape is B's). The
+  // shape's own box, turned, prunes far more than its bounds in the link frame (a slab seen askew).
+  link.tree().forEachWithin(placedBox(s, Pose::identity()), shape_in_link, m.cutoff, [&](std::int32_t i) {
+    DistanceResult r = shape_is_a ? gjkDistance(s, shape_in_link, tris[i], Pose::identity(), tol)
+                                  : gjkDistance(tris[i], Pose::identity(), s, shape_in_link, tol);
+    r.point_a = link_in_a * r.point_a;
+    r.point_b = link_in_a * r.point_b;
+    r.normal = link_in_a.R * r.normal;
+    return m.add(r);
+  });
+}
+
+}  // namespace
+
+DistanceResult meshDistance(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                            const Tolerances& tol, double relative_error, double cutoff) noexcept {
+  if (!pose_a.isFinite() || !pose_b.isFinite() || !(relative_error >= 0.0) || !std::isfinite(relative_error) ||
+      !(cutoff >= 0.0)) {
+    DistanceResult r;
+    r.status = Status::InvalidInput;
+    return r;
+  }
+  const Pose b_in_a = relativePose(pose_a, pose_b);
+  DistanceMin m(relative_error, cutoff);
+  const std::vector<Triangle>& ta = a.triangles();
+  const std::vector<Triangle>& tb = b.triangles();
+  bool stop = false;
+  if (!ta.empty() && !tb.empty()) {
+    // Box gaps are loose for distance (a triangle's box, turned, reaches far beyond it), so a triangle
+    // pair passing them is first projected on two axes, each gap a lower bound on its distance: the
+    // line through the centroids (tight for small triangles far apart) and the normal of the best pair
+    // so far (tight for surfaces facing each other). GJK runs only when neither reaches the cutoff.
+    const double rounding = margins::kRounding * (a.boundingRadius() + b.boundingRadius() + b_in_a.t.norm());
+    stop = forEachPairWithin(a.tree(), b.tree(), b_in_a, m.cutoff, [&](std::int32_t i, std::int32_t j) {
+      if (m.cutoff < std::numeric_limits<double>::infinity()) {
+        const Vec3* va = ta[i].v;
+        const Vec3 vb[3] = {b_in_a * tb[j].v[0], b_in_a * tb[j].v[1], b_in_a * tb[j].v[2]};
+        const Vec3 u = (vb[0] + vb[1] + vb[2]) - (va[0] + va[1] + va[2]);
+        const double len = u.norm();
+        if (len > 0.0 && projectedGap(va, vb, u / len) - rounding >= m.cutoff) return false;
+        if (projectedGap(va, vb, m.best.normal) - rounding >= m.cutoff) return false;
+      }
+      return m.add(gjkDistance(ta[i], Pose::identity(), tb[j], b_in_a, tol));
+    });
+  }
+  if (!stop && (!a.primitives().empty() || !b.primitives().empty())) {
+    const Pose a_in_b = b_in_a.inverse();
+    for (const auto& p : a.primitives())
+      std::visit([&](const auto& s) { shapeTrianglesDistance(s, a_in_b * p.pose, b, tol, m, true, b_in_a); }, p.shape);
+    for (const auto& p : b.primitives())
+      std::visit([&](const auto& s) { shapeTrianglesDistance(s, b_in_a * p.pose, a, tol, m, false, Pose::identity()); },
+                 p.shape);
+    for (const auto& p : a.primitives())
+      for (const auto& q : b.primitives())
+        if (!m.failed) m.add(gjkDistance(p.shape, p.pose, q.shape, b_in_a * q.pose, tol));
+  }
+  if (!m.failed && m.best.distance > 0.0 && (a.solidCount() > 0 || b.solidCount() > 0) && linkContained(a, b, b_in_a))
+    m.inside();
+  return m.finish(pose_a);
+}
+
+DistanceResult shapeLinkDistance(const Shape& shape, const Pose& pose_shape, const LinkGeometry& link,
+                                 const Pose& pose_link, const Tolerances& tol, double relative_error) noexcept {
+  if (!pose_shape.isFinite() || !pose_link.isFinite() || !(relative_error >= 0.0) || !std::isfinite(relative_error)) {
+    DistanceResult r;
+    r.status = Status::InvalidInput;
+    return r;
+  }
+  // In the link's frame: its tree needs no transform, and the shape is A (its results need none either).
+  const Pose shape_in_link = relativePose(pose_link, pose_shape);
+  DistanceMin m(relative_error);
+  std::visit([&](const auto& s) { shapeTrianglesDistance(s, shape_in_link, link, tol, m, true, Pose::identity()); },
+             shape);
+  for (const auto& p : link.primitives())
+    if (!m.failed && !(m.best.distance <= 0.0)) m.add(gjkDistance(shape, shape_in_link, p.shape, p.pose, tol));
+  if (!m.failed && m.best.distance > 0.0 && shapeInsideLink(shape, shape_in_link, link)) m.inside();
+  return m.finish(pose_link);
+}
+
+// ---- BodyPair ------------------------------------------------------------------------------------------
 
 BodyPair::BodyPair(const LinkGeometry& a, const LinkGeometry& b) : a_(&a), b_(&b) {}
 

@@ -1,6 +1,6 @@
 // The triangle–triangle separating-axis test (17 axes: 2 normals, 9 edge–edge cross products, 6 in-plane
-// edge normals), the cheap rejection before GJK on a triangle pair (link_queries.cpp).
-#include <clearway/body/link_geometry.h>
+// edge normals), the cheap rejection before GJK on a triangle pair (proximity.cpp).
+#include <clearway/body/proximity.h>
 
 #include <algorithm>
 #include <cmath>

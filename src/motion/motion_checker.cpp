@@ -2,6 +2,8 @@
 // choice of mode.
 #include <clearway/motion/motion.h>
 
+#include <clearway/body/proximity.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>

@@ -3,7 +3,7 @@
 #include <clearway/scene/scene.h>
 
 #include <clearway/body/enclosing.h>
-#include <clearway/body/link_geometry.h>
+#include <clearway/body/proximity.h>
 
 #include <clearway/detail/per_thread.h>
 

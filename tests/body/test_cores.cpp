@@ -2,7 +2,7 @@
 // generated meshes, primitives and the links of real robots; overlapping cores are collisions the
 // brute-force reference confirms; and they decide a real share of deep contacts (a layer that never
 // fires would pass the first two).
-#include <clearway/body/link_geometry.h>
+#include <clearway/body/proximity.h>
 #include <clearway/body/robot_geometry.h>
 #include <clearway/load/robot_loader.h>
 

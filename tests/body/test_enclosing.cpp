@@ -3,6 +3,7 @@
 // is farther apart than the padding by the exact meshes, and it clears pairs the bounding balls alone do
 // not (a layer that never fires would pass the first check).
 #include <clearway/body/enclosing.h>
+#include <clearway/body/proximity.h>
 #include <clearway/kinematics/forward_kinematics.h>
 #include <clearway/kinematics/kinematic_lanes.h>
 #include <clearway/load/robot_loader.h>

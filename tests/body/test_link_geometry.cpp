@@ -2,7 +2,7 @@
 // tree, SAT or GJK in it) on random poses of generated meshes and of the Panda's link meshes; Hull mode
 // never "free" where Mesh says "collision"; padding; touching; primitives; distances.
 #include <clearway/load/mesh_loader.h>
-#include <clearway/body/link_geometry.h>
+#include <clearway/body/proximity.h>
 
 #include <gtest/gtest.h>
 

@@ -10,6 +10,92 @@
 
 namespace clearway {
 
+// ---- The rungs: one question each, of two links or of a convex shape and a link ----------------------
+
+/// True when the two links are within `padding` metres of each other (padding ≥ 0; 0: touching counts).
+/// Hull: the bounding spheres, then one GJK test of the hulls. Mesh: the same, then the two triangle trees descended together
+/// (oriented boxes, SAT lite), then triangle pairs (a separating-axis test, confirmed by GJK), and
+/// primitives against triangles and primitives. `hull_cache`, if given, carries the hulls' separating
+/// axis to the next query of the same pair (keep one per link pair and thread).
+/// Pairs within the narrow phase's band (tol.gjk_absolute times the pair's size) of touching count as
+/// intersecting. Never "free" by accident: a non-finite pose or padding, or a narrow-phase query that
+/// does not converge, answers true.
+bool meshesIntersect(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                     const Tolerances& tol, GeometryMode mode, double padding = 0.0,
+                     SimplexCache* hull_cache = nullptr) noexcept;
+
+/// What the cheap rungs of meshesIntersect (bounding balls, boxes, hulls, cores) tell of a pair.
+enum class Screen : char { Apart, Touching, Unsure };
+/// meshesIntersect's rungs short of the triangles: Apart or Touching where they settle it (the answer
+/// meshesIntersect gives), Unsure where only meshesIntersectExactly can. Hull mode is never Unsure.
+Screen screenMeshes(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                    const Tolerances& tol, GeometryMode mode, double padding = 0.0,
+                    SimplexCache* hull_cache = nullptr) noexcept;
+/// The exact rung of meshesIntersect in Mesh mode (triangles, primitives, closed meshes as solids), for a pair
+/// the screen left Unsure; meshesIntersect's answer there.
+bool meshesIntersectExactly(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                            const Tolerances& tol, double padding = 0.0) noexcept;
+/// Two triangles, one of each link (indices into triangles()), that touch: a witness that the links do.
+struct TrianglePair {
+  ///@{
+  std::int32_t a = -1, b = -1;  ///< index into the first / the second link's triangles(); -1: none
+  ///@}
+  /// True when both indices are set (a pair was found).
+  bool valid() const noexcept { return a >= 0 && b >= 0; }
+};
+/// meshesIntersectExactly, also giving (when the answer is true because two triangles touch) the pair found.
+bool meshesIntersectExactly(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                            const Tolerances& tol, double padding, TrianglePair* witness) noexcept;
+/// True when the witness's triangles touch at these poses, tested as meshesIntersectExactly tests a pair:
+/// then the links intersect. False proves nothing (a witness out of range is false).
+bool trianglesTouch(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                    TrianglePair witness, const Tolerances& tol, double padding = 0.0) noexcept;
+
+/// A certified lower bound on the distance between two links from their convex parts (0 when parts
+/// touch): the least over part pairs, each pair's GJK stopping once it reaches `enough` metres or is
+/// within `relative` of its distance. Between the hulls' bound and meshDistance in cost and tightness.
+/// `caches`, if given, holds a.parts().size()·b.parts().size() warm starts (pair i, j at i·nb + j).
+double partsLowerBound(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                       const Tolerances& tol, double enough, double relative, SimplexCache* caches = nullptr) noexcept;
+
+/// The same for a convex shape (an obstacle, a primitive) against a link: hull first, then (Mesh mode)
+/// the shape's box in the link frame against the triangle tree, and the link's primitives.
+bool shapeIntersectsLink(const Shape& shape, const Pose& pose_shape, const LinkGeometry& link, const Pose& pose_link,
+                         const Tolerances& tol, GeometryMode mode, double padding = 0.0,
+                         SimplexCache* hull_cache = nullptr) noexcept;
+
+/// The distance between the exact geometries of two links (triangles and primitives): the minimum over
+/// element pairs of GJK's distance, pairs pruned by their boxes' separation. `distance` is an upper
+/// bound and `lower_bound` a certified lower bound, both 0 when the links intersect; points and normal
+/// (from A to B) in the world frame (the poses' frame). With relative_error = 0 the two agree within
+/// tol.gjk_relative; a relative_error e > 0 lets the search skip pairs that cannot be closer than
+/// distance / (1 + e), so lower_bound ≥ distance / (1 + e) only (much faster: conservative advancement
+/// needs a lower bound, not the exact distance). Element pairs farther apart than `cutoff` are not
+/// examined: when none is nearer, distance = lower_bound = cutoff. A narrow-phase failure, a non-finite
+/// pose, a negative relative_error or cutoff gives distance 0 and a failure status.
+DistanceResult meshDistance(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                            const Tolerances& tol = {}, double relative_error = 0.0,
+                            double cutoff = std::numeric_limits<double>::infinity()) noexcept;
+
+/// The distance between a convex shape (A, an obstacle or a voxel) and a link's exact geometry (B):
+/// the minimum over the link's triangles and primitives, with the same bounds, frames and relative_error
+/// as meshDistance (normal from the shape towards the link). The link's hull is not consulted: callers
+/// that want a cheap lower bound first ask GJK for the shape-to-hull distance.
+DistanceResult shapeLinkDistance(const Shape& shape, const Pose& pose_shape, const LinkGeometry& link,
+                                 const Pose& pose_link, const Tolerances& tol = {}, double relative_error = 0.0) noexcept;
+
+namespace detail {
+
+/// The separating-axis test of two closed triangles given in one frame: true when one of the 17 axes
+/// (2 normals, 9 edge–edge cross products, 6 in-plane edge normals) separates them by more than `slack`
+/// metres (slack > 0 must exceed the rounding of the coordinates: then "true" is certain). Complete
+/// for non-degenerate triangles in exact arithmetic; a false "false" can come only from rounding.
+bool trianglesSeparated(const Vec3 a[3], const Vec3 b[3], double slack) noexcept;
+
+}  // namespace detail
+
+// ---- BodyPair: the rungs climbed in order, warm --------------------------------------------------------
+
 /// What BodyPair::intersects asks.
 struct IntersectQuery {
   double padding = 0.0;                    ///< bodies within this many metres count as touching (≥ 0)

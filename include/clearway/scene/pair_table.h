@@ -10,7 +10,7 @@
 // cell (Free), and a pair whose cores overlap by more than δ at c overlaps everywhere in it (Colliding).
 // Other cells are Unsure and the pair is checked as before, after one triangle test of the pair that
 // touched at the cell's centre. A coarse grid is refined where it is unsure.
-#include <clearway/body/link_geometry.h>
+#include <clearway/body/proximity.h>
 #include <clearway/body/robot_geometry.h>
 #include <clearway/kinematics/robot_model.h>
 #include <clearway/tolerances.h>
