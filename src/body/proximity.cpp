@@ -457,61 +457,138 @@ DistanceResult shapeLinkDistance(const Shape& shape, const Pose& pose_shape, con
 
 // ---- BodyPair ------------------------------------------------------------------------------------------
 
-BodyPair::BodyPair(const LinkGeometry& a, const LinkGeometry& b) : a_(&a), b_(&b) {}
+namespace {
+
+// A lower bound on the distance from the link's bounding ball (placed by pose_a) to the convex shape: the
+// ball against the shape's own ball and against its box (in its frame), a dozen operations where GJK costs
+// hundreds. The ball is grown by the rounding of placing its centre, the gap shrunk by that of the box test.
+double ballShapeGap(const LinkGeometry& a, const Pose& pose_a, const Shape& b, const Pose& pose_b) noexcept {
+  // (A hull's ball and box cost a pass over its vertices: GJK, warm, costs less.)
+  if (std::holds_alternative<ConvexHull>(b)) return -std::numeric_limits<double>::infinity();
+  const Vec3 centre = pose_a * a.sphereCenter();
+  const double reach =
+      a.sphereRadius() * (1.0 + margins::kRounding) + margins::placedRounding(a.sphereCenter().norm(), pose_a.t.norm());
+  const double balls = (centre - pose_b.t).norm() - reach - boundingRadius(b) * (1.0 + margins::kRounding);
+  const Aabb box = localBox(b);
+  const Vec3 c = pose_b.R.transpose() * (centre - pose_b.t);
+  const Vec3 gap = (box.min - c).cwiseMax(c - box.max).cwiseMax(0.0);
+  const double margin =
+      margins::kSlack * (1.0 + c.cwiseAbs().maxCoeff() + pose_b.t.cwiseAbs().maxCoeff() + centre.cwiseAbs().maxCoeff());
+  const double boxed = gap.norm() - reach - margin;
+  // (A norm that overflowed is no bound: only finite gaps count; a NaN gives way to the other.)
+  const double x = std::isfinite(boxed) ? boxed : -std::numeric_limits<double>::infinity();
+  const double y = std::isfinite(balls) ? balls : -std::numeric_limits<double>::infinity();
+  return std::max(x, y);
+}
+
+// The least bound over the link's convex parts against the shape (cold starts: asked only once the hull has
+// come near), each GJK stopping once it proves `enough`; 0 when the shape lies inside a closed mesh of the
+// link, which the parts (covering the surfaces) do not hold.
+double partsShapeBound(const LinkGeometry& a, const Pose& pose_a, const Shape& b, const Pose& pose_b,
+                       const Tolerances& tol, double enough, double relative) noexcept {
+  double best = enough;
+  const double rb = boundingRadius(b);
+  for (const LinkGeometry::Part& part : a.parts()) {
+    if ((pose_a * part.center - pose_b.t).norm() - part.radius - rb >= best) continue;
+    SimplexCache cold;
+    best = std::min(best, std::visit([&](const auto& s) { return gjkLowerBound(part.hull, pose_a, s, pose_b, tol, cold, best, relative); }, b));
+    if (!(best > 0.0)) return 0.0;
+  }
+  // (The shape's support point is a point of it.)
+  if (a.solidCount() > 0) {
+    const Vec3 p = std::visit([](const auto& s) { return s.support(Vec3::UnitX()); }, b);
+    if (a.containsPoint(relativePose(pose_a, pose_b) * p)) return 0.0;
+  }
+  return best;
+}
+
+// A distance with A and B exchanged.
+DistanceResult swapped(DistanceResult r) noexcept {
+  std::swap(r.point_a, r.point_b);
+  r.normal = -r.normal;
+  return r;
+}
+
+}  // namespace
+
+BodyPair::BodyPair(const LinkGeometry& a, const LinkGeometry& b, SimplexCache* hull_warm)
+    : a_(&a), b_(&b), warm_(hull_warm) {}
+
+BodyPair::BodyPair(const LinkGeometry& a, const Shape& b, SimplexCache* hull_warm)
+    : a_(&a), shape_(&b), warm_(hull_warm) {}
 
 void BodyPair::forget() noexcept {
-  hull_ = SimplexCache{};
+  hullCache() = SimplexCache{};
   parts_stale_ = true;
 }
 
 bool BodyPair::intersects(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol,
                           const IntersectQuery& q) noexcept {
-  return meshesIntersect(*a_, pose_a, *b_, pose_b, tol, q.mode, q.padding, &hull_);
+  if (shape_) return shapeIntersectsLink(*shape_, pose_b, *a_, pose_a, tol, q.mode, q.padding, &hullCache());
+  return meshesIntersect(*a_, pose_a, *b_, pose_b, tol, q.mode, q.padding, &hullCache());
 }
 
 Screen BodyPair::screen(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, const IntersectQuery& q) noexcept {
-  return screenMeshes(*a_, pose_a, *b_, pose_b, tol, q.mode, q.padding, &hull_);
+  if (shape_) {  // (one convex piece: the hull-mode test screens, the exact one decides)
+    if (!shapeIntersectsLink(*shape_, pose_b, *a_, pose_a, tol, GeometryMode::Hull, q.padding, &hullCache()))
+      return Screen::Apart;
+    return q.mode == GeometryMode::Hull ? Screen::Touching : Screen::Unsure;
+  }
+  return screenMeshes(*a_, pose_a, *b_, pose_b, tol, q.mode, q.padding, &hullCache());
 }
 
 bool BodyPair::intersectsExactly(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol,
                                  double padding) const noexcept {
+  if (shape_) return shapeIntersectsLink(*shape_, pose_b, *a_, pose_a, tol, GeometryMode::Mesh, padding);
   return meshesIntersectExactly(*a_, pose_a, *b_, pose_b, tol, padding);
 }
 
 double BodyPair::convexBound(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, double enough,
                              double relative, double climb, GeometryMode mode) noexcept {
   const LinkGeometry& a = *a_;
-  const LinkGeometry& b = *b_;
   // (In every max() below the bound so far comes second: a NaN rung leaves it, and a NaN first bound
-  // gives way to the rung's number.)
+  // gives way to the rung's number.) A dearer rung only while the bound is at most climb and short of enough.
+  const auto climbs = [&](double lower) { return lower <= climb && !(lower >= enough); };
   rung_ = Rung::Balls;
-  double lower = (pose_a * a.sphereCenter() - pose_b * b.sphereCenter()).norm() - a.sphereRadius() - b.sphereRadius();
+  double lower = shape_ ? ballShapeGap(a, pose_a, *shape_, pose_b)
+                        : (pose_a * a.sphereCenter() - pose_b * b_->sphereCenter()).norm() - a.sphereRadius() -
+                              b_->sphereRadius();
   if (!(lower >= enough)) {
     rung_ = Rung::Hulls;
-    lower = std::max(gjkLowerBound(a.hull(), pose_a, b.hull(), pose_b, tol, hull_, enough, relative), lower);
+    SimplexCache& cache = hullCache();
+    const double hulls =
+        shape_ ? std::visit([&](const auto& s) { return gjkLowerBound(a.hull(), pose_a, s, pose_b, tol, cache, enough, relative); }, *shape_)
+               : gjkLowerBound(a.hull(), pose_a, b_->hull(), pose_b, tol, cache, enough, relative);
+    lower = std::max(hulls, lower);
   }
-  if (!(lower <= climb) || mode == GeometryMode::Hull) return lower >= 0.0 ? lower : 0.0;
-  if (parts_stale_ || parts_.empty()) {  // (allocated when first needed: most pairs never get this far)
-    parts_.assign(a.parts().size() * b.parts().size(), SimplexCache{});
-    parts_stale_ = false;
-  }
+  if (!climbs(lower) || mode == GeometryMode::Hull) return lower >= 0.0 ? lower : 0.0;
   rung_ = Rung::Parts;
-  return std::max(partsLowerBound(a, pose_a, b, pose_b, tol, enough, relative, parts_.data()), lower);
+  if (shape_) return std::max(partsShapeBound(a, pose_a, *shape_, pose_b, tol, enough, relative), lower);
+  SimplexCache* caches = nullptr;  // (a pair whose hull warm start the caller keeps starts its parts cold)
+  if (!warm_) {
+    if (parts_stale_ || parts_.empty()) {  // (allocated when first needed: most pairs never get this far)
+      parts_.assign(a.parts().size() * b_->parts().size(), SimplexCache{});
+      parts_stale_ = false;
+    }
+    caches = parts_.data();
+  }
+  return std::max(partsLowerBound(a, pose_a, *b_, pose_b, tol, enough, relative, caches), lower);
 }
 
 double BodyPair::lowerBound(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol,
                             const BoundQuery& q) noexcept {
   if (!pose_a.isFinite() || !pose_b.isFinite()) return 0.0;
   const double climb = q.climb >= 0.0 ? q.climb : q.enough;
-  const double lower = convexBound(pose_a, pose_b, tol, q.enough, q.relative, climb, q.mode);
-  if (rung_ != Rung::Parts || !(lower <= climb)) return lower;
+  const GeometryMode mode = q.top <= Rung::Hulls ? GeometryMode::Hull : q.mode;
+  const double lower = convexBound(pose_a, pose_b, tol, q.enough, q.relative, climb, mode);
+  if (rung_ != Rung::Parts || !(lower <= climb) || !(lower < q.enough) || q.top < Rung::Exact) return lower;
   rung_ = Rung::Exact;
   const LinkGeometry& a = *a_;
-  const LinkGeometry& b = *b_;
   // The convex pieces are near, so the triangles are (and a fine mesh has many near): whether they lie
   // within `within` is a search that stops at the first pair; only if not, how far they are.
-  if (q.within >= 0.0 && meshesIntersect(a, pose_a, b, pose_b, tol, GeometryMode::Mesh, q.within)) return 0.0;
-  const DistanceResult m = meshDistance(a, pose_a, b, pose_b, tol, q.relative, std::min(q.enough, q.near));
+  if (q.within >= 0.0 && intersectsExactly(pose_a, pose_b, tol, q.within)) return 0.0;
+  const DistanceResult m = shape_ ? shapeLinkDistance(*shape_, pose_b, a, pose_a, tol, q.relative)
+                                  : meshDistance(a, pose_a, *b_, pose_b, tol, q.relative, std::min(q.enough, q.near));
   if (isFailure(m.status)) return 0.0;
   return q.within >= 0.0 ? std::max(m.lower_bound, q.within * margins::kBeyond) : m.lower_bound;
 }
@@ -519,7 +596,9 @@ double BodyPair::lowerBound(const Pose& pose_a, const Pose& pose_b, const Tolera
 double BodyPair::penetration(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol,
                               double padding) const noexcept {
   if (!(padding >= 0.0) || !std::isfinite(padding)) return std::numeric_limits<double>::quiet_NaN();
-  const PenetrationResult r = epaPenetration(a_->hull(), pose_a, b_->hull(), pose_b, tol);
+  const PenetrationResult r =
+      shape_ ? std::visit([&](const auto& s) { return epaPenetration(a_->hull(), pose_a, s, pose_b, tol); }, *shape_)
+             : epaPenetration(a_->hull(), pose_a, b_->hull(), pose_b, tol);
   if (isFailure(r.status)) return std::numeric_limits<double>::quiet_NaN();
   return std::max(0.0, padding - r.signed_distance);  // padded bodies may overlap with their hulls apart
 }
@@ -529,17 +608,22 @@ DistanceResult BodyPair::distance(const Pose& pose_a, const Pose& pose_b, const 
   // A finite cutoff lets the convex rungs answer first: bodies they prove at least the cutoff apart get
   // what meshDistance gives when no element pair is nearer (cutoff, points at A's origin), no triangle
   // touched. meshDistance's distance is at least any certified lower bound, so nothing else changes.
-  if (q.cutoff < std::numeric_limits<double>::infinity() && q.cutoff > 0.0 && q.relative >= 0.0 &&
-      std::isfinite(q.relative) && pose_a.isFinite() && pose_b.isFinite() &&
-      convexBound(pose_a, pose_b, tol, q.cutoff, 0.0, q.cutoff, GeometryMode::Mesh) >= q.cutoff) {
+  const auto atCutoff = [&] {
     DistanceResult r;
     r.distance = r.lower_bound = q.cutoff;
     r.point_a = r.point_b = pose_a.t;
     r.status = Status::Separated;
     return r;
-  }
+  };
+  if (q.cutoff < std::numeric_limits<double>::infinity() && q.cutoff > 0.0 && q.relative >= 0.0 &&
+      std::isfinite(q.relative) && pose_a.isFinite() && pose_b.isFinite() &&
+      convexBound(pose_a, pose_b, tol, q.cutoff, 0.0, q.cutoff, GeometryMode::Mesh) >= q.cutoff)
+    return atCutoff();
   rung_ = Rung::Exact;
-  return meshDistance(*a_, pose_a, *b_, pose_b, tol, q.relative, q.cutoff);
+  if (!shape_) return meshDistance(*a_, pose_a, *b_, pose_b, tol, q.relative, q.cutoff);
+  const DistanceResult r = swapped(shapeLinkDistance(*shape_, pose_b, *a_, pose_a, tol, q.relative));
+  // (As meshDistance's cutoff: nothing nearer than it, the cutoff.)
+  return !isFailure(r.status) && q.cutoff >= 0.0 && r.distance > q.cutoff ? atCutoff() : r;
 }
 
 }  // namespace clearway

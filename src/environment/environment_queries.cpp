@@ -53,12 +53,6 @@ double ballReach(const LinkGeometry& link, const Pose& pose) noexcept {
   return link.sphereRadius() * (1.0 + margins::kRounding) + margins::placedRounding(link.sphereCenter().norm(), pose.t.norm());
 }
 
-bool obstacleIntersects(const Obstacle& o, const Pose& pose_o, const LinkGeometry& link, const Pose& pose,
-                        const Tolerances& tol, GeometryMode mode, double padding) noexcept {
-  return o.mesh ? meshesIntersect(*o.mesh, pose_o, link, pose, tol, mode, padding)
-                : shapeIntersectsLink(o.shape, pose_o, link, pose, tol, mode, padding);
-}
-
 // Voxels passing the hull test that the Mesh mode checks one by one (each against the triangles near
 // it); beyond this many, descending the two trees together is cheaper than a triangle-tree query each.
 constexpr int kFewVoxels = 4;
@@ -141,6 +135,15 @@ struct Environment::Item {
   decltype(auto) convex(F&& f) const {
     return obstacle ? onConvex(*obstacle, f) : f(Box(voxel->halfExtents()));
   }
+  // f applied to the link's BodyPair with the item (a voxel as a box: a Shape holding a Box allocates nothing),
+  // its hulls' warm start `warm` when given.
+  template <class F>
+  decltype(auto) pairWith(const LinkGeometry& link, SimplexCache* warm, F&& f) const {
+    if (obstacle && obstacle->mesh) return f(BodyPair(link, *obstacle->mesh, warm));
+    if (obstacle) return f(BodyPair(link, obstacle->shape, warm));  // (its own shape: a copied hull would allocate)
+    const Shape box = Box(voxel->halfExtents());
+    return f(BodyPair(link, box, warm));
+  }
   // What a hit on it reports.
   EnvironmentHit hit() const noexcept {
     EnvironmentHit h;
@@ -179,6 +182,17 @@ Environment::Walk Environment::forEachItem(const Reach& reach, double t, F&& vis
                     : voxel_tree_->forEachWithin(*reach.local, *reach.pose, *reach.limit, on_voxel))
              ? Walk::Stopped
              : Walk::Done;
+}
+
+EnvironmentHit Environment::invalidMovingHit(double t) const noexcept {
+  EnvironmentHit h;
+  h.kind = EnvironmentHit::Kind::Obstacle;
+  for (const auto& o : moving_)
+    if (!poseAt(*o, t).isFinite()) {
+      h.obstacle = o.get();
+      break;
+    }
+  return h;
 }
 
 bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, GeometryMode mode,
@@ -228,8 +242,8 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
   const Walk walk = forEachItem(Reach::overlapping(query), t, [&](const Item& item) {
     if (item.index < 0) {  // an obstacle, or a voxel made by withPoints: on its own
       if (counters) ++counters->obstacle_tests;
-      if (item.obstacle ? !obstacleIntersects(*item.obstacle, item.pose, link, pose, tol, mode, padding)
-                        : !shapeIntersectsLink(Box(item.voxel->halfExtents()), item.pose, link, pose, tol, mode, padding))
+      const IntersectQuery q{padding, mode};
+      if (!item.pairWith(link, nullptr, [&](BodyPair pair) { return pair.intersects(pose, item.pose, tol, q); }))
         return false;
       found_obstacle = item.hit();
       return true;
@@ -253,15 +267,7 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
     passed[n_passed++] = item.index;
     return false;
   });
-  if (walk == Walk::Invalid) {  // a moving obstacle out of reach of the doubles: touching, never free
-    for (const auto& o : moving_)
-      if (!poseAt(*o, t).isFinite()) {
-        EnvironmentHit h;
-        h.kind = EnvironmentHit::Kind::Obstacle;
-        h.obstacle = o.get();
-        return report(h);
-      }
-  }
+  if (walk == Walk::Invalid) return report(invalidMovingHit(t));  // out of reach of the doubles: touching
   if (found_obstacle.kind != EnvironmentHit::Kind::None) return report(found_obstacle);
   if (!voxel_tree_) return false;
   const AabbTree& voxel_tree = *voxel_tree_;
@@ -382,71 +388,39 @@ DistanceResult Environment::linkDistance(const LinkGeometry& link, const Pose& p
   return r;
 }
 
-double Environment::hullLowerBound(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, double enough,
-                                   double relative, double t, EnvironmentCounters* counters,
-                                   SimplexCache* warm, bool by_parts) const noexcept {
-  if (!pose.isFinite() || !std::isfinite(t) || !(enough >= 0.0) || !(relative >= 0.0) || !std::isfinite(relative))
-    return 0.0;
-  // (No clearance grid here: it exists only once enough queries were asked, and a bound it settled could
-  // differ from the GJKs' within their relative error, so a segment's verdict would depend on history.)
-  const Vec3 centre = pose * link.sphereCenter();
-  const double reach = ballReach(link, pose);
-  double lower = enough;  // the least bound so far: items certainly beyond it cannot lower it
-  const auto measure = [&](const auto& shape, const Pose& pose_o, SimplexCache* cache) {
-    using S = std::decay_t<decltype(shape)>;
-    if constexpr (std::is_same_v<S, Box>) {
-      // The link's bounding ball (which holds its hull and its parts) against the box, in the box's frame:
-      // a box it shows beyond the bound so far cannot lower it, for a dozen operations where GJK costs
-      // hundreds.
-      // (The margin is far above the few roundings of the distance.)
-      const Vec3 c = pose_o.R.transpose() * (centre - pose_o.t);
-      const Vec3 gap = (c.cwiseAbs() - shape.half).cwiseMax(0.0);
-      const double margin =
-          margins::kSlack * (1.0 + c.cwiseAbs().maxCoeff() + pose_o.t.cwiseAbs().maxCoeff() + centre.cwiseAbs().maxCoeff());
-      // (Only below 1e150: a norm that overflowed would skip a box nearer than an infinite bound.)
-      if (lower < 1e150 && gap.norm() - reach - margin >= lower) return false;
-    }
-    SimplexCache cold;
-    if (by_parts) {  // (cold starts: callers ask only when the hull has come within contact)
-      for (const LinkGeometry::Part& part : link.parts()) {
-        cold = SimplexCache{};
-        lower = std::min(lower, gjkLowerBound(part.hull, pose, shape, pose_o, tol, cold, lower, relative));
-        if (!(lower > 0.0)) return true;
-      }
-      // The parts cover the link's surfaces, not a closed mesh's inside, where the item may lie.
-      // (The core's support point is a point of the item.)
-      if (link.solidCount() > 0 && link.containsPoint(relativePose(pose, pose_o) * shape.support(Vec3::UnitX()))) {
-        lower = 0.0;
-        return true;
-      }
-      return false;
-    }
-    lower = std::min(lower, gjkLowerBound(link.hull(), pose, shape, pose_o, tol, cache ? *cache : cold, lower, relative));
-    return !(lower > 0.0);
-  };
-  const Walk walk = forEachItem(Reach::within(link.bounds(), pose, lower), t, [&](const Item& item) {
-    if (!item.obstacle && counters) ++counters->voxel_tests;  // (as linkDistance counts: voxel hull tests)
-    SimplexCache* cache = warm && item.warm >= 0 ? warm + item.warm : nullptr;
-    return item.convex([&](const auto& s) { return measure(s, item.pose, cache); });
-  });
-  if (walk == Walk::Invalid) return 0.0;
-  return lower >= 0.0 ? lower : 0.0;  // (NaN: 0)
-}
-
 double Environment::lowerBound(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, const BoundQuery& q,
                                double t, SimplexCache* warm, EnvironmentHit* hit,
                                EnvironmentCounters* counters) const noexcept {
   if (hit) *hit = EnvironmentHit{};
-  const double climb = q.climb >= 0.0 ? q.climb : q.enough;
-  double lower = hullLowerBound(link, pose, tol, q.enough, q.relative, t, counters, warm);
-  if (!(lower <= climb) || q.mode == GeometryMode::Hull) return lower;
-  // (The bound so far second in max(): a NaN leaves it.)
-  lower = std::max(hullLowerBound(link, pose, tol, q.enough, q.relative, t, counters, nullptr, true), lower);
-  if (!(lower <= climb)) return lower;
-  if (q.within >= 0.0 && linkIntersects(link, pose, tol, GeometryMode::Mesh, q.within, t, hit, counters)) return 0.0;
-  const DistanceResult m = linkDistance(link, pose, tol, std::min(q.enough, q.near), t, q.relative, counters);
-  if (isFailure(m.status)) return 0.0;
-  return q.within >= 0.0 ? std::max(m.lower_bound, q.within * margins::kBeyond) : m.lower_bound;
+  if (!pose.isFinite() || !std::isfinite(t) || !(q.enough >= 0.0) || !(q.relative >= 0.0) || !std::isfinite(q.relative))
+    return 0.0;
+  // (No clearance grid here: it exists only once enough queries were asked, and a bound it settled could
+  // differ from the GJKs' within their relative error, so a segment's verdict would depend on history.)
+  // One walk: each item near the link climbs its own ladder, asked only to prove the least bound so far
+  // (items certainly beyond it cannot lower it, and are not visited).
+  double lower = q.enough;
+  BoundQuery item_q = q;
+  std::optional<Item> nearest;
+  const Walk walk = forEachItem(Reach::within(link.bounds(), pose, lower), t, [&](const Item& item) {
+    if (!item.obstacle && counters) ++counters->voxel_tests;  // (as linkDistance counts: voxel hull tests)
+    SimplexCache* cache = warm && item.warm >= 0 ? warm + item.warm : nullptr;
+    item_q.enough = lower;
+    double d = 0.0;
+    item.pairWith(link, cache, [&](BodyPair pair) {
+      d = pair.lowerBound(pose, item.pose, tol, item_q);
+      if (counters && pair.lastRung() == Rung::Exact) ++counters->distance_tests;
+    });
+    if (!(d < lower)) return false;  // (NaN: a failure, which BodyPair answers 0 for, never comes here)
+    lower = d;
+    nearest = item;
+    return !(lower > 0.0);
+  });
+  if (walk == Walk::Invalid) {  // a moving obstacle out of reach of the doubles: touching, never free
+    if (hit) *hit = invalidMovingHit(t);
+    return 0.0;
+  }
+  if (hit && nearest) *hit = nearest->hit();
+  return lower >= 0.0 ? lower : 0.0;  // (NaN: 0)
 }
 
 double Environment::linkCast(const LinkGeometry& link, const Pose& pose, const Vec3& velocity, double margin,
@@ -500,25 +474,16 @@ double Environment::linkPenetration(const LinkGeometry& link, const Pose& pose, 
   const Aabb link_box = transformed(link.bounds(), pose).inflated(padding);
   double deepest = 0.0;
   bool failed = false;
-  // One touching item: the hull's depth into it (EPA runs only here).
-  const auto depth = [&](const auto& shape, const Pose& pose_s) {
-    if (counters) ++counters->penetration_tests;
-    const PenetrationResult r = epaPenetration(link.hull(), pose, shape, pose_s, tol);
-    if (isFailure(r.status)) failed = true;
-    deepest = std::max(deepest, padding - r.signed_distance);  // padded links may touch with the hull apart
-  };
+  // Each touching item: the hulls' depth (EPA runs only there).
+  const IntersectQuery q{padding, GeometryMode::Mesh};
   const Walk walk = forEachItem(Reach::overlapping(link_box), t, [&](const Item& item) {
-    const Obstacle* o = item.obstacle;
-    if (o && o->mesh) {
-      if (meshesIntersect(link, pose, *o->mesh, item.pose, tol, GeometryMode::Mesh, padding)) depth(o->mesh->hull(), item.pose);
-      return false;
-    }
-    const auto visit = [&](const Shape& shape) {  // (by reference: a copied hull would allocate)
-      if (shapeIntersectsLink(shape, item.pose, link, pose, tol, GeometryMode::Mesh, padding))
-        std::visit([&](const auto& s) { depth(s, item.pose); }, shape);
-    };
-    if (o) visit(o->shape);
-    else visit(Box(item.voxel->halfExtents()));
+    item.pairWith(link, nullptr, [&](BodyPair pair) {
+      if (!pair.intersects(pose, item.pose, tol, q)) return;
+      if (counters) ++counters->penetration_tests;
+      const double d = pair.penetration(pose, item.pose, tol, padding);
+      if (std::isnan(d)) failed = true;
+      else deepest = std::max(deepest, d);
+    });
     return false;
   });
   if (walk == Walk::Invalid) return nan;

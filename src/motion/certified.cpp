@@ -256,18 +256,12 @@ struct MotionChecker::Sweep {
       SimplexCache* warm = ctx.warm_obstacles == sc.environment().staticCount()
                                ? warmStarts(ctx.env_cache, ctx.env_slot[e], ctx.env_stamp[e], ctx.warm_obstacles)
                                : nullptr;
-      EnvironmentHit hit;  // what lies within contact, when that settled it
+      EnvironmentHit hit;  // the item the bound came from: within contact when d is
       d = sc.environment().lowerBound(*it.ga, pa, tol, q, t, warm, &hit, &ctx.scene.counters.environment) - it.padding;
-      const bool found = hit.kind != EnvironmentHit::Kind::None;
       if (d <= contact && !head) {
         report = CollisionReport{};
         report.kind = CollisionReport::Kind::Environment;
         report.link = it.a;
-        // Which obstacle or voxel (for the report only): one within the contact distance, widened by the
-        // relative error the distance's lower bound was allowed.
-        if (!found)
-          sc.environment().linkIntersects(*it.ga, pa, tol, sc.options().mode,
-                                          it.padding + (contact + margins::kSlack) * (1.0 + relative), t, &hit);
         report.hit = hit;
       }
     }

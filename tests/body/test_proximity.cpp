@@ -1,7 +1,8 @@
 // BodyPair (body/proximity.h): the ladder's bound never exceeds the brute-force distance of
 // tests/tree/mesh_reference.h, `within` decides as the reference does, Hull mode is never tighter than
 // Mesh mode, forgetting the warm starts gives a fresh pair's answers bit for bit, a distance with a cutoff
-// is meshDistance's, and bad input is never "far".
+// is meshDistance's, a link against a convex shape answers as the shape queries, and bad input is never
+// "far".
 #include <clearway/body/proximity.h>
 
 #include <gtest/gtest.h>
@@ -10,6 +11,7 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "tree/mesh_reference.h"
@@ -149,6 +151,114 @@ TEST(BodyPair, ScreenThenTrianglesAnswerAsIntersects) {
   EXPECT_GT(counts[0], 0);
   EXPECT_GT(counts[1], 0);
   EXPECT_GT(counts[2], 0);
+}
+
+// The convex side (a link against an obstacle's primitive or a voxel's box) answers as the shape queries it
+// climbs to: intersects is shapeIntersectsLink's answer, the screen and the exact rung together the same,
+// the bound never exceeds shapeLinkDistance's distance and is tight within the relative error, `within`
+// decides as the distance does, the parts' rung is certified, distance is shapeLinkDistance's (A and B
+// exchanged), forgetting gives a fresh pair's answers bit for bit, and a shape inside a closed mesh is 0 away.
+TEST(BodyPair, ConvexSideAnswersAsTheShapeQueries) {
+  const std::vector<Named> m = meshes();
+  std::vector<LinkGeometry> g;
+  for (const Named& n : m) g.emplace_back(n.mesh);
+  const std::vector<std::pair<std::string, Shape>> shapes = {
+      {"box", Box(Vec3(0.05, 0.02, 0.08))},
+      {"sphere", Sphere(0.03)},
+      {"capsule", Capsule(0.02, 0.05)},
+      {"cylinder", Cylinder(0.04, 0.03)},
+      {"hull", ConvexHull({Vec3(0, 0, 0), Vec3(0.06, 0, 0), Vec3(0, 0.05, 0), Vec3(0, 0, 0.07), Vec3(0.03, 0.03, 0.03)})}};
+  const Tolerances tol;
+  std::mt19937_64 rng(29);
+  int cases = 0, exact = 0, within_hits = 0, within_clear = 0, touching = 0;
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    for (const auto& [name, shape] : shapes) {
+      BodyPair pair(g[i], shape);  // warm starts carried from case to case, as along a segment
+      SimplexCache kept;  // a hull warm start the caller keeps
+      const double reach = 1.2 * (tree_ref::meshRadius(m[i].mesh) + boundingRadius(shape));
+      for (int c = 0; c < 24; ++c, ++cases) {
+        const Pose pa = randomPose(rng, 0.1);
+        Pose pb = randomPose(rng, reach);
+        pb.t += pa.t;
+        const std::string what = m[i].name + " vs " + name + " case " + std::to_string(c);
+        const DistanceResult truth = shapeLinkDistance(shape, pb, g[i], pa, tol);
+        ASSERT_FALSE(isFailure(truth.status)) << what;
+        const double ref = truth.distance;
+        for (GeometryMode mode : {GeometryMode::Mesh, GeometryMode::Hull}) {
+          const IntersectQuery iq{c % 3 == 0 ? 0.01 : 0.0, mode};
+          const bool answer = shapeIntersectsLink(shape, pb, g[i], pa, tol, mode, iq.padding);
+          EXPECT_EQ(pair.intersects(pa, pb, tol, iq), answer) << what;
+          const Screen sc = pair.screen(pa, pb, tol, iq);
+          EXPECT_EQ(sc == Screen::Unsure ? pair.intersectsExactly(pa, pb, tol, iq.padding) : sc == Screen::Touching, answer)
+              << what;
+          if (mode == GeometryMode::Mesh && answer) ++touching;
+        }
+        BoundQuery q;
+        q.relative = 0.1;
+        const double full = pair.lowerBound(pa, pb, tol, q);
+        EXPECT_LE(full, ref + kBand) << what;
+        EXPECT_GE(full, ref / 1.1 - kBand) << what;
+        if (pair.lastRung() == Rung::Exact) ++exact;
+        kept = SimplexCache{};  // cold both: where the warm start lives changes nothing
+        EXPECT_EQ(BodyPair(g[i], shape, &kept).lowerBound(pa, pb, tol, q), BodyPair(g[i], shape).lowerBound(pa, pb, tol, q))
+            << what;
+        q.enough = 0.5 * ref;
+        const double part = pair.lowerBound(pa, pb, tol, q);
+        EXPECT_LE(part, ref + kBand) << what;
+        EXPECT_GE(part, std::min(q.enough, ref / 1.1) - kBand) << what;
+        BoundQuery rungs;
+        rungs.climb = INFINITY;
+        for (Rung top : {Rung::Hulls, Rung::Parts}) {
+          rungs.top = top;
+          EXPECT_LE(pair.lowerBound(pa, pb, tol, rungs), ref + kBand) << what;
+          EXPECT_LE(pair.lastRung(), top) << what;
+        }
+        BoundQuery near;
+        near.relative = 0.1;
+        near.within = 0.01;
+        near.climb = 0.01;
+        const double w = pair.lowerBound(pa, pb, tol, near);
+        if (ref < near.within - kBand) {
+          EXPECT_EQ(w, 0.0) << what;
+          ++within_hits;
+        } else if (ref > near.within + kBand) {
+          EXPECT_GT(w, near.within) << what << ": beyond `within` must compare beyond it";
+          EXPECT_LE(w, ref + kBand) << what;
+          ++within_clear;
+        }
+        pair.forget();
+        BodyPair fresh(g[i], shape);
+        EXPECT_EQ(pair.lowerBound(pa, pb, tol, near), fresh.lowerBound(pa, pb, tol, near)) << what;
+        const DistanceResult d = pair.distance(pa, pb, tol, {});
+        EXPECT_EQ(d.distance, ref) << what;
+        EXPECT_EQ(d.point_a, truth.point_b) << what << ": A is the link";
+        DistanceQuery cut;
+        cut.cutoff = 0.5 * ref;
+        if (ref > kBand) EXPECT_EQ(pair.distance(pa, pb, tol, cut).distance, cut.cutoff) << what;
+        const double depth = pair.penetration(pa, pb, tol, 0.0);
+        EXPECT_GE(depth, 0.0) << what;
+      }
+    }
+  }
+  std::printf("  %d cases: %d reached the exact geometry, %d touching, %d within 1 cm, %d beyond\n", cases, exact,
+              touching, within_hits, within_clear);
+  EXPECT_GT(exact, cases / 10);
+  EXPECT_GT(touching, cases / 10);
+  EXPECT_GT(within_hits, cases / 10);
+  EXPECT_GT(within_clear, cases / 10);
+  // A small box inside the closed sphere: the solid holds it, 0 apart on every rung from the parts up.
+  const Shape pebble = Box(Vec3(0.01, 0.01, 0.01));
+  BodyPair inside(g[0], pebble);
+  BoundQuery parts;
+  parts.top = Rung::Parts;
+  parts.climb = INFINITY;
+  EXPECT_EQ(inside.lowerBound(Pose(), Pose(), tol, parts), 0.0);
+  EXPECT_EQ(inside.lowerBound(Pose(), Pose(), tol, {}), 0.0);
+  EXPECT_TRUE(inside.intersects(Pose(), Pose(), tol, {}));
+  Pose bad;
+  bad.t.x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(inside.lowerBound(Pose(), bad, tol, {}), 0.0);
+  EXPECT_TRUE(inside.intersects(bad, Pose(), tol, {}));
 }
 
 TEST(BodyPair, PenetrationBoundsTheOverlap) {

@@ -104,6 +104,18 @@ Aabb cube(const Vec3& lo, double edge) { return Aabb::fromMinMax(lo, lo + Vec3::
 double volume(const Aabb& b) { return b.extents().prod(); }
 
 const Tolerances kTol;
+
+// The environment's lower bound climbing no higher than `top`, every rung up to it taken.
+double boundTo(const Environment& env, const LinkGeometry& link, const Pose& pose, double enough, double relative,
+               Rung top, SimplexCache* warm = nullptr) {
+  BoundQuery q;
+  q.enough = enough;
+  q.relative = relative;
+  q.top = top;
+  q.climb = INFINITY;
+  return env.lowerBound(link, pose, kTol, q, 0.0, warm);
+}
+
 constexpr double kPi = 3.14159265358979323846;
 constexpr GeometryMode kModes[] = {GeometryMode::Hull, GeometryMode::Mesh};
 
@@ -449,7 +461,7 @@ TEST(Environment, ObstacleInsideALink) {
     EXPECT_EQ(hit.obstacle->name, "pebble");
     EXPECT_EQ(env.linkDistance(*link, Pose(), kTol).distance, 0.0);
     EXPECT_EQ(env.linkDistance(*link, Pose(), kTol).lower_bound, 0.0);
-    EXPECT_EQ(env.hullLowerBound(*link, Pose(), kTol, 1.0, 0.1, 0.0, nullptr, nullptr, true), 0.0);
+    EXPECT_EQ(boundTo(env, *link, Pose(), 1.0, 0.1, Rung::Parts), 0.0);
   }
   EXPECT_TRUE(env.linkIntersects(open, Pose(), kTol, GeometryMode::Hull));
   EXPECT_FALSE(env.linkIntersects(open, Pose(), kTol, GeometryMode::Mesh));
@@ -481,7 +493,7 @@ TEST(Environment, ManyVoxelsInsideAMeshLink) {
     EXPECT_TRUE(env.linkIntersects(closed, Pose(), kTol, GeometryMode::Mesh, 0.0, 0.0, &inside));
     EXPECT_EQ(inside.kind, EnvironmentHit::Kind::Voxel);
     EXPECT_EQ(env.linkDistance(closed, Pose(), kTol).lower_bound, 0.0);
-    EXPECT_EQ(env.hullLowerBound(closed, Pose(), kTol, 1.0, 0.1, 0.0, nullptr, nullptr, true), 0.0);
+    EXPECT_EQ(boundTo(env, closed, Pose(), 1.0, 0.1, Rung::Parts), 0.0);
     EnvironmentCounters counters;
     EXPECT_TRUE(env.linkIntersects(surface, Pose(), kTol, GeometryMode::Hull));
     EXPECT_FALSE(env.linkIntersects(surface, Pose(), kTol, GeometryMode::Mesh, 0.0, 0.0, nullptr, &counters));
@@ -703,10 +715,10 @@ TEST(Environment, RandomLinksAgreeWithBruteForce) {
   EXPECT_GT(checked_distances, 50);
 }
 
-// The hull's lower bound against obstacles (boxes and box meshes) and voxels, from cold starts and from
+// The bound's hull and parts rungs against obstacles (boxes and box meshes) and voxels, from cold starts and from
 // warm starts carried along a path as a motion check carries them: certified (never above the nearest
 // hull distance), as tight as promised (within the relative error, or at least `enough`), both ways.
-TEST(Environment, HullLowerBoundIsCertifiedAndTightColdOrWarm) {
+TEST(Environment, LowerBoundRungsAreCertifiedAndTightColdOrWarm) {
   std::mt19937 rng(77);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   const auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * unit(rng); };
@@ -763,8 +775,8 @@ TEST(Environment, HullLowerBoundIsCertifiedAndTightColdOrWarm) {
     for (int step = 0; step < 40; ++step, pose.t += drift, pose.R = turn * pose.R) {
       const double truth = nearest(*link, pose);
       const double enough = step % 3 == 0 ? INFINITY : uniform(0.0, 0.3);
-      const double cold = env.hullLowerBound(*link, pose, kTol, enough, kRelative);
-      const double warmed = env.hullLowerBound(*link, pose, kTol, enough, kRelative, 0.0, nullptr, warm.data());
+      const double cold = boundTo(env, *link, pose, enough, kRelative, Rung::Hulls);
+      const double warmed = boundTo(env, *link, pose, enough, kRelative, Rung::Hulls, warm.data());
       const std::string what = "path " + std::to_string(path) + " step " + std::to_string(step);
       for (const double h : {cold, warmed}) {
         EXPECT_LE(h, truth + 1e-9) << what;
@@ -773,7 +785,7 @@ TEST(Environment, HullLowerBoundIsCertifiedAndTightColdOrWarm) {
       // By the convex parts: as certified and as tight against the parts' own nearest distance, which is
       // never below the hull's.
       const double parts_truth = nearestPart(*link, pose);
-      const double parts = env.hullLowerBound(*link, pose, kTol, enough, kRelative, 0.0, nullptr, warm.data(), true);
+      const double parts = boundTo(env, *link, pose, enough, kRelative, Rung::Parts, warm.data());
       EXPECT_GE(parts_truth, truth - 1e-9) << what;
       EXPECT_LE(parts, parts_truth + 1e-9) << what;
       EXPECT_GE(parts, std::min(enough, (1.0 - kRelative) * parts_truth) - 1e-9) << what;
@@ -791,10 +803,113 @@ TEST(Environment, HullLowerBoundIsCertifiedAndTightColdOrWarm) {
   }()});
   const LinkGeometry dumbbell(twoBoxes(Vec3(0.05, 0.05, 0.05), 0.2));
   ASSERT_GE(dumbbell.parts().size(), 2u);
-  EXPECT_EQ(between.hullLowerBound(dumbbell, Pose::identity(), kTol, INFINITY, kRelative), 0.0);
-  const double parts = between.hullLowerBound(dumbbell, Pose::identity(), kTol, INFINITY, kRelative, 0.0, nullptr, nullptr, true);
+  EXPECT_EQ(boundTo(between, dumbbell, Pose::identity(), INFINITY, kRelative, Rung::Hulls), 0.0);
+  const double parts = boundTo(between, dumbbell, Pose::identity(), INFINITY, kRelative, Rung::Parts);
   EXPECT_LE(parts, 0.1 + 1e-9);
   EXPECT_GE(parts, (1.0 - kRelative) * 0.1);
+}
+
+// The whole ladder against everything near the link, in one walk: never above the exact distance
+// (linkDistance), tight within the relative error, `within` deciding as linkIntersects does, the item the
+// bound came from named (and, when the bound is 0 within a contact distance, touching the link within it),
+// the same from cold and warm starts up to the relative error. Obstacles of every kind: boxes, spheres, box
+// meshes (closed), a moving box, map voxels, a point voxel.
+TEST(Environment, LowerBoundClimbsEachItemAndNamesIt) {
+  std::mt19937 rng(91);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * unit(rng); };
+  std::vector<Obstacle> obstacles;
+  Obstacle drifting;
+  drifting.name = "drifting";
+  drifting.shape = Box(Vec3(0.1, 0.05, 0.08));
+  drifting.pose = randomPose(uniform, 0.6);
+  drifting.velocity = Vec3(10.0, 0.0, 0.0);  // (measured at t = 0, and at 1e308 where it overflows)
+  obstacles.push_back(drifting);
+  for (int i = 0; i < 12; ++i) {
+    Obstacle o;
+    o.name = "o" + std::to_string(i);
+    const Vec3 half(uniform(0.02, 0.15), uniform(0.02, 0.15), uniform(0.02, 0.15));
+    if (i % 3 == 2) o.mesh = std::make_shared<const LinkGeometry>(boxSurface(half));
+    else if (i % 3 == 1) o.shape = Sphere(half.x());
+    else o.shape = Box(half);
+    o.pose = randomPose(uniform, 0.6);
+    obstacles.push_back(o);
+  }
+  const Environment base(obstacles, mapOf({cube(Vec3(0.5, 0.5, 0.5), 0.1), cube(Vec3(-0.6, 0.5, -0.6), 0.1),
+                                           cube(Vec3(-0.6, 0.4, -0.6), 0.1)}));
+  const Environment env = base.withPoints({Vec3(0.0, -0.55, 0.0)}, 0.05);
+  // Does the named item touch the link within `padding`? (Its own pair, asked exactly.)
+  const auto touches = [&](const EnvironmentHit& hit, const LinkGeometry& link, const Pose& pose, double padding) {
+    const IntersectQuery q{padding, GeometryMode::Mesh};
+    if (hit.kind == EnvironmentHit::Kind::Voxel) {
+      const Shape box = Box(hit.voxel.halfExtents());
+      return BodyPair(link, box).intersects(pose, Pose::translation(hit.voxel.center()), kTol, q);
+    }
+    if (!hit.obstacle) return false;
+    const Obstacle& o = *hit.obstacle;
+    return o.mesh ? BodyPair(link, *o.mesh).intersects(pose, o.pose, kTol, q)
+                  : BodyPair(link, o.shape).intersects(pose, o.pose, kTol, q);
+  };
+  constexpr double kRelative = 0.1, kWithin = 0.01, kBand = 1e-9;
+  int cases = 0, zero = 0, clear = 0, named_far = 0;
+  for (int path = 0; path < 12; ++path) {
+    const Vec3 half(uniform(0.02, 0.15), uniform(0.02, 0.15), uniform(0.02, 0.15));
+    std::unique_ptr<LinkGeometry> link =
+        path % 4 == 3 ? std::make_unique<LinkGeometry>(twoBoxes(half, 0.2)) : randomLink(path % 3, half);
+    std::vector<SimplexCache> warm(env.staticCount());
+    Pose pose = randomPose(uniform, 0.6);
+    const Vec3 drift(uniform(-0.02, 0.02), uniform(-0.02, 0.02), uniform(-0.02, 0.02));
+    for (int step = 0; step < 30; ++step, ++cases, pose.t += drift) {
+      const std::string what = "path " + std::to_string(path) + " step " + std::to_string(step);
+      const double truth = env.linkDistance(*link, pose, kTol).distance;
+      BoundQuery q;
+      q.relative = kRelative;
+      EnvironmentHit hit;
+      for (SimplexCache* w : {static_cast<SimplexCache*>(nullptr), warm.data()}) {
+        const double full = env.lowerBound(*link, pose, kTol, q, 0.0, w, &hit);
+        EXPECT_LE(full, truth + kBand) << what;
+        EXPECT_GE(full, truth / (1.0 + kRelative) - kBand) << what;
+        EXPECT_NE(hit.kind, EnvironmentHit::Kind::None) << what << ": a finite bound comes from an item";
+      }
+      BoundQuery hulls = q;
+      hulls.mode = GeometryMode::Hull;
+      EXPECT_LE(env.lowerBound(*link, pose, kTol, hulls, 0.0, warm.data()), truth + kBand) << what;
+      // Within a contact distance: 0 exactly when linkIntersects says so, and then the item named touches.
+      BoundQuery near = q;
+      near.within = kWithin;
+      near.climb = kWithin;
+      near.enough = 4.0 * kWithin;
+      const double w = env.lowerBound(*link, pose, kTol, near, 0.0, warm.data(), &hit);
+      const bool touching = env.linkIntersects(*link, pose, kTol, GeometryMode::Mesh, kWithin);
+      EXPECT_EQ(w == 0.0, touching) << what;
+      if (w == 0.0) {
+        ++zero;
+        EXPECT_TRUE(touches(hit, *link, pose, kWithin)) << what << ": the item named lies within the contact distance";
+      } else {
+        ++clear;
+        EXPECT_LE(w, truth + kBand) << what;
+        EXPECT_GT(w, kWithin) << what;
+        if (w < near.enough) {
+          EXPECT_NE(hit.kind, EnvironmentHit::Kind::None) << what;
+          ++named_far;
+        }
+      }
+    }
+  }
+  std::printf("  %d cases: %d within 1 cm, %d beyond (%d of them named)\n", cases, zero, clear, named_far);
+  EXPECT_GT(zero, cases / 8);
+  EXPECT_GT(clear, cases / 8);
+  // Nothing within enough: nothing named, the answer at least enough.
+  const LinkGeometry far_link = primitiveLink(Sphere(0.01));
+  BoundQuery q;
+  q.enough = 0.01;
+  EnvironmentHit hit;
+  EXPECT_GE(env.lowerBound(far_link, Pose::translation(Vec3(5, 5, 5)), kTol, q, 0.0, nullptr, &hit), 0.01);
+  EXPECT_EQ(hit.kind, EnvironmentHit::Kind::None);
+  // A moving obstacle out of reach of the doubles: 0, and it is named.
+  EXPECT_EQ(env.lowerBound(far_link, Pose::translation(Vec3(5, 5, 5)), kTol, q, 1e308, nullptr, &hit), 0.0);
+  ASSERT_NE(hit.obstacle, nullptr);
+  EXPECT_EQ(hit.obstacle->name, "drifting");
 }
 
 // ---- Casts: a translating link against obstacles and voxels -------------------------------------------

@@ -102,9 +102,13 @@ struct IntersectQuery {
   GeometryMode mode = GeometryMode::Mesh;  ///< Hull: the balls and hulls only (conservative)
 };
 
+/// The rungs of the ladder, cheapest first.
+enum class Rung : char { Balls, Hulls, Parts, Exact };
+
 /// What BodyPair::lowerBound asks: a certified lower bound on the distance, as cheap as it may be.
 struct BoundQuery {
-  /// A bound of at least this is all that is asked: each GJK stops once it proves it.
+  /// A bound of at least this is all that is asked: each GJK stops once it proves it, and no dearer rung
+  /// is climbed once the bound reaches it.
   double enough = std::numeric_limits<double>::infinity();
   /// Each GJK may stop once within this relative error of its distance (any value is safe: only lower
   /// bounds are used; looser ends each GJK sooner and sends more pairs down the ladder).
@@ -112,6 +116,8 @@ struct BoundQuery {
   GeometryMode mode = GeometryMode::Mesh;  ///< Hull: stop at the hulls
   /// A dearer rung is climbed only while the bound is at most this (below 0: while it is short of enough).
   double climb = -1.0;
+  /// The dearest rung climbed (a cheap bound: Hulls, Parts); Hull mode stops at the hulls whatever this says.
+  Rung top = Rung::Exact;
   /// ≥ 0: at the exact rung, first ask whether the bodies lie within this distance (a search that stops at
   /// the first touching pair, far cheaper near fine meshes than a distance): if so, the bound is 0; if not,
   /// it is above `within` (by a relative 1e-9, so that callers comparing with ≤ see it beyond).
@@ -126,23 +132,29 @@ struct DistanceQuery {
   double relative = 0.0;  ///< as meshDistance's relative_error
 };
 
-/// The rungs of the ladder, cheapest first.
-enum class Rung : char { Balls, Hulls, Parts, Exact };
-
-/// Two bodies (two links, or a link and a mesh obstacle) and the warm starts of their convex bounds. Made
-/// without allocating; the geometries must outlive it. Not thread-safe: one per pair and thread.
+/// Two bodies and the warm starts of their convex bounds: a link (A) and either another link or a mesh
+/// obstacle (B, a LinkGeometry), or a convex shape (B: an obstacle's primitive, a voxel's box), which has
+/// one convex piece, itself, for hull, part and exact geometry alike. Made without allocating; the
+/// geometries must outlive it. Not thread-safe: one per pair and thread.
 class BodyPair {
  public:
-  /// The pair of a and b (borrowed), with cold warm starts; allocates nothing.
-  BodyPair(const LinkGeometry& a, const LinkGeometry& b);
+  /// The pair of a and b (borrowed), with cold warm starts; allocates nothing. `hull_warm`, when given, is
+  /// where the hulls' warm start lives (the caller's, so that it outlives a pair made for one query); such
+  /// a pair keeps no warm starts of its own (its parts start cold).
+  BodyPair(const LinkGeometry& a, const LinkGeometry& b, SimplexCache* hull_warm = nullptr);
+  /// The link a against the convex shape b (placed by pose_b in every query), both borrowed; `hull_warm`
+  /// as above.
+  BodyPair(const LinkGeometry& a, const Shape& b, SimplexCache* hull_warm = nullptr);
 
   /// The first body, as given.
   const LinkGeometry& a() const noexcept { return *a_; }
-  /// The second body, as given.
-  const LinkGeometry& b() const noexcept { return *b_; }
+  /// The second body of a pair of links (null for a convex shape).
+  const LinkGeometry* b() const noexcept { return b_; }
+  /// The second body of a link and a convex shape (null for a pair of links).
+  const Shape* shape() const noexcept { return shape_; }
 
-  /// True when the bodies (placed by the poses) are within q.padding of each other: meshesIntersect, warm.
-  /// Never "free" by accident (non-finite input, a narrow-phase failure: true).
+  /// True when the bodies (placed by the poses) are within q.padding of each other: meshesIntersect (or
+  /// shapeIntersectsLink), warm. Never "free" by accident (non-finite input, a narrow-phase failure: true).
   bool intersects(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, const IntersectQuery& q) noexcept;
   /// intersects() split in two: its rungs short of the triangles (screenMeshes, warm), then, for an Unsure
   /// pair, the triangles (meshesIntersectExactly). Together they answer as intersects() does.
@@ -156,8 +168,9 @@ class BodyPair {
   /// apart than padding): the hulls' EPA depth plus padding, the hulls containing the bodies. NaN when EPA
   /// fails or the input is not finite (never a depth of 0 by accident).
   double penetration(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, double padding = 0.0) const noexcept;
-  /// The distance between the exact geometries: meshDistance's answer, but with a finite q.cutoff the balls,
-  /// hulls and parts (warm) are asked first, and bodies they prove that far apart answer the cutoff at once.
+  /// The distance between the exact geometries (normal from A towards B): meshDistance's answer (or
+  /// shapeLinkDistance's), but with a finite q.cutoff the balls, hulls and parts (warm) are asked first,
+  /// and bodies they prove that far apart answer the cutoff at once.
   DistanceResult distance(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol,
                           const DistanceQuery& q) noexcept;
 
@@ -165,7 +178,7 @@ class BodyPair {
   /// depend on nothing asked before.
   void forget() noexcept;
   /// The hulls' last GJK axis (valid once a query has reached the hulls).
-  const SimplexCache& hullAxis() const noexcept { return hull_; }
+  const SimplexCache& hullAxis() const noexcept { return warm_ ? *warm_ : hull_; }
   /// The rung the last lowerBound() or distance() stopped at.
   Rung lastRung() const noexcept { return rung_; }
 
@@ -173,9 +186,12 @@ class BodyPair {
   // The balls, the hulls, then (in Mesh mode, while the bound is at most `climb`) the convex parts; sets rung_.
   double convexBound(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, double enough, double relative,
                      double climb, GeometryMode mode) noexcept;
+  SimplexCache& hullCache() noexcept { return warm_ ? *warm_ : hull_; }
 
   const LinkGeometry* a_;
-  const LinkGeometry* b_;
+  const LinkGeometry* b_ = nullptr;
+  const Shape* shape_ = nullptr;
+  SimplexCache* warm_ = nullptr;
   SimplexCache hull_;
   std::vector<SimplexCache> parts_;  // a's part i against b's part j at i·nb + j
   bool parts_stale_ = false;

@@ -164,25 +164,17 @@ class Environment {
                               double relative_error = 0.0, EnvironmentCounters* counters = nullptr,
                               GeometryMode mode = GeometryMode::Mesh) const noexcept;
 
-  /// A certified lower bound on the distance from the link's convex hull to the nearest obstacle (a mesh
-  /// obstacle's hull) or voxel, computed only as far as `enough`: the answer is at least `enough` when
-  /// nothing is nearer. One GJK per item within reach of the link's oriented box, each stopping once it
-  /// proves the item beyond the nearest so far, or within `relative` of its distance. Conservative
-  /// advancement needs no more. 0 for non-finite input or when the hull touches. `warm`, if given, holds
-  /// staticCount() GJK warm starts for this link, one per non-moving obstacle in the order given.
-  /// by_parts: the least over the link's convex parts instead of its hull (tighter where the link is
-  /// concave, up to kMaxParts GJKs per item; `warm` is then not used).
-  double hullLowerBound(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, double enough,
-                        double relative, double t = 0.0, EnvironmentCounters* counters = nullptr,
-                        SimplexCache* warm = nullptr, bool by_parts = false) const noexcept;
-  /// BodyPair::lowerBound's ladder against everything near the link, at time t: the hull's bound (with the
-  /// warm starts `warm`, as hullLowerBound takes them), the convex parts' (Mesh mode), then the exact
-  /// geometry (q.within, q.near as there); `hit` (optional) names what lies within q.within when that
-  /// settles it. 0 for non-finite input or a failed query.
+  /// A certified lower bound on the distance from the link to the nearest obstacle or voxel at time t,
+  /// computed only as far as q.enough (the answer is at least q.enough when nothing is nearer): one walk,
+  /// each item within reach of the link's oriented box climbing BodyPair::lowerBound's ladder (the balls,
+  /// the hulls, the link's convex parts, the exact geometry; q as there), asked to prove only the least
+  /// bound so far. `warm`, if given, holds staticCount() hull warm starts for this link, one per static
+  /// obstacle. `hit` (optional) names the item the bound came from when one came below q.enough. 0 for
+  /// non-finite input or a failed query.
   double lowerBound(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, const BoundQuery& q,
                     double t = 0.0, SimplexCache* warm = nullptr, EnvironmentHit* hit = nullptr,
                     EnvironmentCounters* counters = nullptr) const noexcept;
-  /// How many warm starts hullLowerBound takes: one slot per static obstacle (slots of removed obstacles
+  /// How many warm starts lowerBound takes: one slot per static obstacle (slots of removed obstacles
   /// are reused by those added later).
   std::size_t staticCount() const noexcept { return static_cast<std::size_t>(slot_count_); }
 
@@ -209,6 +201,8 @@ class Environment {
   enum class Walk { Done, Stopped, Invalid };
   template <class F>
   Walk forEachItem(const Reach& reach, double t, F&& visit) const;
+  // What a walk stopped by a moving obstacle out of reach of the doubles at time t reports: that obstacle.
+  EnvironmentHit invalidMovingHit(double t) const noexcept;
 
   // A static obstacle in the tree, with its warm-start slot; or a voxel made by withPoints: no obstacle,
   // slot −1, the item's box its cell (a cloud's million voxels, each a small node and nothing more).
