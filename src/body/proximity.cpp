@@ -603,6 +603,17 @@ double BodyPair::penetration(const Pose& pose_a, const Pose& pose_b, const Toler
   return std::max(0.0, padding - r.signed_distance);  // padded bodies may overlap with their hulls apart
 }
 
+CastResult BodyPair::cast(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol,
+                          const CastQuery& q) const noexcept {
+  if (!pose_a.isFinite() || !pose_b.isFinite() || !q.velocity.allFinite() || !(q.margin >= 0.0) ||
+      !std::isfinite(q.margin) || !(q.max_s >= 0.0) || !std::isfinite(q.max_s))
+    return CastResult{};  // (hit at 0)
+  const Margin<ConvexHull> grown{a_->hull(), q.margin};
+  if (!shape_) return gjkShapeCast(grown, pose_a, q.velocity, b_->hull(), pose_b, q.max_s, tol);
+  return std::visit([&](const auto& s) { return gjkShapeCast(grown, pose_a, q.velocity, s, pose_b, q.max_s, tol); },
+                    *shape_);
+}
+
 DistanceResult BodyPair::distance(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol,
                                   const DistanceQuery& q) noexcept {
   // A finite cutoff lets the convex rungs answer first: bodies they prove at least the cutoff apart get

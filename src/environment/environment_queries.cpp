@@ -436,31 +436,29 @@ double Environment::linkCast(const LinkGeometry& link, const Pose& pose, const V
   swept.max += (max_s * velocity).cwiseMax(Vec3::Zero());
   const double band = cullBand(scale_ + maxAbs(swept), tol);
   swept = swept.inflated(band);
-  const Margin<ConvexHull> grown{link.hull(), margin};
   double first = kNone;
   // One candidate: the slab test of the moving box against its box first (the s interval where they
-  // overlap), then the cast, only as far as the earliest hit so far.
-  const auto visit = [&](const Aabb& box, const auto& shape, const Pose& pose_o) {
+  // overlap), then the pair's cast, only as far as the earliest hit so far.
+  const Walk walk = forEachItem(Reach::overlapping(swept), t, [&](const Item& item) {
+    const Aabb box = item.box();
     const double limit = std::min(first, max_s);
     double enter = 0.0, leave = limit;
     for (int i = 0; i < 3 && enter <= leave; ++i) {
       const double lo = box.min[i] - band - start.max[i], hi = box.max[i] + band - start.min[i];  // overlap: lo ≤ s·v ≤ hi
       const double v = velocity[i];
       if (v == 0.0) {
-        if (lo > 0.0 || hi < 0.0) return;
+        if (lo > 0.0 || hi < 0.0) return false;
       } else {
         const double a = lo / v, b = hi / v;
         enter = std::max(enter, std::min(a, b));
         leave = std::min(leave, std::max(a, b));
       }
     }
-    if (!(enter <= leave)) return;
+    if (!(enter <= leave)) return false;
     if (counters) ++counters->cast_tests;
-    const CastResult c = gjkShapeCast(grown, pose, velocity, shape, pose_o, limit, tol);
+    const CastQuery q{velocity, margin, limit};
+    const CastResult c = item.pairWith(link, nullptr, [&](const BodyPair& pair) { return pair.cast(pose, item.pose, tol, q); });
     if (c.hit) first = std::min(first, std::max(0.0, c.t));
-  };
-  const Walk walk = forEachItem(Reach::overlapping(swept), t, [&](const Item& item) {
-    item.convex([&](const auto& shape) { visit(item.box(), shape, item.pose); });
     return false;
   });
   if (walk == Walk::Invalid) return 0.0;

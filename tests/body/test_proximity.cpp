@@ -1,8 +1,8 @@
 // BodyPair (body/proximity.h): the ladder's bound never exceeds the brute-force distance of
 // tests/tree/mesh_reference.h, `within` decides as the reference does, Hull mode is never tighter than
 // Mesh mode, forgetting the warm starts gives a fresh pair's answers bit for bit, a distance with a cutoff
-// is meshDistance's, a link against a convex shape answers as the shape queries, and bad input is never
-// "far".
+// is meshDistance's, a link against a convex shape answers as the shape queries, a cast never passes the
+// first contact, and bad input is never "far".
 #include <clearway/body/proximity.h>
 
 #include <gtest/gtest.h>
@@ -259,6 +259,62 @@ TEST(BodyPair, ConvexSideAnswersAsTheShapeQueries) {
   bad.t.x() = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(inside.lowerBound(Pose(), bad, tol, {}), 0.0);
   EXPECT_TRUE(inside.intersects(bad, Pose(), tol, {}));
+}
+
+// A cast: the link's hull, grown by a margin, translating against a convex shape or another link held still.
+// Where it reports no contact before s, the grown hulls are apart at every sampled s' < s (a certified lower
+// bound on the first contact); where it reports a hit within reach, they touch there (within the band);
+// bad input is a hit at 0.
+TEST(BodyPair, CastBoundsTheFirstContact) {
+  const std::vector<Named> m = meshes();
+  std::vector<LinkGeometry> g;
+  for (const Named& n : m) g.emplace_back(n.mesh);
+  const Shape box = Box(Vec3(0.05, 0.1, 0.02));
+  const Tolerances tol;
+  std::mt19937_64 rng(41);
+  int hits = 0, clear = 0;
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    for (int c = 0; c < 40; ++c) {
+      const bool links = c % 2 == 1;
+      const BodyPair pair = links ? BodyPair(g[i], g[(i + 1) % g.size()]) : BodyPair(g[i], box);
+      const Pose pa = randomPose(rng, 0.1);
+      const Pose pb = randomPose(rng, 0.3);
+      CastQuery q;
+      q.velocity = (pb.t - pa.t) + tree_ref::randomInBall(rng, 0.2);
+      q.margin = c % 3 == 0 ? 0.01 : 0.0;
+      q.max_s = 1.5;
+      const std::string what = m[i].name + (links ? " vs the next mesh" : " vs a box") + " case " + std::to_string(c);
+      const CastResult r = pair.cast(pa, pb, tol, q);
+      ASSERT_FALSE(isFailure(r.status)) << what;
+      const double first = r.hit ? r.t : q.max_s;
+      // The hulls grown by the margin, A moved by s·velocity: apart before the first contact.
+      const auto gap = [&](double s) {
+        const Pose moved = Pose::translation(s * q.velocity) * pa;
+        return links ? gjkDistance(g[i].hull(), moved, g[(i + 1) % g.size()].hull(), pb, tol).distance - q.margin
+                     : std::visit([&](const auto& b) { return gjkDistance(g[i].hull(), moved, b, pb, tol).distance; }, box) -
+                           q.margin;
+      };
+      if (first > 0.0)  // (s strictly before the first contact)
+        for (int k = 0; k < 16; ++k) EXPECT_GT(gap(first * k / 16.0 * (1.0 - 1e-6)), -1e-9) << what << " sample " << k;
+      if (r.hit && r.t > 0.0) {
+        EXPECT_LT(gap(r.t), 1e-5) << what << ": a hit touches";
+        ++hits;
+      } else if (!r.hit) {
+        ++clear;
+      }
+    }
+  }
+  std::printf("  %d casts hit, %d clear\n", hits, clear);
+  EXPECT_GT(hits, 20);
+  EXPECT_GT(clear, 10);
+  Pose bad;
+  bad.t.x() = std::numeric_limits<double>::quiet_NaN();
+  CastQuery q;
+  q.velocity = Vec3(1, 0, 0);
+  const BodyPair pair(g[0], box);
+  EXPECT_TRUE(pair.cast(bad, Pose::translation(Vec3(5, 0, 0)), tol, q).hit);
+  q.margin = -1.0;
+  EXPECT_TRUE(pair.cast(Pose(), Pose::translation(Vec3(5, 0, 0)), tol, q).hit);
 }
 
 TEST(BodyPair, PenetrationBoundsTheOverlap) {

@@ -4,6 +4,7 @@
 // exact triangles and primitives (closed meshes as solids). A query stops at the first rung that settles
 // it. A BodyPair keeps the pair's GJK warm starts from one query to the next.
 #include <clearway/body/link_geometry.h>
+#include <clearway/narrowphase/ray_cast.h>
 
 #include <limits>
 #include <vector>
@@ -132,6 +133,14 @@ struct DistanceQuery {
   double relative = 0.0;  ///< as meshDistance's relative_error
 };
 
+/// What BodyPair::cast asks: A's hull, grown by `margin`, translating by s·velocity (the poses' frame),
+/// s ∈ [0, max_s], B held.
+struct CastQuery {
+  Vec3 velocity = Vec3::Zero();  ///< A's translation per unit of s
+  double margin = 0.0;           ///< metres A's hull is grown by (≥ 0)
+  double max_s = 1.0;            ///< the sweep ends at s = max_s
+};
+
 /// Two bodies and the warm starts of their convex bounds: a link (A) and either another link or a mesh
 /// obstacle (B, a LinkGeometry), or a convex shape (B: an obstacle's primitive, a voxel's box), which has
 /// one convex piece, itself, for hull, part and exact geometry alike. Made without allocating; the
@@ -173,6 +182,11 @@ class BodyPair {
   /// and bodies they prove that far apart answer the cutoff at once.
   DistanceResult distance(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol,
                           const DistanceQuery& q) noexcept;
+
+  /// The first s at which A's hull (grown by q.margin), moving by s·q.velocity, touches B's hull (a shape:
+  /// itself): gjkShapeCast's answer, a certified lower bound on when the bodies meet. Hit at 0 on a failure
+  /// or non-finite input (never "clear" by accident).
+  CastResult cast(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, const CastQuery& q) const noexcept;
 
   /// Drops the warm starts (O(1): the parts' are emptied when next used), so that the next answers
   /// depend on nothing asked before.
