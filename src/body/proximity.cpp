@@ -461,19 +461,20 @@ namespace {
 
 // A lower bound on the distance from the link's bounding ball (placed by pose_a) to the convex shape: the
 // ball against the shape's own ball and against its box (in its frame), a dozen operations where GJK costs
-// hundreds. The ball is grown by the rounding of placing its centre, the gap shrunk by that of the box test.
+// hundreds. The ball is grown by the rounding of placing its centre, both gaps shrunk by that of measuring them.
 double ballShapeGap(const LinkGeometry& a, const Pose& pose_a, const Shape& b, const Pose& pose_b) noexcept {
   // (A hull's ball and box cost a pass over its vertices: GJK, warm, costs less.)
   if (std::holds_alternative<ConvexHull>(b)) return -std::numeric_limits<double>::infinity();
   const Vec3 centre = pose_a * a.sphereCenter();
   const double reach =
       a.sphereRadius() * (1.0 + margins::kRounding) + margins::placedRounding(a.sphereCenter().norm(), pose_a.t.norm());
-  const double balls = (centre - pose_b.t).norm() - reach - boundingRadius(b) * (1.0 + margins::kRounding);
-  const Aabb box = localBox(b);
   const Vec3 c = pose_b.R.transpose() * (centre - pose_b.t);
-  const Vec3 gap = (box.min - c).cwiseMax(c - box.max).cwiseMax(0.0);
+  // (The margin is far above the few roundings of either distance.)
   const double margin =
       margins::kSlack * (1.0 + c.cwiseAbs().maxCoeff() + pose_b.t.cwiseAbs().maxCoeff() + centre.cwiseAbs().maxCoeff());
+  const double balls = (centre - pose_b.t).norm() - reach - boundingRadius(b) * (1.0 + margins::kRounding) - margin;
+  const Aabb box = localBox(b);
+  const Vec3 gap = (box.min - c).cwiseMax(c - box.max).cwiseMax(0.0);
   const double boxed = gap.norm() - reach - margin;
   // (A norm that overflowed is no bound: only finite gaps count; a NaN gives way to the other.)
   const double x = std::isfinite(boxed) ? boxed : -std::numeric_limits<double>::infinity();
@@ -489,7 +490,9 @@ double partsShapeBound(const LinkGeometry& a, const Pose& pose_a, const Shape& b
   double best = enough;
   const double rb = boundingRadius(b);
   for (const LinkGeometry::Part& part : a.parts()) {
-    if ((pose_a * part.center - pose_b.t).norm() - part.radius - rb >= best) continue;
+    const Vec3 centre = pose_a * part.center;  // (the margin is far above the rounding of the gap)
+    const double margin = margins::kSlack * (1.0 + centre.cwiseAbs().maxCoeff() + pose_b.t.cwiseAbs().maxCoeff());
+    if ((centre - pose_b.t).norm() - part.radius - rb - margin >= best) continue;
     SimplexCache cold;
     best = std::min(best, std::visit([&](const auto& s) { return gjkLowerBound(part.hull, pose_a, s, pose_b, tol, cold, best, relative); }, b));
     if (!(best > 0.0)) return 0.0;
