@@ -629,6 +629,13 @@ DistanceResult BodyPair::distance(const Pose& pose_a, const Pose& pose_b, const 
     r.status = Status::Separated;
     return r;
   };
+  if (q.mode == GeometryMode::Hull) {
+    rung_ = Rung::Hulls;
+    const DistanceResult r =
+        shape_ ? std::visit([&](const auto& s) { return gjkDistance(a_->hull(), pose_a, s, pose_b, tol); }, *shape_)
+               : gjkDistance(a_->hull(), pose_a, b_->hull(), pose_b, tol);
+    return !isFailure(r.status) && r.distance > q.cutoff ? atCutoff() : r;
+  }
   if (q.cutoff < std::numeric_limits<double>::infinity() && q.cutoff > 0.0 && q.relative >= 0.0 &&
       std::isfinite(q.relative) && pose_a.isFinite() && pose_b.isFinite() &&
       convexBound(pose_a, pose_b, tol, q.cutoff, 0.0, q.cutoff, GeometryMode::Mesh) >= q.cutoff)

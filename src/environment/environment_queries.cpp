@@ -35,12 +35,6 @@ using environment_detail::maxAbs;
 using environment_detail::obstacleBox;
 using environment_detail::shapeWorldBox;
 
-// f applied to the obstacle as a convex shape: a mesh obstacle's hull, or its primitive.
-template <class F>
-decltype(auto) onConvex(const Obstacle& o, F&& f) {
-  return o.mesh ? f(o.mesh->hull()) : std::visit(f, o.shape);
-}
-
 Pose poseAt(const Obstacle& o, double t) noexcept {
   Pose p = o.pose;
   if (o.moving()) p.t += t * o.velocity;
@@ -88,13 +82,6 @@ struct NearestSearch {
   }
 };
 
-// A distance with A and B exchanged.
-DistanceResult swapped(DistanceResult r) noexcept {
-  std::swap(r.point_a, r.point_b);
-  r.normal = -r.normal;
-  return r;
-}
-
 }  // namespace
 
 // Which items a query visits: those whose boxes overlap a world box, or those within `limit` of the link's
@@ -130,11 +117,6 @@ struct Environment::Item {
   int warm;                    // a static obstacle's warm-start slot, else −1
 
   Aabb box() const noexcept { return obstacle ? obstacleBox(*obstacle, pose) : *voxel; }
-  // f applied to the item as a convex shape: a mesh obstacle's hull, a primitive, a voxel's box.
-  template <class F>
-  decltype(auto) convex(F&& f) const {
-    return obstacle ? onConvex(*obstacle, f) : f(Box(voxel->halfExtents()));
-  }
   // f applied to the link's BodyPair with the item (a voxel as a box: a Shape holding a Box allocates nothing),
   // its hulls' warm start `warm` when given.
   template <class F>
@@ -195,9 +177,12 @@ EnvironmentHit Environment::invalidMovingHit(double t) const noexcept {
   return h;
 }
 
-bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, GeometryMode mode,
-                                 double padding, double t, EnvironmentHit* hit,
-                                 EnvironmentCounters* counters) const noexcept {
+bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, const Tolerances& tol,
+                                 const IntersectQuery& q, const EnvironmentQuery& at) const noexcept {
+  const double padding = q.padding, t = at.t;
+  const GeometryMode mode = q.mode;
+  EnvironmentHit* const hit = at.hit;
+  EnvironmentCounters* const counters = at.counters;
   if (hit) *hit = EnvironmentHit{};
   if (!pose.isFinite() || !(padding >= 0.0) || !std::isfinite(padding) || !std::isfinite(t)) return true;
   const auto report = [&](const EnvironmentHit& h) {
@@ -242,7 +227,6 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
   const Walk walk = forEachItem(Reach::overlapping(query), t, [&](const Item& item) {
     if (item.index < 0) {  // an obstacle, or a voxel made by withPoints: on its own
       if (counters) ++counters->obstacle_tests;
-      const IntersectQuery q{padding, mode};
       if (!item.pairWith(link, nullptr, [&](BodyPair pair) { return pair.intersects(pose, item.pose, tol, q); }))
         return false;
       found_obstacle = item.hit();
@@ -350,8 +334,10 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
 }
 
 DistanceResult Environment::linkDistance(const LinkGeometry& link, const Pose& pose, const Tolerances& tol,
-                                         double cutoff, double t, double relative_error,
-                                         EnvironmentCounters* counters, GeometryMode mode) const noexcept {
+                                         const DistanceQuery& q, const EnvironmentQuery& at) const noexcept {
+  const double cutoff = q.cutoff, t = at.t, relative_error = q.relative;
+  const GeometryMode mode = q.mode;
+  EnvironmentCounters* const counters = at.counters;
   if (!pose.isFinite() || !std::isfinite(t) || !(cutoff >= 0.0) || !(relative_error >= 0.0) ||
       !std::isfinite(relative_error)) {
     DistanceResult r;
@@ -360,19 +346,21 @@ DistanceResult Environment::linkDistance(const LinkGeometry& link, const Pose& p
   }
   NearestSearch search(cutoff, relative_error);
 
-  // One item: the hull's lower bound first (one GJK), the exact geometry only when it may be nearer. The
-  // link's box as an oriented box sees items much nearer than its world box admits.
+  // One item: the hulls' distance first (one GJK), the exact geometry only when it may be nearer. The
+  // link's box as an oriented box sees items much nearer than its world box admits. (The exact distance is
+  // asked with no cutoff: a cut-off answer carries no witness points, and could still become the best.)
+  DistanceQuery hulls;
+  hulls.mode = GeometryMode::Hull;
+  DistanceQuery exact;
+  exact.relative = relative_error;
   const Walk walk = forEachItem(Reach::within(link.bounds(), pose, search.limit), t, [&](const Item& item) {
-    const DistanceResult hull = item.convex([&](const auto& s) { return gjkDistance(link.hull(), pose, s, item.pose, tol); });
-    if (!isFailure(hull.status) && hull.lower_bound >= search.limit) return false;
-    if (mode == GeometryMode::Hull) return search.add(hull);
-    if (counters) ++counters->distance_tests;
-    if (item.obstacle && item.obstacle->mesh)
-      return search.add(meshDistance(link, pose, *item.obstacle->mesh, item.pose, tol, relative_error));
-    // (The obstacle's own shape by reference: a copy of a hull would allocate per item.)
-    if (item.obstacle)
-      return search.add(swapped(shapeLinkDistance(item.obstacle->shape, item.pose, link, pose, tol, relative_error)));
-    return search.add(swapped(shapeLinkDistance(Box(item.voxel->halfExtents()), item.pose, link, pose, tol, relative_error)));
+    return item.pairWith(link, nullptr, [&](BodyPair pair) {
+      const DistanceResult hull = pair.distance(pose, item.pose, tol, hulls);
+      if (!isFailure(hull.status) && hull.lower_bound >= search.limit) return false;
+      if (mode == GeometryMode::Hull) return search.add(hull);
+      if (counters) ++counters->distance_tests;
+      return search.add(pair.distance(pose, item.pose, tol, exact));
+    });
   });
   if (walk == Walk::Invalid) search.failed = true;
 
@@ -389,8 +377,11 @@ DistanceResult Environment::linkDistance(const LinkGeometry& link, const Pose& p
 }
 
 double Environment::lowerBound(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, const BoundQuery& q,
-                               double t, SimplexCache* warm, EnvironmentHit* hit,
-                               EnvironmentCounters* counters) const noexcept {
+                               const EnvironmentQuery& at) const noexcept {
+  const double t = at.t;
+  SimplexCache* const warm = at.warm;
+  EnvironmentHit* const hit = at.hit;
+  EnvironmentCounters* const counters = at.counters;
   if (hit) *hit = EnvironmentHit{};
   if (!pose.isFinite() || !std::isfinite(t) || !(q.enough >= 0.0) || !(q.relative >= 0.0) || !std::isfinite(q.relative))
     return 0.0;
@@ -423,9 +414,11 @@ double Environment::lowerBound(const LinkGeometry& link, const Pose& pose, const
   return lower >= 0.0 ? lower : 0.0;  // (NaN: 0)
 }
 
-double Environment::linkCast(const LinkGeometry& link, const Pose& pose, const Vec3& velocity, double margin,
-                             const Tolerances& tol, double max_s, double t,
-                             EnvironmentCounters* counters) const noexcept {
+double Environment::linkCast(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, const CastQuery& q,
+                             const EnvironmentQuery& at) const noexcept {
+  const Vec3& velocity = q.velocity;
+  const double margin = q.margin, max_s = q.max_s, t = at.t;
+  EnvironmentCounters* const counters = at.counters;
   constexpr double kNone = std::numeric_limits<double>::infinity();
   if (!pose.isFinite() || !velocity.allFinite() || !(margin >= 0.0) || !std::isfinite(margin) || !std::isfinite(t) ||
       !(max_s >= 0.0) || !std::isfinite(max_s))
@@ -456,8 +449,9 @@ double Environment::linkCast(const LinkGeometry& link, const Pose& pose, const V
     }
     if (!(enter <= leave)) return false;
     if (counters) ++counters->cast_tests;
-    const CastQuery q{velocity, margin, limit};
-    const CastResult c = item.pairWith(link, nullptr, [&](const BodyPair& pair) { return pair.cast(pose, item.pose, tol, q); });
+    const CastQuery item_q{velocity, margin, limit};
+    const CastResult c =
+        item.pairWith(link, nullptr, [&](const BodyPair& pair) { return pair.cast(pose, item.pose, tol, item_q); });
     if (c.hit) first = std::min(first, std::max(0.0, c.t));
     return false;
   });
@@ -466,7 +460,9 @@ double Environment::linkCast(const LinkGeometry& link, const Pose& pose, const V
 }
 
 double Environment::linkPenetration(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, double padding,
-                                    double t, EnvironmentCounters* counters) const noexcept {
+                                    const EnvironmentQuery& at) const noexcept {
+  const double t = at.t;
+  EnvironmentCounters* const counters = at.counters;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   if (!pose.isFinite() || !(padding >= 0.0) || !std::isfinite(padding) || !std::isfinite(t)) return nan;
   const Aabb link_box = transformed(link.bounds(), pose).inflated(padding);

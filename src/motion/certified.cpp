@@ -48,8 +48,9 @@ void MotionChecker::castAhead(const double* q0, const double* q1, double t0, int
                                         it.gb->hull(), Pose::identity(), 1.0, tol);
       first = c.hit ? std::max(0.0, c.t) : 2.0;
     } else {
-      first = sc.environment().linkCast(*it.ga, start[it.frame_a], end[it.frame_a].t - start[it.frame_a].t,
-                                        it.padding + contact, tol, 1.0, t0, &ctx.scene.counters.environment);
+      const CastQuery q{end[it.frame_a].t - start[it.frame_a].t, it.padding + contact, 1.0};
+      first = sc.environment().linkCast(*it.ga, start[it.frame_a], tol, q,
+                                        {t0, nullptr, nullptr, &ctx.scene.counters.environment});
     }
     ctx.safe_until[k] = std::min(first, 2.0);
   }
@@ -206,7 +207,7 @@ struct MotionChecker::Sweep {
     if (it.b >= 0) {
       d = BodyPair(*it.ga, *it.gb).lowerBound(pa, pose(s, it.frame_b), tol, q);
     } else {
-      d = sc.environment().lowerBound(*it.ga, pa, tol, q, time(s), nullptr, nullptr, &ctx.scene.counters.environment);
+      d = sc.environment().lowerBound(*it.ga, pa, tol, q, {time(s), nullptr, nullptr, &ctx.scene.counters.environment});
     }
     return d - it.padding;
   }
@@ -257,7 +258,8 @@ struct MotionChecker::Sweep {
                                ? warmStarts(ctx.env_cache, ctx.env_slot[e], ctx.env_stamp[e], ctx.warm_obstacles)
                                : nullptr;
       EnvironmentHit hit;  // the item the bound came from: within contact when d is
-      d = sc.environment().lowerBound(*it.ga, pa, tol, q, t, warm, &hit, &ctx.scene.counters.environment) - it.padding;
+      d = sc.environment().lowerBound(*it.ga, pa, tol, q, {t, warm, &hit, &ctx.scene.counters.environment}) -
+          it.padding;
       if (d <= contact && !head) {
         report = CollisionReport{};
         report.kind = CollisionReport::Kind::Environment;

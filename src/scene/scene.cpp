@@ -303,8 +303,8 @@ void Scene::initEnvironment() {
     for (int i : geometry_->geometricLinks()) {
       if (moves[i]) continue;
       EnvironmentHit hit;
-      if (environment_->linkIntersects(*geometry_->link(i), poses[i], options_.tolerances, options_.mode,
-                                       link_padding_[i], 0.0, &hit)) {
+      if (environment_->linkIntersects(*geometry_->link(i), poses[i], options_.tolerances,
+                                       {link_padding_[i], options_.mode}, {0.0, nullptr, &hit})) {
         static_collision_.kind = CollisionReport::Kind::Environment;
         static_collision_.link = i;
         static_collision_.hit = hit;

@@ -141,8 +141,9 @@ bool Scene::environmentFree(const Pose* poses, SceneContext& ctx, CollisionRepor
         return false;
       }
       EnvironmentHit hit;
-      if (!environment_->linkIntersects(*geometry_->link(i), poses[i], options_.tolerances, options_.mode,
-                                        link_padding_[i], time, &hit, &ctx.counters.environment))
+      if (!environment_->linkIntersects(*geometry_->link(i), poses[i], options_.tolerances,
+                                        {link_padding_[i], options_.mode},
+                                        {time, nullptr, &hit, &ctx.counters.environment}))
         return false;
       r.kind = CollisionReport::Kind::Environment;
       r.link = i;
@@ -311,8 +312,9 @@ double Scene::clearance(const double* state, SceneContext& ctx, double* lower_bo
   const double time = fx.moving ? t : 0.0;
   if (env && best > 0.0) {
     for (int i : env_links_) {
-      const DistanceResult d = environment_->linkDistance(*geometry_->link(i), ctx.poses[i], options_.tolerances,
-                                                          best + link_padding_[i], time, 0.0, &ctx.counters.environment);
+      const DistanceResult d =
+          environment_->linkDistance(*geometry_->link(i), ctx.poses[i], options_.tolerances, {best + link_padding_[i]},
+                                     {time, nullptr, nullptr, &ctx.counters.environment});
       if (isFailure(d.status)) return nan;
       best = std::min(best, std::max(0.0, d.distance - link_padding_[i]));
       lower = std::min(lower, std::max(0.0, d.lower_bound - link_padding_[i]));
@@ -329,8 +331,9 @@ double Scene::clearance(const double* state, SceneContext& ctx, double* lower_bo
     double deepest = 0.0;
     if (env)
       for (int i : geometry_->geometricLinks()) {
-        const double p = environment_->linkPenetration(*geometry_->link(i), ctx.poses[i], options_.tolerances,
-                                                       link_padding_[i], time, &ctx.counters.environment);
+        const double p =
+            environment_->linkPenetration(*geometry_->link(i), ctx.poses[i], options_.tolerances, link_padding_[i],
+                                          {time, nullptr, nullptr, &ctx.counters.environment});
         if (std::isnan(p)) return nan;
         deepest = std::max(deepest, p);
       }

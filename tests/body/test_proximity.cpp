@@ -109,6 +109,15 @@ TEST(BodyPair, LadderBoundsTheBruteForceDistance) {
         EXPECT_EQ(pair.distance(pa, pb, tol, cut).distance,
                   meshDistance(g[i], pa, g[j], pb, tol, 0.0, cut.cutoff).distance)
             << what;
+        // Hull mode: the hulls' distance, one GJK, certified never beyond the exact one; cut off likewise.
+        DistanceQuery hulls;
+        hulls.mode = GeometryMode::Hull;
+        const DistanceResult h = pair.distance(pa, pb, tol, hulls);
+        EXPECT_EQ(h.distance, gjkDistance(g[i].hull(), pa, g[j].hull(), pb, tol).distance) << what;
+        EXPECT_LE(h.lower_bound, ref + kBand) << what;
+        EXPECT_EQ(pair.lastRung(), Rung::Hulls) << what;
+        hulls.cutoff = 0.5 * h.distance;
+        if (h.distance > kBand) EXPECT_EQ(pair.distance(pa, pb, tol, hulls).distance, hulls.cutoff) << what;
       }
     }
   }
@@ -235,6 +244,12 @@ TEST(BodyPair, ConvexSideAnswersAsTheShapeQueries) {
         DistanceQuery cut;
         cut.cutoff = 0.5 * ref;
         if (ref > kBand) EXPECT_EQ(pair.distance(pa, pb, tol, cut).distance, cut.cutoff) << what;
+        DistanceQuery hulls;
+        hulls.mode = GeometryMode::Hull;
+        const DistanceResult hull =
+            std::visit([&](const auto& s) { return gjkDistance(g[i].hull(), pa, s, pb, tol); }, shape);
+        EXPECT_EQ(pair.distance(pa, pb, tol, hulls).distance, hull.distance) << what;
+        EXPECT_LE(hull.lower_bound, ref + kBand) << what;
         const double depth = pair.penetration(pa, pb, tol, 0.0);
         EXPECT_GE(depth, 0.0) << what;
       }

@@ -133,7 +133,8 @@ TEST(ClearanceGrid, EachVersionBuildsItsOwnOnceAskedEnough) {
   const auto link = std::make_shared<LinkGeometry>(std::vector<CollisionElement>{ball}, std::vector<TriangleMesh>{});
   const Tolerances tol;
   const auto ask = [&](const Environment& e, int times) {
-    for (int i = 0; i < times; ++i) e.linkIntersects(*link, Pose::translation(Vec3(0, 0, 0.01 * (i % 7))), tol, GeometryMode::Mesh);
+    for (int i = 0; i < times; ++i)
+      e.linkIntersects(*link, Pose::translation(Vec3(0, 0, 0.01 * (i % 7))), tol, {0.0, GeometryMode::Mesh});
   };
   EXPECT_EQ(env.clearanceGrid(), nullptr);
   ask(env, Environment::kClearanceAfter);

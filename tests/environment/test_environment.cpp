@@ -113,7 +113,7 @@ double boundTo(const Environment& env, const LinkGeometry& link, const Pose& pos
   q.relative = relative;
   q.top = top;
   q.climb = INFINITY;
-  return env.lowerBound(link, pose, kTol, q, 0.0, warm);
+  return env.lowerBound(link, pose, kTol, q, {0.0, warm});
 }
 
 constexpr double kPi = 3.14159265358979323846;
@@ -155,8 +155,8 @@ TEST(OctomapLoader, CoarseLeafBecomesOneBox) {
   const Environment env({}, std::make_shared<const OccupancyMap>(map));
   const LinkGeometry link = primitiveLink(Box(Vec3(0.05, 0.05, 0.05)));
   for (const GeometryMode mode : kModes) {
-    EXPECT_TRUE(env.linkIntersects(link, Pose::translation(Vec3(0.45, 0.2, 0.2)), kTol, mode));
-    EXPECT_FALSE(env.linkIntersects(link, Pose::translation(Vec3(0.45 + 1e-6, 0.2, 0.2)), kTol, mode));
+    EXPECT_TRUE(env.linkIntersects(link, Pose::translation(Vec3(0.45, 0.2, 0.2)), kTol, {0.0, mode}));
+    EXPECT_FALSE(env.linkIntersects(link, Pose::translation(Vec3(0.45 + 1e-6, 0.2, 0.2)), kTol, {0.0, mode}));
   }
 }
 
@@ -198,11 +198,11 @@ TEST(OctomapLoader, UnknownSpaceUnderBothPolicies) {
   const Environment env_free({}, std::make_shared<const OccupancyMap>(free_map));
   const Environment env_occ({}, std::make_shared<const OccupancyMap>(occ));
   for (const GeometryMode mode : kModes) {
-    EXPECT_FALSE(env_free.linkIntersects(ball, Pose::translation(Vec3(0.2, 0.2, 0.2)), kTol, mode));
-    EXPECT_TRUE(env_occ.linkIntersects(ball, Pose::translation(Vec3(0.2, 0.2, 0.2)), kTol, mode));
-    EXPECT_FALSE(env_occ.linkIntersects(ball, Pose::translation(Vec3(0.35, 0.35, 0.35)), kTol, mode));
+    EXPECT_FALSE(env_free.linkIntersects(ball, Pose::translation(Vec3(0.2, 0.2, 0.2)), kTol, {0.0, mode}));
+    EXPECT_TRUE(env_occ.linkIntersects(ball, Pose::translation(Vec3(0.2, 0.2, 0.2)), kTol, {0.0, mode}));
+    EXPECT_FALSE(env_occ.linkIntersects(ball, Pose::translation(Vec3(0.35, 0.35, 0.35)), kTol, {0.0, mode}));
     // Outside the known bounds unknown space stays free.
-    EXPECT_FALSE(env_occ.linkIntersects(ball, Pose::translation(Vec3(0.6, 0.2, 0.2)), kTol, mode));
+    EXPECT_FALSE(env_occ.linkIntersects(ball, Pose::translation(Vec3(0.6, 0.2, 0.2)), kTol, {0.0, mode}));
   }
 }
 
@@ -217,8 +217,8 @@ TEST(OctomapLoader, EmptyMap) {
   const Environment env({}, std::make_shared<const OccupancyMap>(map));
   EXPECT_TRUE(env.empty());
   EnvironmentCounters counters;
-  EXPECT_FALSE(env.linkIntersects(primitiveLink(Sphere(1.0)), Pose(), kTol, GeometryMode::Mesh, 0.0, 0.0, nullptr,
-                                  &counters));
+  EXPECT_FALSE(env.linkIntersects(primitiveLink(Sphere(1.0)), Pose(), kTol, {0.0, GeometryMode::Mesh},
+                                  {0.0, nullptr, nullptr, &counters}));
   EXPECT_EQ(counters.voxel_tests, 0);
 }
 
@@ -421,20 +421,21 @@ TEST(Environment, TouchingVoxelFaceCollidesApartIsFree) {
   for (const LinkGeometry* link : {&solid, &surface})
     for (const GeometryMode mode : kModes) {
       EnvironmentHit hit;
-      EXPECT_TRUE(env.linkIntersects(*link, Pose::translation(Vec3(0.15, 0.05, 0.05)), kTol, mode, 0.0, 0.0, &hit));
+      EXPECT_TRUE(env.linkIntersects(*link, Pose::translation(Vec3(0.15, 0.05, 0.05)), kTol, {0.0, mode},
+                                     {0.0, nullptr, &hit}));
       EXPECT_EQ(hit.kind, EnvironmentHit::Kind::Voxel);
       EXPECT_EQ(hit.index, 0);
-      EXPECT_FALSE(env.linkIntersects(*link, Pose::translation(Vec3(0.15 + 1e-6, 0.05, 0.05)), kTol, mode, 0.0, 0.0,
-                                      &hit));
+      EXPECT_FALSE(env.linkIntersects(*link, Pose::translation(Vec3(0.15 + 1e-6, 0.05, 0.05)), kTol, {0.0, mode},
+                                      {0.0, nullptr, &hit}));
       EXPECT_EQ(hit.kind, EnvironmentHit::Kind::None);
       // Padding reaches across the gap.
-      EXPECT_TRUE(env.linkIntersects(*link, Pose::translation(Vec3(0.15 + 1e-6, 0.05, 0.05)), kTol, mode, 2e-6));
+      EXPECT_TRUE(env.linkIntersects(*link, Pose::translation(Vec3(0.15 + 1e-6, 0.05, 0.05)), kTol, {2e-6, mode}));
       // Edge to edge, rotated 45° about z: the link's corner touches the voxel's +x face.
       const double r = 0.05 * std::sqrt(2.0);
       Pose turned = Pose::fromQuaternion(0, 0, std::sin(kPi / 8), std::cos(kPi / 8), Vec3(0.1 + r, 0.05, 0.05));
-      EXPECT_TRUE(env.linkIntersects(*link, turned, kTol, mode));
+      EXPECT_TRUE(env.linkIntersects(*link, turned, kTol, {0.0, mode}));
       turned.t.x() += 1e-6;
-      EXPECT_FALSE(env.linkIntersects(*link, turned, kTol, mode));
+      EXPECT_FALSE(env.linkIntersects(*link, turned, kTol, {0.0, mode}));
     }
 }
 
@@ -453,9 +454,9 @@ TEST(Environment, ObstacleInsideALink) {
   EXPECT_EQ(closed.solidCount(), 1);
   EXPECT_EQ(open.solidCount(), 0);
   EnvironmentHit hit;
-  EXPECT_TRUE(env.linkIntersects(solid, Pose(), kTol, GeometryMode::Hull));
+  EXPECT_TRUE(env.linkIntersects(solid, Pose(), kTol, {0.0, GeometryMode::Hull}));
   for (const LinkGeometry* link : {&solid, &closed}) {
-    EXPECT_TRUE(env.linkIntersects(*link, Pose(), kTol, GeometryMode::Mesh, 0.0, 0.0, &hit));
+    EXPECT_TRUE(env.linkIntersects(*link, Pose(), kTol, {0.0, GeometryMode::Mesh}, {0.0, nullptr, &hit}));
     EXPECT_EQ(hit.kind, EnvironmentHit::Kind::Obstacle);
     ASSERT_NE(hit.obstacle, nullptr);
     EXPECT_EQ(hit.obstacle->name, "pebble");
@@ -463,18 +464,18 @@ TEST(Environment, ObstacleInsideALink) {
     EXPECT_EQ(env.linkDistance(*link, Pose(), kTol).lower_bound, 0.0);
     EXPECT_EQ(boundTo(env, *link, Pose(), 1.0, 0.1, Rung::Parts), 0.0);
   }
-  EXPECT_TRUE(env.linkIntersects(open, Pose(), kTol, GeometryMode::Hull));
-  EXPECT_FALSE(env.linkIntersects(open, Pose(), kTol, GeometryMode::Mesh));
+  EXPECT_TRUE(env.linkIntersects(open, Pose(), kTol, {0.0, GeometryMode::Hull}));
+  EXPECT_FALSE(env.linkIntersects(open, Pose(), kTol, {0.0, GeometryMode::Mesh}));
   EXPECT_GT(env.linkDistance(open, Pose(), kTol).lower_bound, 0.38);
   const LinkGeometry& surface = closed;
   // Moved onto the surface, the mesh touches it.
   // Moved so that a face crosses it, then touches it from either side, then clears it by 1e-6.
   const auto at = [](double x) { return Pose::translation(Vec3(x, 0, 0)); };
-  EXPECT_TRUE(env.linkIntersects(surface, at(0.6), kTol, GeometryMode::Mesh));
-  EXPECT_TRUE(env.linkIntersects(surface, at(0.61), kTol, GeometryMode::Mesh));
-  EXPECT_FALSE(env.linkIntersects(surface, at(0.61 + 1e-6), kTol, GeometryMode::Mesh));
-  EXPECT_TRUE(env.linkIntersects(surface, at(-0.41), kTol, GeometryMode::Mesh));
-  EXPECT_FALSE(env.linkIntersects(surface, at(-0.41 - 1e-6), kTol, GeometryMode::Mesh));
+  EXPECT_TRUE(env.linkIntersects(surface, at(0.6), kTol, {0.0, GeometryMode::Mesh}));
+  EXPECT_TRUE(env.linkIntersects(surface, at(0.61), kTol, {0.0, GeometryMode::Mesh}));
+  EXPECT_FALSE(env.linkIntersects(surface, at(0.61 + 1e-6), kTol, {0.0, GeometryMode::Mesh}));
+  EXPECT_TRUE(env.linkIntersects(surface, at(-0.41), kTol, {0.0, GeometryMode::Mesh}));
+  EXPECT_FALSE(env.linkIntersects(surface, at(-0.41 - 1e-6), kTol, {0.0, GeometryMode::Mesh}));
 }
 
 TEST(Environment, ManyVoxelsInsideAMeshLink) {
@@ -490,22 +491,23 @@ TEST(Environment, ManyVoxelsInsideAMeshLink) {
   {
     const Environment env({}, mapOf(voxels));
     EnvironmentHit inside;
-    EXPECT_TRUE(env.linkIntersects(closed, Pose(), kTol, GeometryMode::Mesh, 0.0, 0.0, &inside));
+    EXPECT_TRUE(env.linkIntersects(closed, Pose(), kTol, {0.0, GeometryMode::Mesh}, {0.0, nullptr, &inside}));
     EXPECT_EQ(inside.kind, EnvironmentHit::Kind::Voxel);
     EXPECT_EQ(env.linkDistance(closed, Pose(), kTol).lower_bound, 0.0);
     EXPECT_EQ(boundTo(env, closed, Pose(), 1.0, 0.1, Rung::Parts), 0.0);
     EnvironmentCounters counters;
-    EXPECT_TRUE(env.linkIntersects(surface, Pose(), kTol, GeometryMode::Hull));
-    EXPECT_FALSE(env.linkIntersects(surface, Pose(), kTol, GeometryMode::Mesh, 0.0, 0.0, nullptr, &counters));
+    EXPECT_TRUE(env.linkIntersects(surface, Pose(), kTol, {0.0, GeometryMode::Hull}));
+    EXPECT_FALSE(
+        env.linkIntersects(surface, Pose(), kTol, {0.0, GeometryMode::Mesh}, {0.0, nullptr, nullptr, &counters}));
     EXPECT_GT(counters.voxel_tests, 4);
     // 0.3 − 0.125 = 0.175: padding just short of the nearest voxel face, then just past it.
-    EXPECT_FALSE(env.linkIntersects(surface, Pose(), kTol, GeometryMode::Mesh, 0.175 - 1e-6));
-    EXPECT_TRUE(env.linkIntersects(surface, Pose(), kTol, GeometryMode::Mesh, 0.175 + 1e-6));
+    EXPECT_FALSE(env.linkIntersects(surface, Pose(), kTol, {0.175 - 1e-6, GeometryMode::Mesh}));
+    EXPECT_TRUE(env.linkIntersects(surface, Pose(), kTol, {0.175 + 1e-6, GeometryMode::Mesh}));
   }
   voxels.push_back(cube(Vec3(0.28, 0.0, 0.0), 0.05));  // crosses the +x face
   const Environment env({}, mapOf(voxels));
   EnvironmentHit hit;
-  EXPECT_TRUE(env.linkIntersects(surface, Pose(), kTol, GeometryMode::Mesh, 0.0, 0.0, &hit));
+  EXPECT_TRUE(env.linkIntersects(surface, Pose(), kTol, {0.0, GeometryMode::Mesh}, {0.0, nullptr, &hit}));
   EXPECT_EQ(hit.kind, EnvironmentHit::Kind::Voxel);
   EXPECT_EQ(hit.index, 27);
 }
@@ -520,13 +522,13 @@ TEST(Environment, MovingObstacle) {
   EXPECT_TRUE(env.hasMovingObstacles());
   const LinkGeometry link = primitiveLink(Box(Vec3(0.5, 0.5, 0.5)));
   EnvironmentHit hit;
-  EXPECT_FALSE(env.linkIntersects(link, Pose(), kTol, GeometryMode::Mesh, 0.0, 0.0, &hit));
-  EXPECT_TRUE(env.linkIntersects(link, Pose(), kTol, GeometryMode::Mesh, 0.0, 1.0, &hit));
+  EXPECT_FALSE(env.linkIntersects(link, Pose(), kTol, {0.0, GeometryMode::Mesh}, {0.0, nullptr, &hit}));
+  EXPECT_TRUE(env.linkIntersects(link, Pose(), kTol, {0.0, GeometryMode::Mesh}, {1.0, nullptr, &hit}));
   EXPECT_EQ(hit.kind, EnvironmentHit::Kind::Obstacle);
   // At t the ball's surface is at 1.9 − 1.5t: it touches the face x = 0.5 at t = 14/15.
-  EXPECT_FALSE(env.linkIntersects(link, Pose(), kTol, GeometryMode::Mesh, 0.0, 14.0 / 15.0 - 1e-6));
-  EXPECT_TRUE(env.linkIntersects(link, Pose(), kTol, GeometryMode::Mesh, 0.0, 14.0 / 15.0 + 1e-9));
-  const DistanceResult d = env.linkDistance(link, Pose(), kTol, INFINITY, 0.5);
+  EXPECT_FALSE(env.linkIntersects(link, Pose(), kTol, {0.0, GeometryMode::Mesh}, {14.0 / 15.0 - 1e-6}));
+  EXPECT_TRUE(env.linkIntersects(link, Pose(), kTol, {0.0, GeometryMode::Mesh}, {14.0 / 15.0 + 1e-9}));
+  const DistanceResult d = env.linkDistance(link, Pose(), kTol, {}, {0.5});
   EXPECT_NEAR(d.distance, 1.9 - 0.75 - 0.5, 1e-9);
 }
 
@@ -539,22 +541,22 @@ TEST(Environment, CountersCountOnlyWhatRuns) {
   {
     const Environment env({wall});
     EnvironmentCounters c;
-    EXPECT_FALSE(env.linkIntersects(link, Pose(), kTol, GeometryMode::Mesh, 0.0, 0.0, nullptr, &c));
+    EXPECT_FALSE(env.linkIntersects(link, Pose(), kTol, {0.0, GeometryMode::Mesh}, {0.0, nullptr, nullptr, &c}));
     EXPECT_EQ(c.obstacle_tests, 0);  // the boxes are apart: nothing exact ran
     EXPECT_EQ(c.voxel_tests, 0);
-    EXPECT_TRUE(env.linkIntersects(link, Pose::translation(Vec3(0.75, 0, 0)), kTol, GeometryMode::Mesh, 0.0, 0.0,
-                                   nullptr, &c));
+    EXPECT_TRUE(env.linkIntersects(link, Pose::translation(Vec3(0.75, 0, 0)), kTol, {0.0, GeometryMode::Mesh},
+                                   {0.0, nullptr, nullptr, &c}));
     EXPECT_EQ(c.obstacle_tests, 1);
     EXPECT_EQ(c.voxel_tests, 0);  // no map: zero voxel tests
-    env.linkDistance(link, Pose(), kTol, INFINITY, 0.0, 0.0, &c);
+    env.linkDistance(link, Pose(), kTol, {}, {0.0, nullptr, nullptr, &c});
     EXPECT_EQ(c.distance_tests, 1);
   }
   const Environment env({wall}, mapOf({cube(Vec3(-1.0, -0.05, -0.05), 0.1), cube(Vec3(-3.0, 0, 0), 0.1)}));
   EnvironmentCounters c;
-  EXPECT_FALSE(env.linkIntersects(link, Pose(), kTol, GeometryMode::Mesh, 0.0, 0.0, nullptr, &c));
+  EXPECT_FALSE(env.linkIntersects(link, Pose(), kTol, {0.0, GeometryMode::Mesh}, {0.0, nullptr, nullptr, &c}));
   EXPECT_EQ(c.voxel_tests, 0);
-  EXPECT_TRUE(env.linkIntersects(link, Pose::translation(Vec3(-0.75, 0, 0)), kTol, GeometryMode::Mesh, 0.0, 0.0,
-                                 nullptr, &c));
+  EXPECT_TRUE(env.linkIntersects(link, Pose::translation(Vec3(-0.75, 0, 0)), kTol, {0.0, GeometryMode::Mesh},
+                                 {0.0, nullptr, nullptr, &c}));
   EXPECT_EQ(c.voxel_tests, 2);  // the hull test, then the exact test of the one voxel near the link
   EXPECT_EQ(c.obstacle_tests, 0);
 }
@@ -564,9 +566,9 @@ TEST(Environment, NonFiniteInputIsAHit) {
   const LinkGeometry link = primitiveLink(Sphere(0.1));
   Pose bad;
   bad.t.x() = std::nan("");
-  EXPECT_TRUE(env.linkIntersects(link, bad, kTol, GeometryMode::Mesh));
-  EXPECT_TRUE(env.linkIntersects(link, Pose(), kTol, GeometryMode::Mesh, -1.0));
-  EXPECT_FALSE(env.linkIntersects(link, Pose(), kTol, GeometryMode::Mesh));
+  EXPECT_TRUE(env.linkIntersects(link, bad, kTol, {0.0, GeometryMode::Mesh}));
+  EXPECT_TRUE(env.linkIntersects(link, Pose(), kTol, {-1.0, GeometryMode::Mesh}));
+  EXPECT_FALSE(env.linkIntersects(link, Pose(), kTol, {0.0, GeometryMode::Mesh}));
   EXPECT_TRUE(env.linkDistance(link, bad, kTol).mayCollide());
   Obstacle o;
   o.shape = Sphere(1.0);
@@ -600,7 +602,7 @@ TEST(Environment, DistanceAgainstAnalyticAnswers) {
   EXPECT_TRUE(d.mayCollide());
 
   // Beyond the cutoff: the cutoff itself, certified.
-  d = env.linkDistance(ball, Pose::translation(Vec3(1.0, 0.0, 0.0)), kTol, 0.25);
+  d = env.linkDistance(ball, Pose::translation(Vec3(1.0, 0.0, 0.0)), kTol, {0.25});
   EXPECT_EQ(d.distance, 0.25);
   EXPECT_EQ(d.lower_bound, 0.25);
   EXPECT_EQ(d.status, Status::Separated);
@@ -614,7 +616,7 @@ TEST(Environment, DistanceAgainstAnalyticAnswers) {
   EXPECT_NEAR(d.distance, 0.4 - 0.1, 1e-9);
   // An empty world: nothing within any cutoff.
   const Environment nothing;
-  EXPECT_EQ(nothing.linkDistance(ball, Pose(), kTol, 2.0).distance, 2.0);
+  EXPECT_EQ(nothing.linkDistance(ball, Pose(), kTol, {2.0}).distance, 2.0);
   EXPECT_TRUE(std::isinf(nothing.linkDistance(ball, Pose(), kTol).distance));
 }
 
@@ -625,19 +627,19 @@ TEST(Environment, MeshObstacle) {
   crate.pose = Pose::translation(Vec3(0, 0, 1));
   const Environment env({crate});
   const LinkGeometry ball = primitiveLink(Sphere(0.1));
-  EXPECT_TRUE(env.linkIntersects(ball, Pose::translation(Vec3(0, 0, 0.4)), kTol, GeometryMode::Mesh));
-  EXPECT_FALSE(env.linkIntersects(ball, Pose::translation(Vec3(0, 0, 0.4 - 1e-6)), kTol, GeometryMode::Mesh));
+  EXPECT_TRUE(env.linkIntersects(ball, Pose::translation(Vec3(0, 0, 0.4)), kTol, {0.0, GeometryMode::Mesh}));
+  EXPECT_FALSE(env.linkIntersects(ball, Pose::translation(Vec3(0, 0, 0.4 - 1e-6)), kTol, {0.0, GeometryMode::Mesh}));
   // Inside the closed crate: a solid, so hit in both modes, at distance 0.
-  EXPECT_TRUE(env.linkIntersects(ball, Pose::translation(Vec3(0, 0, 1)), kTol, GeometryMode::Hull));
-  EXPECT_TRUE(env.linkIntersects(ball, Pose::translation(Vec3(0, 0, 1)), kTol, GeometryMode::Mesh));
+  EXPECT_TRUE(env.linkIntersects(ball, Pose::translation(Vec3(0, 0, 1)), kTol, {0.0, GeometryMode::Hull}));
+  EXPECT_TRUE(env.linkIntersects(ball, Pose::translation(Vec3(0, 0, 1)), kTol, {0.0, GeometryMode::Mesh}));
   EXPECT_EQ(env.linkDistance(ball, Pose::translation(Vec3(0, 0, 1)), kTol).lower_bound, 0.0);
   EXPECT_NEAR(env.linkDistance(ball, Pose::translation(Vec3(0, 0, 0.2)), kTol).distance, 0.2, 1e-9);
   // Inside an open crate (a surface): only its hull is hit.
   Obstacle open = crate;
   open.mesh = std::make_shared<const LinkGeometry>(openBoxSurface(Vec3(0.5, 0.5, 0.5)));
   const Environment open_env({open});
-  EXPECT_TRUE(open_env.linkIntersects(ball, Pose::translation(Vec3(0, 0, 1)), kTol, GeometryMode::Hull));
-  EXPECT_FALSE(open_env.linkIntersects(ball, Pose::translation(Vec3(0, 0, 1)), kTol, GeometryMode::Mesh));
+  EXPECT_TRUE(open_env.linkIntersects(ball, Pose::translation(Vec3(0, 0, 1)), kTol, {0.0, GeometryMode::Hull}));
+  EXPECT_FALSE(open_env.linkIntersects(ball, Pose::translation(Vec3(0, 0, 1)), kTol, {0.0, GeometryMode::Mesh}));
   EXPECT_NEAR(open_env.linkDistance(ball, Pose::translation(Vec3(0, 0, 1)), kTol).distance, 0.4, 1e-9);
 }
 
@@ -688,7 +690,7 @@ TEST(Environment, RandomLinksAgreeWithBruteForce) {
           break;
         }
       EnvironmentHit hit;
-      const bool fast = env.linkIntersects(*link, pose, kTol, mode, padding, 0.0, &hit);
+      const bool fast = env.linkIntersects(*link, pose, kTol, {padding, mode}, {0.0, nullptr, &hit});
       ASSERT_EQ(fast, brute) << "trial " << trial << " mode " << static_cast<int>(mode);
       if (fast) {
         ASSERT_EQ(hit.kind, EnvironmentHit::Kind::Voxel);
@@ -866,21 +868,21 @@ TEST(Environment, LowerBoundClimbsEachItemAndNamesIt) {
       q.relative = kRelative;
       EnvironmentHit hit;
       for (SimplexCache* w : {static_cast<SimplexCache*>(nullptr), warm.data()}) {
-        const double full = env.lowerBound(*link, pose, kTol, q, 0.0, w, &hit);
+        const double full = env.lowerBound(*link, pose, kTol, q, {0.0, w, &hit});
         EXPECT_LE(full, truth + kBand) << what;
         EXPECT_GE(full, truth / (1.0 + kRelative) - kBand) << what;
         EXPECT_NE(hit.kind, EnvironmentHit::Kind::None) << what << ": a finite bound comes from an item";
       }
       BoundQuery hulls = q;
       hulls.mode = GeometryMode::Hull;
-      EXPECT_LE(env.lowerBound(*link, pose, kTol, hulls, 0.0, warm.data()), truth + kBand) << what;
+      EXPECT_LE(env.lowerBound(*link, pose, kTol, hulls, {0.0, warm.data()}), truth + kBand) << what;
       // Within a contact distance: 0 exactly when linkIntersects says so, and then the item named touches.
       BoundQuery near = q;
       near.within = kWithin;
       near.climb = kWithin;
       near.enough = 4.0 * kWithin;
-      const double w = env.lowerBound(*link, pose, kTol, near, 0.0, warm.data(), &hit);
-      const bool touching = env.linkIntersects(*link, pose, kTol, GeometryMode::Mesh, kWithin);
+      const double w = env.lowerBound(*link, pose, kTol, near, {0.0, warm.data(), &hit});
+      const bool touching = env.linkIntersects(*link, pose, kTol, {kWithin, GeometryMode::Mesh});
       EXPECT_EQ(w == 0.0, touching) << what;
       if (w == 0.0) {
         ++zero;
@@ -904,10 +906,10 @@ TEST(Environment, LowerBoundClimbsEachItemAndNamesIt) {
   BoundQuery q;
   q.enough = 0.01;
   EnvironmentHit hit;
-  EXPECT_GE(env.lowerBound(far_link, Pose::translation(Vec3(5, 5, 5)), kTol, q, 0.0, nullptr, &hit), 0.01);
+  EXPECT_GE(env.lowerBound(far_link, Pose::translation(Vec3(5, 5, 5)), kTol, q, {0.0, nullptr, &hit}), 0.01);
   EXPECT_EQ(hit.kind, EnvironmentHit::Kind::None);
   // A moving obstacle out of reach of the doubles: 0, and it is named.
-  EXPECT_EQ(env.lowerBound(far_link, Pose::translation(Vec3(5, 5, 5)), kTol, q, 1e308, nullptr, &hit), 0.0);
+  EXPECT_EQ(env.lowerBound(far_link, Pose::translation(Vec3(5, 5, 5)), kTol, q, {1e308, nullptr, &hit}), 0.0);
   ASSERT_NE(hit.obstacle, nullptr);
   EXPECT_EQ(hit.obstacle->name, "drifting");
 }
@@ -942,10 +944,10 @@ TEST(Environment, LinkCastAgainstSampledDistances) {
     const auto hullDistance = [&](double s) {
       Pose at = pose;
       at.t += s * velocity;
-      return env.linkDistance(*link, at, kTol, INFINITY, 0.0, 0.0, nullptr, GeometryMode::Hull).distance;
+      return env.linkDistance(*link, at, kTol, {INFINITY, 0.0, GeometryMode::Hull}).distance;
     };
     if (hullDistance(0.0) <= margin) continue;  // starts in contact: the answer is 0, nothing to sample
-    const double first = env.linkCast(*link, pose, velocity, margin, kTol);
+    const double first = env.linkCast(*link, pose, kTol, {velocity, margin});
     ASSERT_GE(first, 0.0);
     const double until = std::min(first, 1.0);
     for (int k = 0; k < 400; ++k) {
@@ -966,17 +968,18 @@ TEST(Environment, LinkCastAgainstSampledDistances) {
   EXPECT_GT(clear, 10);
   // Starting within the margin is time 0; standing still is 0 or +∞; bad input is 0 (never "clear").
   const LinkGeometry ball = primitiveLink(Sphere(0.1));
-  EXPECT_EQ(env.linkCast(ball, Pose::translation(Vec3(0.6, -0.6, 0.5)), Vec3(1, 0, 0), 0.0, kTol), 0.0);
-  EXPECT_TRUE(std::isinf(env.linkCast(ball, Pose::translation(Vec3(0, 0, 5)), Vec3::Zero(), 0.01, kTol)));
-  EXPECT_EQ(env.linkCast(ball, Pose::translation(Vec3(0, 0, 5)), Vec3(NAN, 0, 0), 0.01, kTol), 0.0);
-  EXPECT_EQ(env.linkCast(ball, Pose::translation(Vec3(0, 0, 5)), Vec3(1, 0, 0), -1.0, kTol), 0.0);
+  EXPECT_EQ(env.linkCast(ball, Pose::translation(Vec3(0.6, -0.6, 0.5)), kTol, {Vec3(1, 0, 0), 0.0}), 0.0);
+  EXPECT_TRUE(std::isinf(env.linkCast(ball, Pose::translation(Vec3(0, 0, 5)), kTol, {Vec3::Zero(), 0.01})));
+  EXPECT_EQ(env.linkCast(ball, Pose::translation(Vec3(0, 0, 5)), kTol, {Vec3(NAN, 0, 0), 0.01}), 0.0);
+  EXPECT_EQ(env.linkCast(ball, Pose::translation(Vec3(0, 0, 5)), kTol, {Vec3(1, 0, 0), -1.0}), 0.0);
   // The thin plate is found from far away, where sampling at 1% of the sweep would step over it (a box:
   // its hull is exact, where a sphere's is a polytope around it).
   const LinkGeometry cube = primitiveLink(Box(Vec3(0.1, 0.1, 0.1)));
-  const double through = env.linkCast(cube, Pose::translation(Vec3(0.0, -2.0, 3.0)), Vec3(0, 8, 0), 0.0, kTol);
+  const double through = env.linkCast(cube, Pose::translation(Vec3(0.0, -2.0, 3.0)), kTol, {Vec3(0, 8, 0), 0.0});
   EXPECT_NEAR(through, (2.0 + 3.0 - 0.002 - 0.1) / 8.0, 1e-6);
   EnvironmentCounters counters;
-  env.linkCast(ball, Pose::translation(Vec3(0.0, -2.0, 3.0)), Vec3(0, 8, 0), 0.0, kTol, 1.0, 0.0, &counters);
+  env.linkCast(ball, Pose::translation(Vec3(0.0, -2.0, 3.0)), kTol, {Vec3(0, 8, 0), 0.0},
+               {0.0, nullptr, nullptr, &counters});
   EXPECT_GT(counters.cast_tests, 0);
   EXPECT_LT(counters.cast_tests, 10) << "the slab test keeps the casts to what the sweep reaches";
 }
@@ -1056,10 +1059,10 @@ TEST(Environment, PointCloudsMakeEachVoxelOnce) {
   int hits = 0;
   for (int i = 0; i < 400; ++i) {
     const Pose pose = Pose::translation(Vec3(v(rng), v(rng), v(rng)));
-    const bool expected = as_boxes.linkIntersects(ball, pose, kTol, GeometryMode::Mesh);
+    const bool expected = as_boxes.linkIntersects(ball, pose, kTol, {0.0, GeometryMode::Mesh});
     hits += expected;
-    ASSERT_EQ(once.linkIntersects(ball, pose, kTol, GeometryMode::Mesh), expected) << i;
-    ASSERT_EQ(piecewise.linkIntersects(ball, pose, kTol, GeometryMode::Mesh), expected) << i;
+    ASSERT_EQ(once.linkIntersects(ball, pose, kTol, {0.0, GeometryMode::Mesh}), expected) << i;
+    ASSERT_EQ(piecewise.linkIntersects(ball, pose, kTol, {0.0, GeometryMode::Mesh}), expected) << i;
     if (!expected) ASSERT_NEAR(once.linkDistance(ball, pose, kTol).distance, as_boxes.linkDistance(ball, pose, kTol).distance, 1e-9) << i;
   }
   EXPECT_GT(hits, 40);

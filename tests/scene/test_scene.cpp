@@ -684,8 +684,8 @@ void expectLeadKeepsVerdicts(const Scene& scene, const std::string& what, std::m
       ++env_hits;
       const int link = a.link;
       EXPECT_TRUE(scene.environment().linkIntersects(*scene.geometry().link(link), kept.poses[link],
-                                                     scene.options().tolerances, scene.options().mode,
-                                                     scene.linkPadding(link)))
+                                                     scene.options().tolerances,
+                                                     {scene.linkPadding(link), scene.options().mode}))
           << what << ": reported " << scene.describe(a) << ", which does not collide";
       ASSERT_GE(kept.env_last_hit, 0);
       EXPECT_EQ(scene.environmentLinks()[kept.env_last_hit], link) << what;

@@ -131,6 +131,8 @@ struct BoundQuery {
 struct DistanceQuery {
   double cutoff = std::numeric_limits<double>::infinity();  ///< bodies farther apart answer `cutoff`
   double relative = 0.0;  ///< as meshDistance's relative_error
+  /// Hull: the distance between the convex hulls (a shape: itself), one GJK, a lower bound on the exact one.
+  GeometryMode mode = GeometryMode::Mesh;
 };
 
 /// What BodyPair::cast asks: A's hull, grown by `margin`, translating by s·velocity (the poses' frame),
@@ -179,7 +181,7 @@ class BodyPair {
   double penetration(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, double padding = 0.0) const noexcept;
   /// The distance between the exact geometries (normal from A towards B): meshDistance's answer (or
   /// shapeLinkDistance's), but with a finite q.cutoff the balls, hulls and parts (warm) are asked first,
-  /// and bodies they prove that far apart answer the cutoff at once.
+  /// and bodies they prove that far apart answer the cutoff at once. q.mode Hull: the hulls' distance.
   DistanceResult distance(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol,
                           const DistanceQuery& q) noexcept;
 

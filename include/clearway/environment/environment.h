@@ -80,6 +80,16 @@ struct EnvironmentCounters {
   long long grid_clears = 0;     ///< links the clearance grid cleared with no tree walk (Scene::isFree)
 };
 
+/// Where and when an Environment link query runs, beside what it asks (BodyPair's IntersectQuery,
+/// DistanceQuery, BoundQuery, CastQuery: one vocabulary for a pair and for the world): the time, the warm
+/// starts, and where it reports what it touched and the work it did.
+struct EnvironmentQuery {
+  double t = 0.0;                 ///< seconds: moving obstacles are displaced by t·velocity (static ones ignore it)
+  SimplexCache* warm = nullptr;   ///< lowerBound: staticCount() hull warm starts for the link, or null (cold)
+  EnvironmentHit* hit = nullptr;  ///< if given: what linkIntersects touched, or the item lowerBound's bound came from
+  EnvironmentCounters* counters = nullptr;  ///< if given: the query's work is added to it
+};
+
 /// Obstacles and occupancy, immutable once built; queries are const and thread-safe. Copies are cheap
 /// (they share everything).
 class Environment {
@@ -146,52 +156,49 @@ class Environment {
   /// This world with another occupancy map (a changed .bt); the obstacles and point voxels are shared.
   Environment withMap(std::shared_ptr<const OccupancyMap> map) const;
 
-  /// True when the link (placed by pose) is within `padding` of an obstacle or an occupied voxel at
-  /// time t (moving obstacles displaced by t·velocity; static ones ignore t). Never "free" by
-  /// accident: a non-finite pose counts as a hit. `hit` (optional) says what was touched first.
-  bool linkIntersects(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, GeometryMode mode,
-                      double padding = 0.0, double t = 0.0, EnvironmentHit* hit = nullptr,
-                      EnvironmentCounters* counters = nullptr) const noexcept;
+  /// True when the link (placed by pose) is within q.padding of an obstacle or an occupied voxel at time
+  /// at.t (moving obstacles displaced by t·velocity; static ones ignore t); q.mode Hull: the link's hull
+  /// instead (conservative). Never "free" by accident: non-finite input counts as a hit. at.hit (optional)
+  /// says what was touched first.
+  bool linkIntersects(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, const IntersectQuery& q = {},
+                      const EnvironmentQuery& at = {}) const noexcept;
 
   /// Distance from the link's exact geometry to the nearest obstacle or voxel (0 when touching;
-  /// lower_bound certified). Only obstacles within `cutoff` are examined: beyond it the result is
-  /// {distance = lower_bound = cutoff, status Separated}. relative_error as in meshDistance. The link is A:
-  /// point_a on the link, point_b on the obstacle or voxel, normal from the link towards it (world frame).
-  /// GeometryMode::Hull measures from the link's convex hull (and a mesh obstacle's hull) instead: one
-  /// GJK call per item, a lower bound on the exact distance.
+  /// lower_bound certified). Only obstacles within q.cutoff are examined: beyond it the result is
+  /// {distance = lower_bound = cutoff, status Separated}. q.relative as meshDistance's relative_error. The
+  /// link is A: point_a on the link, point_b on the obstacle or voxel, normal from the link towards it
+  /// (world frame). q.mode Hull measures from the link's convex hull (and a mesh obstacle's hull) instead:
+  /// one GJK call per item, a lower bound on the exact distance.
   DistanceResult linkDistance(const LinkGeometry& link, const Pose& pose, const Tolerances& tol,
-                              double cutoff = std::numeric_limits<double>::infinity(), double t = 0.0,
-                              double relative_error = 0.0, EnvironmentCounters* counters = nullptr,
-                              GeometryMode mode = GeometryMode::Mesh) const noexcept;
+                              const DistanceQuery& q = {}, const EnvironmentQuery& at = {}) const noexcept;
 
-  /// A certified lower bound on the distance from the link to the nearest obstacle or voxel at time t,
+  /// A certified lower bound on the distance from the link to the nearest obstacle or voxel at time at.t,
   /// computed only as far as q.enough (the answer is at least q.enough when nothing is nearer): one walk,
   /// each item within reach of the link's oriented box climbing BodyPair::lowerBound's ladder (the balls,
   /// the hulls, the link's convex parts, the exact geometry; q as there), asked to prove only the least
-  /// bound so far. `warm`, if given, holds staticCount() hull warm starts for this link, one per static
-  /// obstacle. `hit` (optional) names the item the bound came from when one came below q.enough. 0 for
+  /// bound so far. at.warm, if given, holds staticCount() hull warm starts for this link, one per static
+  /// obstacle. at.hit (optional) names the item the bound came from when one came below q.enough. 0 for
   /// non-finite input or a failed query.
   double lowerBound(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, const BoundQuery& q,
-                    double t = 0.0, SimplexCache* warm = nullptr, EnvironmentHit* hit = nullptr,
-                    EnvironmentCounters* counters = nullptr) const noexcept;
+                    const EnvironmentQuery& at = {}) const noexcept;
   /// How many warm starts lowerBound takes: one slot per static obstacle (slots of removed obstacles
   /// are reused by those added later).
   std::size_t staticCount() const noexcept { return static_cast<std::size_t>(slot_count_); }
 
-  /// For a link translating by s·velocity (world frame), s ∈ [0, max_s], with its convex hull grown by
-  /// `margin`: a certified lower bound on the first s at which it touches an obstacle (its hull, for a mesh
-  /// obstacle) or an occupied voxel, obstacles held where they are at time t; +∞ when nothing is touched
-  /// up to max_s. Each candidate the swept box reaches costs one GJK shape cast. 0 for non-finite input.
-  double linkCast(const LinkGeometry& link, const Pose& pose, const Vec3& velocity, double margin,
-                  const Tolerances& tol, double max_s = 1.0, double t = 0.0,
-                  EnvironmentCounters* counters = nullptr) const noexcept;
+  /// For a link translating by s·q.velocity (world frame), s ∈ [0, q.max_s], with its convex hull grown by
+  /// q.margin: a certified lower bound on the first s at which it touches an obstacle (its hull, for a mesh
+  /// obstacle) or an occupied voxel, obstacles held where they are at time at.t; +∞ when nothing is
+  /// touched up to max_s. Each candidate the swept box reaches costs one GJK shape cast. 0 for non-finite
+  /// input.
+  double linkCast(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, const CastQuery& q,
+                  const EnvironmentQuery& at = {}) const noexcept;
 
   /// How deep the link penetrates the environment: over the obstacles and voxels its exact geometry
   /// (grown by padding) touches, the largest EPA depth of its convex hull into them, plus padding. The
   /// hull contains the link, so this is an upper bound on the exact depth. 0 when nothing touches; NaN
   /// when a query failed or the input is not finite.
   double linkPenetration(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, double padding = 0.0,
-                         double t = 0.0, EnvironmentCounters* counters = nullptr) const noexcept;
+                         const EnvironmentQuery& at = {}) const noexcept;
 
  private:
   // The one walk over what lies near a link (environment.cpp): static obstacles from their tree, moving
