@@ -110,7 +110,7 @@ class FclScene {
   /// Self pairs and/or the environment at this state (the scene's group order).
   bool isFree(const double* state, bool self = true, bool environment = true) {
     place(state);
-    const clearway::Pose* poses = ctx().poses.data();
+    const clearway::Pose* poses = ctx().poses().data();
     if (environment)
       for (int link : scene_.environmentLinks())
         for (auto& obj : robot_.objects[link]) {
@@ -140,7 +140,7 @@ class FclScene {
  private:
   void place(const double* state) {
     scene_.computePoses(state, ctx());
-    const clearway::Pose* poses = ctx().poses.data();
+    const clearway::Pose* poses = ctx().poses().data();
     for (int link : scene_.geometry().geometricLinks())
       for (std::size_t e = 0; e < robot_.objects[link].size(); ++e) {
         fcl::CollisionObjectd& obj = *robot_.objects[link][e];

@@ -32,11 +32,11 @@ void MotionChecker::castAhead(const double* q0, const double* q1, double t0, int
     if (self ? !bound_.translates(it.a, it.b, ctx.dq.data()) : !bound_.translates(it.a, ctx.dq.data())) continue;
     if (!posed) {  // both ends' poses, once: the end's kept aside, the start's left in the scene context
       sc.computePoses(q1, ctx.scene);
-      ctx.end_poses = ctx.scene.poses;
+      ctx.end_poses = ctx.scene.poses();
       sc.computePoses(q0, ctx.scene);
       posed = true;
     }
-    const std::vector<Pose>& start = ctx.scene.poses;
+    const std::vector<Pose>& start = ctx.scene.poses();
     const std::vector<Pose>& end = ctx.end_poses;
     ++r.distance_queries;
     double first;  // certified: the grown hulls do not touch before it
@@ -50,7 +50,7 @@ void MotionChecker::castAhead(const double* q0, const double* q1, double t0, int
     } else {
       const CastQuery q{end[it.frame_a].t - start[it.frame_a].t, it.padding + contact, 1.0};
       first = sc.environment().linkCast(*it.ga, start[it.frame_a], tol, q,
-                                        {t0, nullptr, nullptr, &ctx.scene.counters.environment});
+                                        {t0, nullptr, nullptr, &ctx.scene.counters().environment});
     }
     ctx.safe_until[k] = std::min(first, 2.0);
   }
@@ -94,7 +94,7 @@ struct MotionChecker::Sweep {
       return true;
     }
   }
-  double at_s = -1.0;         // the parameter ctx.scene.q holds
+  double at_s = -1.0;  // the parameter ctx.full_q holds
   // The last measurement's self item whose hulls' GJK axis separates them (splitClearances), −1: none.
   static constexpr std::size_t kSplit = 8;
   int split_item = -1;
@@ -102,7 +102,7 @@ struct MotionChecker::Sweep {
 
   Sweep(const MotionChecker& checker, motion_detail::Scratch& c, MotionResult& result, const double* from, const double* to)
       : mc(checker), ctx(c), r(result), q0(from), q1(to) {
-    ctx.scene.poses[0] = Pose::identity();
+    ctx.poses[0] = Pose::identity();
   }
 
   // The time at parameter s.
@@ -113,16 +113,16 @@ struct MotionChecker::Sweep {
     if (s != at_s) {
       mc.interpolate(q0, q1, s, ctx.q.data());
       const std::vector<int>& group = mc.scene_->groupVariables();
-      for (std::size_t i = 0; i < group.size(); ++i) ctx.scene.q[group[i]] = ctx.q[i];
+      for (std::size_t i = 0; i < group.size(); ++i) ctx.full_q[group[i]] = ctx.q[i];
       ++ctx.step_stamp;
       ++r.steps;
       at_s = s;
     }
     const RobotModel& model = mc.scene_->robot();
-    Pose* poses = ctx.scene.poses.data();
+    Pose* poses = ctx.poses.data();
     for (int l = link; l > 0 && ctx.pose_stamp[l] != ctx.step_stamp; l = model.parentLink(l)) ctx.pose_path.push_back(l);
     for (; !ctx.pose_path.empty(); ctx.pose_path.pop_back()) {
-      computeLinkPose(model, ctx.scene.q.data(), poses, ctx.pose_path.back());
+      computeLinkPose(model, ctx.full_q.data(), poses, ctx.pose_path.back());
       ctx.pose_stamp[ctx.pose_path.back()] = ctx.step_stamp;
     }
     return poses[link];
@@ -207,7 +207,8 @@ struct MotionChecker::Sweep {
     if (it.b >= 0) {
       d = BodyPair(*it.ga, *it.gb).lowerBound(pa, pose(s, it.frame_b), tol, q);
     } else {
-      d = sc.environment().lowerBound(*it.ga, pa, tol, q, {time(s), nullptr, nullptr, &ctx.scene.counters.environment});
+      d = sc.environment().lowerBound(*it.ga, pa, tol, q,
+                                      {time(s), nullptr, nullptr, &ctx.scene.counters().environment});
     }
     return d - it.padding;
   }
@@ -258,7 +259,7 @@ struct MotionChecker::Sweep {
                                ? warmStarts(ctx.env_cache, ctx.env_slot[e], ctx.env_stamp[e], ctx.warm_obstacles)
                                : nullptr;
       EnvironmentHit hit;  // the item the bound came from: within contact when d is
-      d = sc.environment().lowerBound(*it.ga, pa, tol, q, {t, warm, &hit, &ctx.scene.counters.environment}) -
+      d = sc.environment().lowerBound(*it.ga, pa, tol, q, {t, warm, &hit, &ctx.scene.counters().environment}) -
           it.padding;
       if (d <= contact && !head) {
         report = CollisionReport{};
@@ -281,8 +282,8 @@ struct MotionChecker::Sweep {
     const std::vector<LinkGeometry::Part>& parts_a = it.ga->parts();
     const std::vector<LinkGeometry::Part>& parts_b = it.gb->parts();
     if (!cache.valid || parts_a.size() > kSplit || parts_b.size() > kSplit) return false;
-    const Pose& pa = ctx.scene.poses[it.frame_a];  // (as measured)
-    const Pose& pb = ctx.scene.poses[it.frame_b];
+    const Pose& pa = ctx.poses[it.frame_a];  // (as measured)
+    const Pose& pb = ctx.poses[it.frame_b];
     const Vec3 u_a = -cache.axis.normalized();  // A towards B, in A's frame
     const Vec3 u = pa.R * u_a, u_b = pb.R.transpose() * u;
     if (!u.allFinite()) return false;
@@ -315,7 +316,7 @@ struct MotionChecker::Sweep {
   double reach(int k, double d, double want) {
     const Item& it = mc.items_[k];
     const double* dq = ctx.dq.data();
-    const Pose* poses = ctx.scene.poses.data();  // (at the parameter d was measured at)
+    const Pose* poses = ctx.poses.data();  // (at the parameter d was measured at)
     // The static bound first: where it reaches as far as asked, the reaches from the axes now are not needed.
     double h = d / ctx.bound[k];  // (∞ when the item does not move)
     if (std::isnan(h)) h = d == INFINITY ? INFINITY : 0.0;  // (∞ / ∞: nothing near, and an unbounded motion)
@@ -488,7 +489,7 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
     if (!ends_set) {
       const std::vector<int>& group = sc.groupVariables();
       for (int e = 0; e < 2; ++e) {
-        ctx.ends[e] = ctx.scene.q;  // (the variables outside the group at their held values)
+        ctx.ends[e] = ctx.scene.jointValues();  // (the variables outside the group at their held values)
         for (std::size_t i = 0; i < group.size(); ++i) ctx.ends[e][group[i]] = (e ? q1 : q0)[i];
       }
       ends_set = true;

@@ -190,19 +190,19 @@ MotionBound::Tables::Tables(const Scene& scene, const std::vector<Body>& bodies)
       const Joint& joint = model.joint(j);
       if (!still(j) || joint.parent_link < 0 || joint.child_link < 0) continue;
       // Held where the reference state has it (a held planar or floating joint has no limits to bound it).
-      const double offset = relativePose(ctx.poses[joint.parent_link], ctx.poses[joint.child_link]).t.norm();
+      const double offset = relativePose(ctx.poses()[joint.parent_link], ctx.poses()[joint.child_link]).t.norm();
       for (const int e : elements_of[j]) step_[e] = e == elements_of[j].front() ? offset * (1.0 + margins::kRounding) : 0.0;
     }
     for (int e = 0; e < elements; ++e) {
       const Joint& joint = model.joint(joint_of_[e]);
       if (joint_var_[e] < 0 || kind_[e] != static_cast<char>(Kind::Revolute) || joint.child_link < 0 || joint.parent_link < 0)
         continue;
-      const Pose& child = ctx.poses[joint.child_link];  // the joint frame, turned by q about the axis
+      const Pose& child = ctx.poses()[joint.child_link];  // the joint frame, turned by q about the axis
       const Vec3 point = child.t, dir = child.R * axis_[e];
       for (int l = 0; l < links_; ++l) {
         const int root = anchor[frame_[l]];
         if (root != anchor[joint.child_link] && root != anchor[joint.parent_link]) continue;
-        const Pose& pose = ctx.poses[frame_[l]];
+        const Pose& pose = ctx.poses()[frame_[l]];
         exact_[static_cast<std::size_t>(l) * elements + e] =
             axisReach(l, pose.R.transpose() * (point - pose.t), pose.R.transpose() * dir);
       }

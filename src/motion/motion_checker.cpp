@@ -35,7 +35,7 @@ MotionChecker::Bodies MotionChecker::mergeBodies(const Scene& scene) {
   for (const int l : scene.geometry().geometricLinks()) members[out.anchor[l]].push_back(l);
   SceneContext ctx = scene.makeContext();
   scene.computePoses(referenceState(scene).data(), ctx);
-  out.reference = ctx.poses;
+  out.reference = ctx.poses();
   for (int anchor = 0; anchor < model.linkCount(); ++anchor) {
     if (members[anchor].size() < 2) continue;
     // Every member's elements, placed in the anchor's frame (fixed: the joints in between do not move).
@@ -264,6 +264,8 @@ MotionContext MotionChecker::makeContext() const {
   auto scratch = std::make_unique<motion_detail::Scratch>();
   motion_detail::Scratch& c = *scratch;
   c.scene = scene_->makeContext();
+  c.full_q = c.scene.jointValues();
+  c.poses.resize(scene_->robot().linkCount());
   c.q.resize(scene_->dimension());
   c.dq.resize(scene_->dimension());
   c.safe_until.resize(items_.size());
@@ -334,8 +336,9 @@ MotionResult MotionChecker::check(const double* q0, double t0, const double* q1,
   // A context made by a checker of another robot (a World before an attach, say), or of another group of
   // this one (its state buffers sized for another dimension), does not fit: refused.
   const std::size_t dim = static_cast<std::size_t>(scene_->dimension());
-  if (ctx.safe_until.size() != items_.size() || ctx.scene.poses.size() != static_cast<std::size_t>(scene_->robot().linkCount()) ||
-      ctx.q.size() != dim || ctx.dq.size() != dim || ctx.probe_states.size() != motion_detail::kProbes * dim) {
+  if (ctx.safe_until.size() != items_.size() ||
+      ctx.poses.size() != static_cast<std::size_t>(scene_->robot().linkCount()) || ctx.q.size() != dim ||
+      ctx.dq.size() != dim || ctx.probe_states.size() != motion_detail::kProbes * dim) {
     MotionResult r;
     r.report.kind = CollisionReport::Kind::Invalid;
     return r;

@@ -17,6 +17,10 @@ constexpr int kProbes = 4;
 struct Scratch {
   SceneContext scene;
   std::vector<double> q, dq;
+  // The robot's full joint vector and every link's pose at the parameter the sweep last placed (the
+  // sweep's own: a state check in between places the scene context's).
+  std::vector<double> full_q;
+  std::vector<Pose> poses;
   std::vector<double> ends[2];  // the segment's ends as full variable vectors (for the pair tables)
   std::vector<double> safe_until;  // per item: where its coverage starts (Cast: where its shape cast reached)
   std::vector<double> bound;       // per item: its motion bound for this segment
@@ -40,7 +44,7 @@ struct Scratch {
   std::vector<std::uint64_t> split_stamp;
   double obstacle_motion = 0.0;  // how far moving obstacles travel over the segment (per unit of s)
   std::uint64_t segment = 0;  // segments checked with this context (the stamps above refer to it)
-  std::vector<std::uint64_t> pose_stamp;  // per link: the step its pose in scene.poses was computed for
+  std::vector<std::uint64_t> pose_stamp;  // per link: the step its pose in `poses` was computed for
   std::vector<int> pose_path;             // scratch: links whose poses are due, deepest first
   std::vector<Pose> end_poses;            // Cast: the link poses at the segment's end
   std::uint64_t step_stamp = 0;

@@ -5,7 +5,7 @@
 #include <clearway/body/enclosing.h>
 #include <clearway/body/proximity.h>
 
-#include <clearway/detail/per_thread.h>
+#include <clearway/per_thread.h>
 
 #include <clearway/kinematics/attached_body.h>
 #include <clearway/kinematics/forward_kinematics.h>

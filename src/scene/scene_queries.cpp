@@ -4,11 +4,12 @@
 
 #include <clearway/body/enclosing.h>
 #include <clearway/body/link_geometry.h>
-#include <clearway/detail/per_thread.h>
+#include <clearway/per_thread.h>
 #include <clearway/kinematics/forward_kinematics.h>
 #include <clearway/load/input_limits.h>
 
 #include "exact_text.h"
+#include "scene_scratch.h"
 
 #include <algorithm>
 #include <cmath>
@@ -18,20 +19,49 @@
 namespace clearway {
 
 using scene_detail::exactText;
+using scene_detail::SceneScratch;
+
+namespace {
+
+// The scratch of a context; a default-made (or moved-from) one's is an empty scratch of this thread, whose
+// queries answer Invalid (no poses).
+SceneScratch& scratchOf(const std::unique_ptr<SceneScratch>& s) noexcept {
+  thread_local SceneScratch none;
+  return s ? *s : none;
+}
+
+}  // namespace
+
+SceneContext::SceneContext() noexcept = default;
+SceneContext::SceneContext(SceneContext&&) noexcept = default;
+SceneContext& SceneContext::operator=(SceneContext&&) noexcept = default;
+SceneContext::~SceneContext() = default;
+SceneContext::SceneContext(std::unique_ptr<SceneScratch> scratch) noexcept : scratch_(std::move(scratch)) {}
+const std::vector<Pose>& SceneContext::poses() const noexcept { return scratchOf(scratch_).poses; }
+const std::vector<double>& SceneContext::jointValues() const noexcept { return scratchOf(scratch_).q; }
+SceneCounters& SceneContext::counters() noexcept { return scratchOf(scratch_).counters; }
+const SceneCounters& SceneContext::counters() const noexcept { return scratchOf(scratch_).counters; }
 
 SceneContext Scene::makeContext() const {
-  SceneContext c;
+  auto scratch = std::make_unique<SceneScratch>();
+  SceneScratch& c = *scratch;
   c.q = base_q_;
   c.poses.resize(robot().linkCount());
   c.self = self_.makeContext();
+  c.balls = EnclosingBalls(*geometry_);
   c.lanes.emplace(robot());
   c.lane_q.reserve(base_q_.size() * KinematicLanes::kMaxLanes);
   for (int l = 0; l < KinematicLanes::kMaxLanes; ++l) c.lane_q.insert(c.lane_q.end(), base_q_.begin(), base_q_.end());
   c.lane_poses.resize(static_cast<std::size_t>(robot().linkCount()) * KinematicLanes::kMaxLanes);
-  return c;
+  return SceneContext(std::move(scratch));
 }
 
-void Scene::computePoses(const double* state, SceneContext& ctx) const noexcept {
+void Scene::computePoses(const double* state, SceneContext& context) const noexcept {
+  SceneScratch& ctx = scratchOf(context.scratch_);
+  if (ctx.poses.size() == static_cast<std::size_t>(robot().linkCount())) place(state, ctx);  // (else not this scene's)
+}
+
+void Scene::place(const double* state, SceneScratch& ctx) const noexcept {
   for (std::size_t i = 0; i < group_variables_.size(); ++i) ctx.q[group_variables_[i]] = state[i];
   computeLinkPoses(robot(), ctx.q.data(), ctx.poses.data());
 }
@@ -79,7 +109,11 @@ bool Scene::withinBounds(const double* state) const noexcept {
   return true;
 }
 
-bool Scene::isFree(const double* state, SceneContext& ctx, CollisionReport* report, double t) const noexcept {
+bool Scene::isFree(const double* state, SceneContext& context, CollisionReport* report, double t) const noexcept {
+  return checkState(state, scratchOf(context.scratch_), report, t);
+}
+
+bool Scene::checkState(const double* state, SceneScratch& ctx, CollisionReport* report, double t) const noexcept {
   ++ctx.counters.states;
   CollisionReport local;
   CollisionReport& r = report ? *report : local;
@@ -96,17 +130,17 @@ bool Scene::isFree(const double* state, SceneContext& ctx, CollisionReport* repo
   }
   const Effects& fx = description_.effects;
   if (!fx.self && !fx.environment) return true;
-  computePoses(state, ctx);
+  place(state, ctx);
   return posedFree(ctx.poses.data(), ctx.q.data(), ctx, r, t);
 }
 
-bool Scene::posedFree(const Pose* poses, const double* q, SceneContext& ctx, CollisionReport& r,
+bool Scene::posedFree(const Pose* poses, const double* q, SceneScratch& ctx, CollisionReport& r,
                       double t) const noexcept {
   bool balls_placed = false;
   return environmentFree(poses, ctx, r, t, balls_placed) && selfFree(poses, q, ctx, r, balls_placed);
 }
 
-bool Scene::environmentFree(const Pose* poses, SceneContext& ctx, CollisionReport& r, double t,
+bool Scene::environmentFree(const Pose* poses, SceneScratch& ctx, CollisionReport& r, double t,
                             bool& balls_placed) const noexcept {
   const Effects& fx = description_.effects;
   if (fx.environment && !environment_->empty()) {
@@ -115,7 +149,7 @@ bool Scene::environmentFree(const Pose* poses, SceneContext& ctx, CollisionRepor
     // the self check too) clear most links with a look-up each: the bounding ball, else every part's ball
     // (whose union holds the link, the inside of its closed meshes included, but not its hull).
     const Environment& env = *environment_;
-    EnclosingBalls& balls = ctx.self.balls;
+    EnclosingBalls& balls = ctx.balls;
     const ClearanceGrid* grid = nullptr;
     const auto cleared = [&](int i) {
       const int n = balls.ballCount(i);
@@ -157,20 +191,21 @@ bool Scene::environmentFree(const Pose* poses, SceneContext& ctx, CollisionRepor
     const int lead = ctx.env_last_hit >= 0 && ctx.env_last_hit < n ? ctx.env_last_hit : -1;
     if (lead >= 0 && hits(lead)) return false;  // (before the balls are placed: it probably still collides)
     grid = env.hasMovingObstacles() ? nullptr : env.clearanceGrid();
-    if (grid && !(balls_placed = self_.placeBalls(poses, ctx.self))) grid = nullptr;
+    if (grid && !(balls_placed = ctx.balls.madeFor(*geometry_))) grid = nullptr;
+    if (balls_placed) ctx.balls.place(poses);
     for (int k = 0; k < n; ++k)
       if (k != lead && hits(k)) return false;
   }
   return true;
 }
 
-bool Scene::selfFree(const Pose* poses, const double* q, SceneContext& ctx, CollisionReport& r,
+bool Scene::selfFree(const Pose* poses, const double* q, SceneScratch& ctx, CollisionReport& r,
                      bool balls_placed) const noexcept {
   const Effects& fx = description_.effects;
   if (fx.self) {
-    const long long before = ctx.self.pair_tests;
-    const LinkPair* hit = self_.firstCollision(poses, ctx.self, q, balls_placed);
-    ctx.counters.self_pair_tests += ctx.self.pair_tests - before;
+    const long long before = ctx.self.pairTests();
+    const LinkPair* hit = self_.firstCollision(poses, ctx.self, q, balls_placed ? &ctx.balls : nullptr);
+    ctx.counters.self_pair_tests += ctx.self.pairTests() - before;
     if (hit) {
       r.kind = CollisionReport::Kind::Self;
       r.link = hit->a;
@@ -181,12 +216,13 @@ bool Scene::selfFree(const Pose* poses, const double* q, SceneContext& ctx, Coll
   return true;
 }
 
-bool Scene::lanesFit(const SceneContext& ctx) const noexcept {
+bool Scene::lanesFit(const SceneScratch& ctx) const noexcept {
   const RobotModel& model = robot();
   return ctx.lanes && ctx.lanes->madeFor(model) && ctx.poses.size() == static_cast<std::size_t>(model.linkCount());
 }
 
-void Scene::toLane(const double* state, int lane, SceneContext& ctx, const double** lane_q, Pose** lane_poses) const noexcept {
+void Scene::toLane(const double* state, int lane, SceneScratch& ctx, const double** lane_q,
+                   Pose** lane_poses) const noexcept {
   const RobotModel& model = robot();
   double* q = ctx.lane_q.data() + static_cast<std::ptrdiff_t>(lane) * model.variableCount();
   for (std::size_t i = 0; i < group_variables_.size(); ++i) q[group_variables_[i]] = state[i];
@@ -194,8 +230,9 @@ void Scene::toLane(const double* state, int lane, SceneContext& ctx, const doubl
   lane_poses[lane] = ctx.lane_poses.data() + static_cast<std::ptrdiff_t>(lane) * model.linkCount();
 }
 
-int Scene::anyCollides(const double* states, int count, SceneContext& ctx, CollisionReport* report,
+int Scene::anyCollides(const double* states, int count, SceneContext& context, CollisionReport* report,
                        const double* times) const noexcept {
+  SceneScratch& ctx = scratchOf(context.scratch_);
   CollisionReport local;
   CollisionReport& r = report ? *report : local;
   r = CollisionReport{};
@@ -205,7 +242,7 @@ int Scene::anyCollides(const double* states, int count, SceneContext& ctx, Colli
   // A context made for another robot (or before lanes existed) takes the states one at a time.
   if (!lanesFit(ctx)) {
     for (int s = 0; s < count; ++s)
-      if (!isFree(state(s), ctx, &r, time(s))) return s;
+      if (!checkState(state(s), ctx, &r, time(s))) return s;
     return -1;
   }
   const Effects& fx = description_.effects;
@@ -242,11 +279,13 @@ int Scene::anyCollides(const double* states, int count, SceneContext& ctx, Colli
   return -1;
 }
 
-void Scene::areFree(const double* states, int count, SceneContext& ctx, bool* free, double t) const noexcept {
+void Scene::areFree(const double* states, int count, SceneContext& context, bool* free, double t) const noexcept {
+  SceneScratch& ctx = scratchOf(context.scratch_);
   const int dim = dimension();
   // A context made for another robot (or before lanes existed) takes the states one at a time.
   if (!lanesFit(ctx)) {
-    for (int s = 0; s < count; ++s) free[s] = isFree(states + static_cast<std::ptrdiff_t>(s) * dim, ctx, nullptr, t);
+    for (int s = 0; s < count; ++s)
+      free[s] = checkState(states + static_cast<std::ptrdiff_t>(s) * dim, ctx, nullptr, t);
     return;
   }
   const Effects& fx = description_.effects;
@@ -295,16 +334,17 @@ bool Scene::isFree(const std::vector<double>& state, CollisionReport* report, do
 
 SceneContext& Scene::threadContext() const {
   // Keyed by serial, not address: a new scene at a freed scene's address must not inherit its caches.
-  return detail::perThread<SceneContext>(scratch_owner_, [this] { return makeContext(); });
+  return thread_context_.get([this] { return makeContext(); });
 }
 
-double Scene::clearance(const double* state, SceneContext& ctx, double* lower_bound, double t) const noexcept {
+double Scene::clearance(const double* state, SceneContext& context, double* lower_bound, double t) const noexcept {
+  SceneScratch& ctx = scratchOf(context.scratch_);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const Effects& fx = description_.effects;
   if (!fx.clearance) return nan;
   if (!withinBounds(state) || !withinTime(t) || ctx.poses.size() != static_cast<std::size_t>(robot().linkCount())) return nan;
   ++ctx.counters.clearance_queries;
-  computePoses(state, ctx);
+  place(state, ctx);
   // Distances first; EPA only when something touches (then the value is minus the deepest penetration).
   const bool env = fx.environment && !environment_->empty();
   double best = env ? static_clearance_ : std::numeric_limits<double>::infinity();

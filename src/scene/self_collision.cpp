@@ -7,10 +7,44 @@
 #include <string>
 
 namespace clearway {
+namespace scene_detail {
+
+// What SelfCollisionContext holds.
+struct SelfScratch {
+  std::vector<BodyPair> bodies;            // per checked pair: its two links' geometry and warm starts
+  EnclosingBalls balls;                    // the links' enclosing balls at the current query's poses
+  std::vector<int> unsure;                 // pairs the cheap rungs left to the triangles (scratch of one query)
+  std::vector<std::uint8_t> table_free;    // per pair: its table called it Free at this query's q
+  std::vector<std::uint8_t> bounds_apart;  // per pair: its bounding balls apart at this query's poses
+  int last_hit = -1;                       // the pair (index into pairs()) that last collided, tried first; -1: none
+  long long pair_tests = 0;  // pairs that reached the narrow phase (bounding spheres not apart), cumulative
+};
+
+}  // namespace scene_detail
+
 namespace {
 constexpr double kNoCutoff = std::numeric_limits<double>::infinity();
 
+using scene_detail::SelfScratch;
+
+// The scratch of a context; a default-made (or moved-from) one's is an empty scratch of this thread, which
+// holds no warm starts, no balls and no room, so that its queries answer as a fresh context's.
+SelfScratch& scratchOf(std::unique_ptr<SelfScratch>& s) noexcept {
+  thread_local SelfScratch none;
+  if (s) return *s;
+  none.last_hit = -1;
+  return none;
+}
+
 }  // namespace
+
+SelfCollisionContext::SelfCollisionContext() noexcept = default;
+SelfCollisionContext::SelfCollisionContext(SelfCollisionContext&&) noexcept = default;
+SelfCollisionContext& SelfCollisionContext::operator=(SelfCollisionContext&&) noexcept = default;
+SelfCollisionContext::~SelfCollisionContext() = default;
+SelfCollisionContext::SelfCollisionContext(std::unique_ptr<SelfScratch> scratch) noexcept
+    : scratch_(std::move(scratch)) {}
+long long SelfCollisionContext::pairTests() const noexcept { return scratch_ ? scratch_->pair_tests : 0; }
 
 SelfCollision::SelfCollision(std::shared_ptr<const RobotGeometry> geometry, const CollisionFilter& filter,
                              SelfCollisionOptions options)
@@ -47,37 +81,37 @@ SelfCollision::SelfCollision(std::shared_ptr<const RobotGeometry> geometry, cons
 }
 
 SelfCollisionContext SelfCollision::makeContext() const {
-  SelfCollisionContext c;
+  auto scratch = std::make_unique<SelfScratch>();
+  SelfScratch& c = *scratch;
   c.bodies.reserve(pairs_.size());
   for (const LinkPair& p : pairs_) c.bodies.emplace_back(*geometry_->link(p.a), *geometry_->link(p.b));
   c.balls = EnclosingBalls(*geometry_);
   c.unsure.reserve(pairs_.size());
   c.table_free.assign(pairs_.size(), 0);
   c.bounds_apart.assign(pairs_.size(), 0);
-  return c;
+  return SelfCollisionContext(std::move(scratch));
 }
 
-bool SelfCollision::placeBalls(const Pose* poses, SelfCollisionContext& ctx) const noexcept {
-  if (!ctx.balls.madeFor(*geometry_)) return false;  // a default context, or another robot's
+EnclosingBalls* SelfCollision::placeBalls(const Pose* poses, SelfScratch& ctx) const noexcept {
+  if (!ctx.balls.madeFor(*geometry_)) return nullptr;  // a default context, or another robot's
   ctx.balls.place(poses);
-  return true;
+  return &ctx.balls;
 }
 
-bool SelfCollision::pairCollides(int k, const Pose* poses, SelfCollisionContext& ctx) const noexcept {
-  return pairHits(k, poses, ctx, false);
+bool SelfCollision::pairCollides(int k, const Pose* poses, SelfCollisionContext& context) const noexcept {
+  return pairHits(k, poses, scratchOf(context.scratch_), nullptr);
 }
 
-bool SelfCollision::pairHits(int k, const Pose* poses, SelfCollisionContext& ctx, bool balls_placed) const noexcept {
-  const Screen s = pairScreen(k, poses, ctx, balls_placed);
+bool SelfCollision::pairHits(int k, const Pose* poses, SelfScratch& ctx, EnclosingBalls* balls) const noexcept {
+  const Screen s = pairScreen(k, poses, ctx, balls);
   return s == Screen::Unsure ? pairExactly(k, poses) : s == Screen::Touching;
 }
 
-Screen SelfCollision::pairScreen(int k, const Pose* poses, SelfCollisionContext& ctx, bool balls_placed) const noexcept {
+Screen SelfCollision::pairScreen(int k, const Pose* poses, SelfScratch& ctx, EnclosingBalls* balls) const noexcept {
   const LinkPair& p = pairs_[k];
   ++ctx.pair_tests;
   // (Hull mode: the hulls decide, which the parts' balls need not hold.)
-  if (balls_placed &&
-      ctx.balls.apart(p.a, p.b, pair_padding_[k], options_.tolerances, options_.mode == GeometryMode::Mesh))
+  if (balls && balls->apart(p.a, p.b, pair_padding_[k], options_.tolerances, options_.mode == GeometryMode::Mesh))
     return Screen::Apart;
   const IntersectQuery q{pair_padding_[k], options_.mode};
   if (k < static_cast<int>(ctx.bodies.size())) return ctx.bodies[k].screen(poses[p.a], poses[p.b], options_.tolerances, q);
@@ -90,8 +124,9 @@ bool SelfCollision::pairExactly(int k, const Pose* poses) const noexcept {
                                 options_.tolerances, pair_padding_[k]);
 }
 
-const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionContext& ctx, const double* q,
-                                              bool balls_placed) const noexcept {
+const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionContext& context, const double* q,
+                                              EnclosingBalls* placed) const noexcept {
+  SelfScratch& ctx = scratchOf(context.scratch_);
   const int n = static_cast<int>(pairs_.size());
   // The tables first: a pair they prove colliding ends the query before any geometry is placed.
   // A witness (two triangles that touched at the centre of the pair's unsure cell) proves a collision
@@ -110,12 +145,12 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
                                       options_.tolerances, pair_padding_[k]))
         return hit(k, ctx);
     }
-  const bool balls = balls_placed || placeBalls(poses, ctx);
+  EnclosingBalls* balls = placed ? placed : placeBalls(poses, ctx);
   // The enclosing layer's first rung for every pair at once (SIMD lanes): most pairs end here.
   const bool bounds = balls && ctx.bounds_apart.size() == pairs_.size();
   if (bounds)
-    ctx.balls.boundsApart(pair_a_.data(), pair_b_.data(), pair_padding_.data(), n, options_.tolerances,
-                          ctx.bounds_apart.data());
+    balls->boundsApart(pair_a_.data(), pair_b_.data(), pair_padding_.data(), n, options_.tolerances,
+                       ctx.bounds_apart.data());
   // A pair that collided a moment ago probably still does: trying it first ends most colliding queries
   // of a planner exploring near an obstacle after one pair test.
   const auto tableFree = [&](int k) {
@@ -149,13 +184,14 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
   return nullptr;
 }
 
-const LinkPair* SelfCollision::hit(int k, SelfCollisionContext& ctx) const noexcept {
+const LinkPair* SelfCollision::hit(int k, SelfScratch& ctx) const noexcept {
   ctx.last_hit = k;
   return &pairs_[k];
 }
 
-void SelfCollision::allCollisions(const Pose* poses, SelfCollisionContext& ctx, std::vector<LinkPair>& out) const {
-  const bool balls = placeBalls(poses, ctx);
+void SelfCollision::allCollisions(const Pose* poses, SelfCollisionContext& context, std::vector<LinkPair>& out) const {
+  SelfScratch& ctx = scratchOf(context.scratch_);
+  EnclosingBalls* balls = placeBalls(poses, ctx);
   for (int k = 0; k < static_cast<int>(pairs_.size()); ++k)
     if (pairHits(k, poses, ctx, balls)) out.push_back(pairs_[k]);
 }
@@ -183,10 +219,11 @@ DistanceResult SelfCollision::minimumDistance(const Pose* poses, LinkPair* pair,
 }
 
 double SelfCollision::penetration(const Pose* poses, SelfCollisionContext& context, LinkPair* pair) const {
+  SelfScratch& ctx = scratchOf(context.scratch_);
   double deepest = 0.0;
-  const bool balls = placeBalls(poses, context);
+  EnclosingBalls* balls = placeBalls(poses, ctx);
   for (int k = 0; k < static_cast<int>(pairs_.size()); ++k) {
-    if (!pairHits(k, poses, context, balls)) continue;
+    if (!pairHits(k, poses, ctx, balls)) continue;
     const LinkPair& p = pairs_[k];
     const double depth = BodyPair(*geometry_->link(p.a), *geometry_->link(p.b))
                              .penetration(poses[p.a], poses[p.b], options_.tolerances, pair_padding_[k]);

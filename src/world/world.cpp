@@ -1,6 +1,6 @@
 #include <clearway/world/world.h>
 
-#include <clearway/detail/per_thread.h>
+#include <clearway/per_thread.h>
 
 #include <stdexcept>
 #include <utility>
@@ -23,14 +23,11 @@ std::shared_ptr<const WorldSnapshot> World::snapshot() const {
 }
 
 const WorldSnapshot& World::current() const {
-  struct Seen {
-    std::shared_ptr<const WorldSnapshot> snapshot;
-  };
-  Seen& seen = detail::perThread<Seen>(scratch_owner_, [] { return Seen{}; });
+  std::shared_ptr<const WorldSnapshot>& seen = seen_.get([] { return std::shared_ptr<const WorldSnapshot>(); });
   // The version is stored after current_ is swapped, under the same lock: seeing a new version, the copy
   // taken under the lock is at least that new.
-  if (!seen.snapshot || seen.snapshot->version != version_.load(std::memory_order_acquire)) seen.snapshot = snapshot();
-  return *seen.snapshot;
+  if (!seen || seen->version != version_.load(std::memory_order_acquire)) seen = snapshot();
+  return *seen;
 }
 
 void World::publish(std::shared_ptr<const Scene> scene, std::shared_ptr<const MotionChecker> motion) {

@@ -218,10 +218,11 @@ inline void expectBoundsHold(const std::shared_ptr<const Scene>& scene, std::mt1
       const auto vertices = [&](int link) -> const std::vector<Vec3>& { return scene->geometry().link(link)->hull().vertices(); };
       for (int link : scene->environmentLinks()) {
         const double b = bound.link(link, dq.data());
-        for (const Vec3& v : vertices(link)) EXPECT_LE((c1.poses[link] * v - c0.poses[link] * v).norm(), b + 1e-9) << name;
+        for (const Vec3& v : vertices(link))
+          EXPECT_LE((c1.poses()[link] * v - c0.poses()[link] * v).norm(), b + 1e-9) << name;
         // linkStep: over h·dq (and every state on the way) no vertex moves d or farther.
         const double d = std::uniform_real_distribution<double>(0.001, 0.3)(rng);
-        const double h = bound.linkStep(link, dq.data(), c0.poses.data(), d);
+        const double h = bound.linkStep(link, dq.data(), c0.poses().data(), d);
         EXPECT_GE(h, d / b * (1 - 1e-12)) << name;
         for (double t : {0.25, 0.5, 0.75, 1.0}) {
           std::vector<double> q(n);
@@ -229,7 +230,7 @@ inline void expectBoundsHold(const std::shared_ptr<const Scene>& scene, std::mt1
           SceneContext ct = scene->makeContext();
           scene->computePoses(q.data(), ct);
           for (const Vec3& v : vertices(link))
-            EXPECT_LE((ct.poses[link] * v - c0.poses[link] * v).norm(), d + 1e-9)
+            EXPECT_LE((ct.poses()[link] * v - c0.poses()[link] * v).norm(), d + 1e-9)
                 << name << ": " << scene->robot().link(link).name << " h " << h << " t " << t;
         }
       }
@@ -240,7 +241,7 @@ inline void expectBoundsHold(const std::shared_ptr<const Scene>& scene, std::mt1
         const auto& vb = vertices(p.b);
         // pairStep: over h·dq (and every state on the way) no distance between their vertices changes by d.
         const double d = std::uniform_real_distribution<double>(0.001, 0.2)(rng);
-        const double h = std::min(1.0, bound.pairStep(p.a, p.b, dq.data(), c0.poses.data(), d));
+        const double h = std::min(1.0, bound.pairStep(p.a, p.b, dq.data(), c0.poses().data(), d));
         for (double t : {0.5, 1.0}) {
           std::vector<double> q(n);
           for (int i = 0; i < n; ++i) q[i] = q0[i] + h * t * dq[i];
@@ -248,16 +249,16 @@ inline void expectBoundsHold(const std::shared_ptr<const Scene>& scene, std::mt1
           scene->computePoses(q.data(), ct);
           for (std::size_t i = 0; i < va.size(); i += 1 + va.size() / 6)
             for (std::size_t j = 0; j < vb.size(); j += 1 + vb.size() / 6) {
-              const double before = (c0.poses[p.b] * vb[j] - c0.poses[p.a] * va[i]).norm();
-              const double after = (ct.poses[p.b] * vb[j] - ct.poses[p.a] * va[i]).norm();
+              const double before = (c0.poses()[p.b] * vb[j] - c0.poses()[p.a] * va[i]).norm();
+              const double after = (ct.poses()[p.b] * vb[j] - ct.poses()[p.a] * va[i]).norm();
               EXPECT_LE(std::abs(after - before), d + 1e-9) << name << ": " << scene->robot().link(p.a).name << " / "
                                                             << scene->robot().link(p.b).name << " h " << h;
             }
         }
         for (std::size_t i = 0; i < va.size(); i += 1 + va.size() / 12)
           for (std::size_t j = 0; j < vb.size(); j += 1 + vb.size() / 12) {
-            const double before = (c0.poses[p.b] * vb[j] - c0.poses[p.a] * va[i]).norm();
-            const double after = (c1.poses[p.b] * vb[j] - c1.poses[p.a] * va[i]).norm();
+            const double before = (c0.poses()[p.b] * vb[j] - c0.poses()[p.a] * va[i]).norm();
+            const double after = (c1.poses()[p.b] * vb[j] - c1.poses()[p.a] * va[i]).norm();
             EXPECT_LE(std::abs(after - before), b + 1e-9)
                 << name << ": " << scene->robot().link(p.a).name << " / " << scene->robot().link(p.b).name;
             ++checked;
@@ -302,25 +303,26 @@ inline std::pair<double, double> expectTwistHolds(const Scene& scene, std::mt199
     at(s, ct);
     for (const int link : scene.environmentLinks()) {
       double speed = 0.0, accel = 0.0;
-      EXPECT_TRUE(bound.linkTwist(link, dq.data(), ct.poses.data(), speed, accel)) << name << ": every joint turns";
+      EXPECT_TRUE(bound.linkTwist(link, dq.data(), ct.poses().data(), speed, accel)) << name << ": every joint turns";
       ++links;
       tighter += speed < bound.link(link, dq.data());
       const std::vector<Vec3>& vertices = scene.geometry().link(link)->hull().vertices();
       for (std::size_t k = 0; k < vertices.size(); k += 1 + vertices.size() / 24) {
-        const Vec3 x = ct.poses[link] * vertices[k];
+        const Vec3 x = ct.poses()[link] * vertices[k];
         constexpr double kV = 1e-6, kA = 1e-3;  // difference steps: truncation and rounding both far below the bounds
         at(s + kV, cp), at(s - kV, cm);
-        const double v = (cp.poses[link] * vertices[k] - cm.poses[link] * vertices[k]).norm() / (2 * kV);
+        const double v = (cp.poses()[link] * vertices[k] - cm.poses()[link] * vertices[k]).norm() / (2 * kV);
         EXPECT_LE(v, speed * (1 + 1e-6) + 1e-7) << name << ": " << scene.robot().link(link).name;
         at(s + kA, cp), at(s - kA, cm);
-        const double a = (cp.poses[link] * vertices[k] - 2.0 * x + cm.poses[link] * vertices[k]).norm() / (kA * kA);
+        const double a = (cp.poses()[link] * vertices[k] - 2.0 * x + cm.poses()[link] * vertices[k]).norm() / (kA * kA);
         EXPECT_LE(a, accel * (1 + 1e-3) + 1e-6) << name << ": " << scene.robot().link(link).name;
         worst_speed = std::max(worst_speed, v / speed);
         worst_accel = std::max(worst_accel, a / accel);
         for (const double h : {0.05, 0.3, 1.0}) {
           const double step = h * std::max(s, 1.0 - s);  // either way, as far as the segment goes
           at(s + (s < 0.5 ? step : -step), ch);
-          EXPECT_LE((ch.poses[link] * vertices[k] - x).norm(), step * speed + 0.5 * step * step * accel + 1e-9) << name;
+          EXPECT_LE((ch.poses()[link] * vertices[k] - x).norm(), step * speed + 0.5 * step * step * accel + 1e-9)
+              << name;
         }
       }
     }

@@ -47,7 +47,7 @@ TEST(MotionBound, BoundsTheMotionOfEveryPoint) {
     scene->computePoses(q1, c1);
     // The corners of link2's bounding cylinder (end points on its surface).
     for (const Vec3 p : {Vec3(0.5, 0.05, 0), Vec3(0, -0.05, 0.05), Vec3(0.5, 0, -0.05)}) {
-      const double moved = (c1.poses[link2] * p - c0.poses[link2] * p).norm();
+      const double moved = (c1.poses()[link2] * p - c0.poses()[link2] * p).norm();
       EXPECT_LE(moved, bound.link(link2, dq) + 1e-12);
     }
     // The pair bound: link2's motion relative to link1 depends on the elbow only; watched from link2,
@@ -57,8 +57,8 @@ TEST(MotionBound, BoundsTheMotionOfEveryPoint) {
     EXPECT_LE(pair, bound.linkCoefficient(link2, 1) * std::abs(dq[1]) + 1e-12);
     for (const Vec3 p1 : {Vec3(1.0, 0.05, 0), Vec3(0.2, -0.05, 0.05), Vec3(0, 0, 0)})
       for (const Vec3 p2 : {Vec3(0.5, 0.05, 0), Vec3(0, -0.05, 0.05), Vec3(0.25, 0, -0.05)}) {
-        const double before = (c0.poses[link2] * p2 - c0.poses[link1] * p1).norm();
-        const double after = (c1.poses[link2] * p2 - c1.poses[link1] * p1).norm();
+        const double before = (c0.poses()[link2] * p2 - c0.poses()[link1] * p1).norm();
+        const double after = (c1.poses()[link2] * p2 - c1.poses()[link1] * p1).norm();
         EXPECT_LE(std::abs(after - before), pair + 1e-12);
       }
   }
@@ -82,7 +82,7 @@ TEST(MotionBound, HoldsForPlanarAndFloatingJoints) {
       for (int i = 0; i < n; ++i) dq[i] = b[i] - a[i];
       std::vector<std::vector<Vec3>> start;
       scene->computePoses(a.data(), ctx);
-      const std::vector<Pose> p0 = ctx.poses;
+      const std::vector<Pose> p0 = ctx.poses();
       for (int k = 1; k <= 20; ++k) {
         const double t = k / 20.0;
         checker.interpolate(q0.data(), q1.data(), t, q.data());
@@ -92,7 +92,7 @@ TEST(MotionBound, HoldsForPlanarAndFloatingJoints) {
           if (!g) continue;
           const double bound = t * checker.bound().link(link, dq.data());
           for (const Vec3& v : g->hull().vertices()) {
-            const double moved = (ctx.poses[link] * v - p0[link] * v).norm();
+            const double moved = (ctx.poses()[link] * v - p0[link] * v).norm();
             ASSERT_LE(moved, bound * (1 + 1e-9) + 1e-12) << scene->name() << " trial " << trial << " link " << link;
             tightest = std::max(tightest, moved / bound);
           }
@@ -100,10 +100,10 @@ TEST(MotionBound, HoldsForPlanarAndFloatingJoints) {
       }
       // The ends: the states themselves (a quaternion up to its sign and norm).
       scene->computePoses(q1.data(), ctx);
-      const std::vector<Pose> end = ctx.poses;
+      const std::vector<Pose> end = ctx.poses();
       scene->computePoses(b.data(), ctx);
       for (int link = 0; link < scene->robot().linkCount(); ++link)
-        EXPECT_LT((ctx.poses[link].t - end[link].t).norm() + (ctx.poses[link].R - end[link].R).norm(), 1e-9);
+        EXPECT_LT((ctx.poses()[link].t - end[link].t).norm() + (ctx.poses()[link].R - end[link].R).norm(), 1e-9);
     }
     EXPECT_GT(tightest, 0.3) << scene->name() << ": a bound this loose would make the check slow";
   }
@@ -140,8 +140,8 @@ TEST(MotionBound, NeverNaNWithAnUnboundedSlideBelowAStillMimic) {
     std::vector<double> dq = {u(rng), trial % 2 ? 0.0 : u(rng), trial % 3 ? 0.0 : u(rng), trial % 5 ? 0.0 : u(rng)};
     scene->computePoses(q.data(), ctx);
     for (const double b : {bound.link(cart, dq.data()), bound.pair(turret, cart, dq.data()),
-                           bound.linkStep(cart, dq.data(), ctx.poses.data(), 0.05),
-                           bound.pairStep(turret, cart, dq.data(), ctx.poses.data(), 0.05)})
+                           bound.linkStep(cart, dq.data(), ctx.poses().data(), 0.05),
+                           bound.pairStep(turret, cart, dq.data(), ctx.poses().data(), 0.05)})
       EXPECT_FALSE(std::isnan(b)) << "trial " << trial;
   }
   // The cart swung through the post by the turret (the cart's slides still), and past it: as dense sampling.
@@ -265,8 +265,8 @@ TEST(MotionBound, HoldsForConvexParts) {
           const std::vector<Vec3>& va = pa[k].hull.vertices();
           for (std::size_t i = 0; i < va.size(); i += 1 + va.size() / 8)
             for (std::size_t j = 0; j < vb.size(); j += 1 + vb.size() / 8) {
-              const double before = (c0.poses[p.b] * vb[j] - c0.poses[p.a] * va[i]).norm();
-              const double after = (c1.poses[p.b] * vb[j] - c1.poses[p.a] * va[i]).norm();
+              const double before = (c0.poses()[p.b] * vb[j] - c0.poses()[p.a] * va[i]).norm();
+              const double after = (c1.poses()[p.b] * vb[j] - c1.poses()[p.a] * va[i]).norm();
               EXPECT_LE(std::abs(after - before), b + 1e-9)
                   << name << ": part " << k << " of " << scene->robot().link(p.a).name << " / " << scene->robot().link(p.b).name;
               ++checked;

@@ -333,7 +333,7 @@ TEST(OmplPlugin, PlansAgainAfterAnEditWithoutNewSpaceInformation) {
   Obstacle ball;
   ball.name = "ball";
   ball.shape = Sphere(0.06);
-  ball.pose = Pose::translation(ctx.poses[scene->robot().linkIndex("wrist_2_link")].t);
+  ball.pose = Pose::translation(ctx.poses()[scene->robot().linkIndex("wrist_2_link")].t);
   world->addObstacle(ball);
   EXPECT_FALSE(c.validity->isValid(first.getState(first.getStateCount() / 2)));
   bool first_blocked = false;

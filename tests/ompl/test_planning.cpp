@@ -162,7 +162,7 @@ TEST(Planning, PlansAroundAnObstacleOfAnEditedScene) {
   Obstacle ball;
   ball.name = "ball";
   ball.shape = Sphere(0.06);
-  ball.pose = Pose::translation(ctx.poses[scene->robot().linkIndex("wrist_2_link")].t);
+  ball.pose = Pose::translation(ctx.poses()[scene->robot().linkIndex("wrist_2_link")].t);
   const auto edited = scene->withEnvironment(std::make_shared<const Environment>(scene->environment().withObstacle(ball)));
   ASSERT_FALSE(edited->isFree(mid));
   const PlanResult second = plan(edited, request);

@@ -58,7 +58,7 @@ TEST(Attached, TouchesOnlyItsTouchLinksAndItsLink) {
   // Where the ball sits at the stick's height, the two held bodies meet.
   SceneContext ctx = plain->makeContext();
   plain->computePoses(std::vector<double>(6, 0.0).data(), ctx);
-  const double height = ctx.poses[stick].t.z();
+  const double height = ctx.poses()[stick].t.z();
   std::string at_height = ball;
   at_height.replace(at_height.find("[0.3, 0, 0]"), 11, "[0.3, 0, " + std::to_string(height) + "]");
   const auto both = Scene::load(dir.write("both.yaml", armScene(std::string(kStick) + at_height, "")));
@@ -81,7 +81,7 @@ TEST(Attached, CertifiedCatchesASweepThroughAPostThatSamplingMisses) {
   const double mid = a + (b - a) * (std::floor(n / 2) + 0.5) / n;
   SceneContext ctx = probe->makeContext();
   probe->computePoses(std::vector<double>{mid, 0, 0, 0, 0, 0}.data(), ctx);
-  const Vec3 post = ctx.poses[probe->robot().linkIndex("stick")] * Vec3(0.2, 0, 0);  // 0.5 m out along the stick
+  const Vec3 post = ctx.poses()[probe->robot().linkIndex("stick")] * Vec3(0.2, 0, 0);  // 0.5 m out along the stick
   const std::string obstacles = "    - {name: post, cylinder: {radius: 0.001, length: 0.1}, pose: {position: [" +
                                 std::to_string(post.x()) + ", " + std::to_string(post.y()) + ", " +
                                 std::to_string(post.z()) + "]}}\n";

@@ -281,14 +281,14 @@ TEST(Scene, PlanarArmAgainstAWall) {
   // by moving 0.25 along +x (0.35 along −x, 0.45 up, 1.05 sideways): the signed clearance is −0.25,
   // and EPA ran for it.
   const double into[2] = {0.0, 0.0};
-  const long long epa_before = ctx.counters.environment.penetration_tests;
+  const long long epa_before = ctx.counters().environment.penetration_tests;
   EXPECT_NEAR(scene->clearance(into, ctx, &lower), -0.25, 1e-5);
   EXPECT_LE(lower, -0.25 + 1e-5);
-  EXPECT_GT(ctx.counters.environment.penetration_tests, epa_before);
+  EXPECT_GT(ctx.counters().environment.penetration_tests, epa_before);
   // Free states run no EPA.
-  const long long epa_free = ctx.counters.environment.penetration_tests;
+  const long long epa_free = ctx.counters().environment.penetration_tests;
   scene->clearance(up, ctx);
-  EXPECT_EQ(ctx.counters.environment.penetration_tests, epa_free);
+  EXPECT_EQ(ctx.counters().environment.penetration_tests, epa_free);
 }
 
 TEST(Scene, SignedClearanceOfSelfPenetration) {
@@ -463,7 +463,7 @@ TEST(Scene, UndeclaredEffectsCostNothing) {
     int colliding = 0;
     for (const auto& s : states) colliding += !scene->isFree(s.data(), ctx);
     const double c = scene->clearance(states[0].data(), ctx);
-    const SceneCounters& n = ctx.counters;
+    const SceneCounters& n = ctx.counters();
     SCOPED_TRACE(checks);
     EXPECT_EQ(n.states, 200);
     const bool env = scene->effects().environment, self = scene->effects().self;
@@ -497,8 +497,8 @@ TEST(Scene, ContextsOfDroppedScenesAreReleased) {
     scene->isFree({M_PI / 2, 0.0});
   }
   live->isFree({M_PI / 2, 0.0});
-  EXPECT_LE(detail::threadScratch<SceneContext>().size(), 2u);
-  EXPECT_GE(detail::threadScratch<SceneContext>().size(), 1u);
+  EXPECT_LE(PerThread<SceneContext>::heldByThisThread(), 2u);
+  EXPECT_GE(PerThread<SceneContext>::heldByThisThread(), 1u);
 }
 
 TEST(Scene, ThreadsShareOneScene) {
@@ -677,18 +677,15 @@ void expectLeadKeepsVerdicts(const Scene& scene, const std::string& what, std::m
       for (int i = 0; i < scene.dimension(); ++i)
         q[i] = std::clamp(q[i] + std::normal_distribution<double>(0.0, 0.15)(rng), scene.lower(i), scene.upper(i));
       CollisionReport a, b;
-      if (step == 7) kept.env_last_hit = walk % 2 ? 1000 : -5;  // (a context of another scene's: out of range)
       const bool led = scene.isFree(q.data(), kept, &a);
       ASSERT_EQ(led, fresh(b)) << what << " walk " << walk << " step " << step;
       if (led || a.kind != CollisionReport::Kind::Environment) continue;
       ++env_hits;
       const int link = a.link;
-      EXPECT_TRUE(scene.environment().linkIntersects(*scene.geometry().link(link), kept.poses[link],
+      EXPECT_TRUE(scene.environment().linkIntersects(*scene.geometry().link(link), kept.poses()[link],
                                                      scene.options().tolerances,
                                                      {scene.linkPadding(link), scene.options().mode}))
           << what << ": reported " << scene.describe(a) << ", which does not collide";
-      ASSERT_GE(kept.env_last_hit, 0);
-      EXPECT_EQ(scene.environmentLinks()[kept.env_last_hit], link) << what;
       changed += b.kind != CollisionReport::Kind::Environment || b.link != link;
     }
   }
@@ -741,9 +738,9 @@ void expectGridKeepsVerdicts(const std::shared_ptr<const Scene>& with, const std
   std::unique_ptr<bool[]> free(new bool[verdicts.size()]);
   with->areFree(states.data(), static_cast<int>(verdicts.size()), batched, free.get());
   for (std::size_t k = 0; k < verdicts.size(); ++k) ASSERT_EQ(free[k], verdicts[k] != 0) << what << " batched state " << k;
-  EXPECT_EQ(b.counters.environment.grid_clears, 0) << what;
-  EXPECT_GT(a.counters.environment.grid_clears, 0) << what << ": the grid cleared no link";
-  clears += a.counters.environment.grid_clears;
+  EXPECT_EQ(b.counters().environment.grid_clears, 0) << what;
+  EXPECT_GT(a.counters().environment.grid_clears, 0) << what << ": the grid cleared no link";
+  clears += a.counters().environment.grid_clears;
 }
 
 // Two open plates (0.2 m squares at z = ±0.5) as dir/plates.stl: one link of two parts whose hull is a
@@ -785,7 +782,7 @@ TEST(Scene, TheClearanceGridKeepsHullModeVerdicts) {
     const std::vector<double> q = {0.0};
     EXPECT_EQ(scene->isFree(q.data(), ctx), mode == GeometryMode::Mesh) << (mode == GeometryMode::Mesh ? "mesh" : "hull");
     if (mode == GeometryMode::Mesh)  // (the parts' balls cleared it: the path the hull must not take)
-      EXPECT_EQ(ctx.counters.environment.grid_clears, 1);
+      EXPECT_EQ(ctx.counters().environment.grid_clears, 1);
   }
 }
 

@@ -87,10 +87,17 @@ TEST(SelfCollision, ScissorsMatchesTheAnalyticAnswer) {
     computeLinkPoses(*model, &theta, poses.data());
     const bool expected = rectanglesMeet(theta, 0.05);
     EXPECT_EQ(checker.firstCollision(poses.data(), ctx) != nullptr, expected) << "theta " << theta;
+    // A default-made context (no warm starts, no balls, no room) answers the same; so does a moved-from one.
+    SelfCollisionContext none;
+    EXPECT_EQ(checker.firstCollision(poses.data(), none) != nullptr, expected) << "theta " << theta;
+    SelfCollisionContext taken = std::move(none);
+    EXPECT_EQ(checker.firstCollision(poses.data(), none) != nullptr, expected)
+        << "theta " << theta;  // NOLINT(bugprone-use-after-move)
     (expected ? collide : free)++;
   }
   EXPECT_GT(collide, 50);
   EXPECT_GT(free, 2000);
+  EXPECT_EQ(ctx.pairTests(), collide + free) << "one pair tested per query";
 }
 
 TEST(SelfCollision, PaddingWidensTheContact) {

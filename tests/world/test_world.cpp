@@ -269,7 +269,7 @@ TEST(WorldAttach, CertifiedCatchesAnAttachedStickSweepingThroughAPostThatSamplin
   const double mid = a + (b - a) * (std::floor(n / 2) + 0.5) / n;
   SceneContext ctx = world->current().scene->makeContext();
   world->current().scene->computePoses(std::vector<double>{mid, 0, 0, 0, 0, 0}.data(), ctx);
-  const Vec3 post_at = ctx.poses[world->current().scene->robot().linkIndex("stick")] * Vec3(0.2, 0, 0);
+  const Vec3 post_at = ctx.poses()[world->current().scene->robot().linkIndex("stick")] * Vec3(0.2, 0, 0);
   Obstacle post;
   post.name = "post";
   post.shape = Cylinder(0.001, 0.05);
@@ -304,7 +304,7 @@ TEST(WorldPoints, VoxelsAppearWherePointsFell) {
   const int forearm = scene.robot().linkIndex("forearm_link");
   const LinkGeometry& g = *scene.geometry().link(forearm);
   ASSERT_FALSE(g.hull().vertices().empty());
-  const Vec3 on_link = ctx.poses[forearm] * g.hull().vertices()[0];
+  const Vec3 on_link = ctx.poses()[forearm] * g.hull().vertices()[0];
   const double res = 0.02;
   world->insertPoints({Vec3(2.0, 2.0, 2.0), Vec3(2.001, 2.001, 2.001), Vec3(-2.0, 0.0, 0.5)}, res);
   EXPECT_EQ(world->current().scene->environment().pointVoxelCount(), 2);  // two points share a voxel

@@ -4,12 +4,12 @@
 // `environment` no obstacle or voxel is looked at, without `clearance` no distance is computed, without
 // `moving` there is no time. Immutable once built; queries are thread-safe given one SceneContext per
 // thread (or through the convenience overloads, which keep one per thread themselves).
-#include <clearway/detail/per_thread.h>
 #include <clearway/environment/environment.h>
 #include <clearway/kinematics/kinematic_lanes.h>
 #include <clearway/kinematics/robot_model.h>
 #include <clearway/load/input_limits.h>
 #include <clearway/load/robot_loader.h>
+#include <clearway/per_thread.h>
 #include <clearway/scene/collision_filter.h>
 #include <clearway/scene/scene_file.h>
 #include <clearway/scene/self_collision.h>
@@ -45,18 +45,38 @@ struct SceneCounters {
   long long clearance_queries = 0;  ///< clearance calls that computed (valid state, scene with clearance)
 };
 
-/// Per-thread scratch of scene queries. Made by Scene::makeContext; queries allocate nothing in it.
-struct SceneContext {
-  std::vector<double> q;       ///< the full joint vector (group values, held values, defaults)
-  std::vector<Pose> poses;     ///< world pose of every link
-  SelfCollisionContext self;   ///< the self-collision checker's scratch
-  /// The environment link (an index into Scene::environmentLinks()) that last met an obstacle, −1: none.
-  int env_last_hit = -1;
-  SceneCounters counters;      ///< this context's work since it was made
-  /// Scene::areFree's kinematics over lanes of states (makeContext sets it).
-  std::optional<KinematicLanes> lanes;
-  std::vector<double> lane_q;    ///< KinematicLanes::kMaxLanes joint vectors
-  std::vector<Pose> lane_poses;  ///< KinematicLanes::kMaxLanes sets of link poses
+namespace scene_detail {
+struct SceneScratch;  // scene_scratch.h
+}  // namespace scene_detail
+
+/// One thread's scratch for a scene's queries (joint vector, link poses, the self checker's context, the
+/// links' enclosing balls, the lanes' kinematics): made by Scene::makeContext(), then reused; queries
+/// allocate nothing in it. Movable, not copyable; a default-made one holds nothing (a query given it
+/// answers Invalid).
+class SceneContext {
+ public:
+  SceneContext() noexcept;
+  ///@{
+  /// Takes the other context's scratch, leaving that one empty.
+  SceneContext(SceneContext&&) noexcept;
+  SceneContext& operator=(SceneContext&&) noexcept;
+  ///@}
+  ~SceneContext();
+
+  /// Every link's world pose at the state the context's last query (or Scene::computePoses) placed.
+  const std::vector<Pose>& poses() const noexcept;
+  /// The robot's full joint vector at that state (group values, held values, defaults).
+  const std::vector<double>& jointValues() const noexcept;
+  ///@{
+  /// This context's work since it was made (the caller may reset it).
+  SceneCounters& counters() noexcept;
+  const SceneCounters& counters() const noexcept;
+  ///@}
+
+ private:
+  friend class Scene;
+  explicit SceneContext(std::unique_ptr<scene_detail::SceneScratch> scratch) noexcept;
+  std::unique_ptr<scene_detail::SceneScratch> scratch_;
 };
 
 /// The robot a description names (URDF, SRDF, meshes → trees and hulls), with its attached bodies as links
@@ -164,7 +184,7 @@ class Scene {
   /// A context for this scene (allocates: make one per thread and reuse it).
   SceneContext makeContext() const;
 
-  /// Fills context.q (full joint vector) and context.poses from a state; no checks.
+  /// Places the state in the context (its jointValues() and poses()); no checks.
   void computePoses(const double* state, SceneContext& context) const noexcept;
 
   /// True when the state is within bounds and finite, and each floating joint's quaternion is not zero
@@ -214,18 +234,24 @@ class Scene {
   // A floating joint's quaternion (qx, qy, qz, qw) that the kinematics can normalise: its squares do not
   // add up to 0, as validateJointVector asks (a zero quaternion's poses are NaN).
   static bool rotates(const double* q) noexcept { return q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] > 0.0; }
+  // computePoses and isFree, given the context's scratch.
+  void place(const double* state, scene_detail::SceneScratch& ctx) const noexcept;
+  bool checkState(const double* state, scene_detail::SceneScratch& ctx, CollisionReport* report,
+                  double t) const noexcept;
   // isFree's geometry, once the poses of the state's links (and its full joint vector q) are known.
-  bool posedFree(const Pose* poses, const double* q, SceneContext& ctx, CollisionReport& r, double t) const noexcept;
+  bool posedFree(const Pose* poses, const double* q, scene_detail::SceneScratch& ctx, CollisionReport& r,
+                 double t) const noexcept;
   // Its two halves: the environment (placing the enclosing balls where the clearance grid is read, which
   // balls_placed then says), and the self pairs.
-  bool environmentFree(const Pose* poses, SceneContext& ctx, CollisionReport& r, double t,
+  bool environmentFree(const Pose* poses, scene_detail::SceneScratch& ctx, CollisionReport& r, double t,
                        bool& balls_placed) const noexcept;
-  bool selfFree(const Pose* poses, const double* q, SceneContext& ctx, CollisionReport& r,
+  bool selfFree(const Pose* poses, const double* q, scene_detail::SceneScratch& ctx, CollisionReport& r,
                 bool balls_placed) const noexcept;
   // True when the context has kinematic lanes for this robot (areFree, anyCollides; else one state at a time).
-  bool lanesFit(const SceneContext& ctx) const noexcept;
+  bool lanesFit(const scene_detail::SceneScratch& ctx) const noexcept;
   // A state into lane `lane` of the context's lanes: its full joint vector and where its poses go.
-  void toLane(const double* state, int lane, SceneContext& ctx, const double** lane_q, Pose** lane_poses) const noexcept;
+  void toLane(const double* state, int lane, scene_detail::SceneScratch& ctx, const double** lane_q,
+              Pose** lane_poses) const noexcept;
 
   SceneDescription description_;
   SceneOptions options_;
@@ -245,7 +271,7 @@ class Scene {
   CollisionReport self_static_collision_;  // the part of it among the robot's own links
   double static_clearance_ = std::numeric_limits<double>::infinity();  // static links to static obstacles
   double static_clearance_lower_ = std::numeric_limits<double>::infinity();
-  detail::ScratchOwner scratch_owner_;  // identifies this scene's per-thread contexts
+  PerThread<SceneContext> thread_context_;  // each thread's context for the overloads without one
 };
 
 }  // namespace clearway

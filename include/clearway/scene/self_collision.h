@@ -46,15 +46,29 @@ struct SelfCollisionOptions {
   double table_seconds = std::numeric_limits<double>::infinity();
 };
 
-/// Per-thread state of self-collision queries: one hull cache per pair and the pair that last collided.
-struct SelfCollisionContext {
-  std::vector<BodyPair> bodies;  ///< per checked pair: its two links' geometry and warm starts
-  EnclosingBalls balls;          ///< the links' enclosing balls at the current query's poses
-  std::vector<int> unsure;       ///< pairs the cheap rungs left to the triangles (scratch of one query)
-  std::vector<std::uint8_t> table_free;  ///< per pair: its table called it Free at this query's q (scratch)
-  std::vector<std::uint8_t> bounds_apart;  ///< per pair: its bounding balls apart at this query's poses (scratch)
-  int last_hit = -1;  ///< the pair (index into pairs()) that last collided, tried first; -1: none
-  long long pair_tests = 0;  ///< pairs that reached the narrow phase (bounding spheres not apart), cumulative
+namespace scene_detail {
+struct SelfScratch;  // self_collision.cpp
+}  // namespace scene_detail
+
+/// One thread's scratch for SelfCollision's queries (each pair's warm starts, the links' enclosing balls,
+/// the pair that collided last): made by the checker's makeContext(), then reused. Movable, not copyable;
+/// a default-made one holds nothing (queries given it answer the same, without warm starts).
+class SelfCollisionContext {
+ public:
+  SelfCollisionContext() noexcept;
+  ///@{
+  /// Takes the other context's scratch, leaving that one empty.
+  SelfCollisionContext(SelfCollisionContext&&) noexcept;
+  SelfCollisionContext& operator=(SelfCollisionContext&&) noexcept;
+  ///@}
+  ~SelfCollisionContext();
+  /// Pairs that reached the narrow phase through this context (their bounding balls not apart), cumulative.
+  long long pairTests() const noexcept;
+
+ private:
+  friend class SelfCollision;
+  explicit SelfCollisionContext(std::unique_ptr<scene_detail::SelfScratch> scratch) noexcept;
+  std::unique_ptr<scene_detail::SelfScratch> scratch_;
 };
 
 /// Self-collision checker of one robot with one filter. Immutable; queries are thread-safe given one
@@ -82,13 +96,11 @@ class SelfCollision {
   /// The pair that collided in the previous query of this context is tried first (frame coherence).
   /// Never "free" by accident: a non-finite pose collides. q (optional): the configuration the poses were
   /// computed from (every variable of the robot, held ones at their held values), which lets the pair
-  /// tables answer; the verdict is the same with or without it. balls_placed: placeBalls() was last
-  /// called with these very poses (and its answer was true), so they are not placed again.
+  /// tables answer; the verdict is the same with or without it. placed (optional): the links' enclosing
+  /// balls, made for this robot and placed at these very poses by the caller (which shares them with its
+  /// other checks); without them the context's own are placed.
   const LinkPair* firstCollision(const Pose* link_poses, SelfCollisionContext& context, const double* q = nullptr,
-                                 bool balls_placed = false) const noexcept;
-  /// Places the context's enclosing balls (body/enclosing.h) at these poses when it has them (a context
-  /// made by makeContext); false otherwise.
-  bool placeBalls(const Pose* link_poses, SelfCollisionContext& context) const noexcept;
+                                 EnclosingBalls* placed = nullptr) const noexcept;
   /// Every colliding pair at these poses, appended to `out` in pair order.
   void allCollisions(const Pose* link_poses, SelfCollisionContext& context, std::vector<LinkPair>& out) const;
   /// True when pair index k collides at these poses.
@@ -102,17 +114,19 @@ class SelfCollision {
   double penetration(const Pose* link_poses, SelfCollisionContext& context, LinkPair* pair = nullptr) const;
 
  private:
-  // pairCollides, first asking the context's enclosing balls (placed for these poses by the caller).
-  bool pairHits(int k, const Pose* link_poses, SelfCollisionContext& context, bool balls_placed) const noexcept;
+  // The context's enclosing balls placed at these poses, or null when it has none (a default-made context).
+  EnclosingBalls* placeBalls(const Pose* link_poses, scene_detail::SelfScratch& s) const noexcept;
+  // pairCollides, first asking the enclosing balls when given (placed at these poses).
+  bool pairHits(int k, const Pose* link_poses, scene_detail::SelfScratch& s, EnclosingBalls* balls) const noexcept;
   // pairHits in two halves: the enclosing balls and the pair's cheap rungs, then (for Unsure) the triangles.
-  Screen pairScreen(int k, const Pose* link_poses, SelfCollisionContext& context, bool balls_placed) const noexcept;
+  Screen pairScreen(int k, const Pose* link_poses, scene_detail::SelfScratch& s, EnclosingBalls* balls) const noexcept;
   bool pairExactly(int k, const Pose* link_poses) const noexcept;
   // Pair k's table verdict at q (Unsure without a table or q).
   PairTable::Verdict tabled(int k, const double* q) const noexcept {
     return q && !tables_.empty() && tables_[k] ? tables_[k]->lookup(q) : PairTable::Verdict::Unsure;
   }
   // Records pair k as the last hit and returns it.
-  const LinkPair* hit(int k, SelfCollisionContext& context) const noexcept;
+  const LinkPair* hit(int k, scene_detail::SelfScratch& s) const noexcept;
 
   std::shared_ptr<const RobotGeometry> geometry_;
   std::vector<LinkPair> pairs_;

@@ -8,6 +8,7 @@
 // waiting for edits, and the snapshot it holds stays whole while edits go on: each verdict is the
 // verdict of the world before an edit or after it, never of a mixture.
 #include <clearway/motion/motion.h>
+#include <clearway/per_thread.h>
 #include <clearway/scene/scene.h>
 
 #include <atomic>
@@ -73,7 +74,7 @@ class World {
   std::shared_ptr<const WorldSnapshot> current_;
   std::atomic<std::uint64_t> version_{0};
   MotionOptions motion_options_;
-  detail::ScratchOwner scratch_owner_;  // identifies this world's per-thread snapshot copies
+  PerThread<std::shared_ptr<const WorldSnapshot>> seen_;  // each thread's copy of the snapshot it last saw
 };
 
 }  // namespace clearway

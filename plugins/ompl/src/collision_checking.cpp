@@ -1,6 +1,6 @@
 #include <clearway/ompl/collision_checking.h>
 
-#include <clearway/detail/per_thread.h>
+#include <clearway/per_thread.h>
 
 #include <ompl/base/spaces/RealVectorStateSpace.h>
 #include <ompl/base/spaces/SE2StateSpace.h>
@@ -15,10 +15,7 @@ namespace clearway {
 
 namespace ob = ompl::base;
 
-namespace {
-
-
-using detail::perThread;
+namespace ompl_detail {
 
 // A thread's scratch, made again when the world's snapshot changes (an attached body changes the links).
 struct ValidityScratch {
@@ -33,6 +30,13 @@ struct MotionScratch {
   MotionContext ctx;
   std::vector<double> q0, q1;
 };
+
+}  // namespace ompl_detail
+
+namespace {
+
+using ompl_detail::MotionScratch;
+using ompl_detail::ValidityScratch;
 
 class Timer {
  public:
@@ -213,8 +217,8 @@ std::shared_ptr<World> worldOf(std::shared_ptr<const Scene> scene, MotionOptions
   return std::make_shared<World>(std::move(scene), options);
 }
 
-ValidityScratch& validityScratch(const detail::ScratchOwner& owner, const WorldSnapshot& w) {
-  ValidityScratch& s = perThread<ValidityScratch>(owner, [] { return ValidityScratch{}; });
+ValidityScratch& validityScratch(const PerThread<ValidityScratch>& scratch, const WorldSnapshot& w) {
+  ValidityScratch& s = scratch.get([] { return ValidityScratch{}; });
   if (s.version != w.version) s = ValidityScratch{w.version, w.scene->makeContext(), std::vector<double>(w.scene->dimension()), {}};
   return s;
 }
@@ -236,7 +240,7 @@ bool ValidityChecker::isValid(const ob::State* state) const {
   const Timer timer(counters_.nanoseconds);
   ++counters_.states;
   const WorldSnapshot& w = world_->current();
-  ValidityScratch& s = validityScratch(scratch_owner_, w);
+  ValidityScratch& s = validityScratch(scratch_, w);
   map_.toVector(state, s.q.data());
   return w.scene->isFree(s.q.data(), s.ctx);
 }
@@ -245,7 +249,7 @@ void ValidityChecker::areValid(const ob::State* const* states, std::size_t n, bo
   const Timer timer(counters_.nanoseconds);
   counters_.states += n;
   const WorldSnapshot& w = world_->current();
-  ValidityScratch& s = validityScratch(scratch_owner_, w);
+  ValidityScratch& s = validityScratch(scratch_, w);
   const std::size_t dim = static_cast<std::size_t>(w.scene->dimension());
   // In slices, so that a batch's count fits areFree's int however many states come.
   constexpr std::size_t kSlice = 1024;
@@ -260,7 +264,7 @@ void ValidityChecker::areValid(const ob::State* const* states, std::size_t n, bo
 double ValidityChecker::clearance(const ob::State* state) const {
   const WorldSnapshot& w = world_->current();
   if (!w.scene->effects().clearance) return ob::StateValidityChecker::clearance(state);
-  ValidityScratch& s = validityScratch(scratch_owner_, w);
+  ValidityScratch& s = validityScratch(scratch_, w);
   map_.toVector(state, s.q.data());
   const double c = w.scene->clearance(s.q.data(), s.ctx);
   return std::isnan(c) ? 0.0 : c;
@@ -300,7 +304,7 @@ MotionResult ContinuousMotionValidator::check(const ob::State* s1, const ob::Sta
     r.free = false;
     return r;
   }
-  MotionScratch& s = perThread<MotionScratch>(scratch_owner_, [] { return MotionScratch{}; });
+  MotionScratch& s = scratch_.get([] { return MotionScratch{}; });
   if (s.version != w.version) {
     const int n = w.scene->dimension();
     s = MotionScratch{w.version, w.motion->makeContext(), std::vector<double>(n), std::vector<double>(n)};

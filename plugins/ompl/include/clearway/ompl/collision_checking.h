@@ -8,6 +8,7 @@
 // The namespace is clearway, not clearway::ompl: inside a clearway::ompl, `ompl::base` would resolve
 // to clearway::ompl::base.
 #include <clearway/motion/motion.h>
+#include <clearway/per_thread.h>
 #include <clearway/scene/scene.h>
 #include <clearway/world/world.h>
 
@@ -21,6 +22,11 @@
 #include <mutex>
 
 namespace clearway {
+
+namespace ompl_detail {
+struct ValidityScratch;  // collision_checking.cpp
+struct MotionScratch;
+}  // namespace ompl_detail
 
 /// The OMPL state space of a scene's group: bounded joints are real-vector dimensions with the joint
 /// limits; continuous joints are SO(2); a planar joint is SE(2) and a floating joint SE(3), their
@@ -91,7 +97,7 @@ class ValidityChecker : public ompl::base::StateValidityChecker {
  private:
   std::shared_ptr<World> world_;
   StateMap map_;
-  detail::ScratchOwner scratch_owner_;  // identifies its per-thread scratch
+  PerThread<ompl_detail::ValidityScratch> scratch_;  // each thread's context and state buffers
   mutable CheckerCounters counters_;
 };
 
@@ -122,7 +128,7 @@ class ContinuousMotionValidator : public ompl::base::MotionValidator {
  private:
   std::shared_ptr<World> world_;
   StateMap map_;
-  detail::ScratchOwner scratch_owner_;  // identifies its per-thread scratch
+  PerThread<ompl_detail::MotionScratch> scratch_;  // each thread's context and state buffers
   mutable CheckerCounters counters_;
   // OMPL's valid_ and invalid_ are plain integers that its benchmark tools read once planning is done;
   // parallel planners call checkMotion from several threads, so each update takes this lock.
