@@ -117,25 +117,29 @@ struct Builder {
   }
 };
 
-// Tables already built, for checkers of the same robot geometry with the same settings (scenes that share
-// a loaded robot, one after another or at once; a scene and its edits): a table depends on nothing else.
-// An entry lives as long as its geometry (the address is then that geometry's alone).
+// Tables already built, for checkers of the same two link geometries joined by the same chain with the
+// same settings (scenes that share a loaded robot, one after another or at once; a scene and its edits,
+// a body attached or detached elsewhere on the robot included): a table depends on nothing else. An entry
+// lives as long as both geometries (the addresses are then theirs alone).
 struct TableCache {
   struct Key {
-    const RobotGeometry* address;
+    const LinkGeometry* ga;
+    const LinkGeometry* gb;
     int a, b;
-    std::vector<double> settings;  // padding, mode, tolerances, grid, held values
+    std::vector<double> settings;  // padding, mode, tolerances, grid, held values, the chain's joints
     bool operator<(const Key& o) const {
-      return std::tie(address, a, b, settings) < std::tie(o.address, o.a, o.b, o.settings);
+      return std::tie(ga, gb, a, b, settings) < std::tie(o.ga, o.gb, o.a, o.b, o.settings);
     }
   };
   struct Entry {
-    std::weak_ptr<const RobotGeometry> geometry;
+    std::weak_ptr<const LinkGeometry> ga, gb;
     std::shared_ptr<const PairTable> table;  // null: the pair gets none
+    bool expired() const noexcept { return ga.expired() || gb.expired(); }
   };
   std::mutex mutex;
   std::map<Key, Entry> tables;
   std::size_t sweep_at = 64;  // the size at which entries of robots gone are next dropped
+  long long built = 0, swept = 0;
 };
 
 TableCache& tableCache() {
@@ -156,6 +160,33 @@ std::vector<double> tableSettings(double padding, GeometryMode mode, const Toler
   return s;
 }
 
+// What PairTable::build reads of the model for links a and b, appended to s: the joints between them, in
+// order (type, origin, axis, variable, mimic and the moving variable's limits); −1 when neither link is
+// the other's ancestor. Robots that agree on it give the same two link geometries the same table.
+void appendChain(const RobotModel& model, int a, int b, std::vector<double>& s) {
+  int up = a, down = b;
+  if (!isAncestor(model, a, b)) {
+    if (!isAncestor(model, b, a)) {
+      s.push_back(-1.0);
+      return;
+    }
+    std::swap(up, down);
+  }
+  s.push_back(up == a ? 0.0 : 1.0);
+  for (int l = down; l != up; l = model.parentLink(l)) {
+    const Joint& j = model.joints()[model.links()[l].parent_joint];
+    s.push_back(static_cast<double>(j.type));
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) s.push_back(j.origin.R(r, c));
+    s.insert(s.end(), {j.origin.t.x(), j.origin.t.y(), j.origin.t.z(), j.axis.x(), j.axis.y(), j.axis.z()});
+    const int leader = j.isMimic() ? model.joint(j.mimic.joint).first_variable : j.first_variable;
+    s.insert(s.end(),
+             {static_cast<double>(j.first_variable), static_cast<double>(leader), j.mimic.multiplier, j.mimic.offset});
+    if (leader >= 0 && leader < static_cast<int>(model.variables().size()))
+      s.insert(s.end(), {model.variables()[leader].lower, model.variables()[leader].upper});
+  }
+}
+
 }  // namespace
 
 std::shared_ptr<const PairTable> PairTable::shared(const std::shared_ptr<const RobotGeometry>& geometry, int a, int b,
@@ -163,11 +194,12 @@ std::shared_ptr<const PairTable> PairTable::shared(const std::shared_ptr<const R
                                                    const std::vector<double>& held, const PairTableOptions& options) {
   if (!geometry || !geometry->link(a) || !geometry->link(b)) return nullptr;
   TableCache& cache = tableCache();
-  TableCache::Key key{geometry.get(), a, b, tableSettings(padding, mode, tol, held, options)};
+  TableCache::Key key{geometry->link(a), geometry->link(b), a, b, tableSettings(padding, mode, tol, held, options)};
+  appendChain(geometry->model(), a, b, key.settings);
   {
     const std::lock_guard<std::mutex> lock(cache.mutex);
     const auto it = cache.tables.find(key);
-    if (it != cache.tables.end() && !it->second.geometry.expired()) return it->second.table;
+    if (it != cache.tables.end() && !it->second.expired()) return it->second.table;
   }
   std::shared_ptr<const PairTable> t =
       build(geometry->model(), a, *geometry->link(a), b, *geometry->link(b), padding, mode, tol, held, options);
@@ -175,13 +207,25 @@ std::shared_ptr<const PairTable> PairTable::shared(const std::shared_ptr<const R
   // Entries of robots gone are dropped as new ones come, in a sweep each time the cache has doubled since
   // the last: a sweep per table made loading a robot quartic in its links (a table per pair, each sweep
   // over every table); this way each entry is swept a constant number of times on average.
-  cache.tables[std::move(key)] = {geometry, t};
+  cache.tables[std::move(key)] = {geometry->linkPtr(a), geometry->linkPtr(b), t};
+  ++cache.built;
   if (cache.tables.size() >= cache.sweep_at) {
+    cache.swept += static_cast<long long>(cache.tables.size());
     for (auto it = cache.tables.begin(); it != cache.tables.end();)
-      it = it->second.geometry.expired() ? cache.tables.erase(it) : std::next(it);
+      it = it->second.expired() ? cache.tables.erase(it) : std::next(it);
     cache.sweep_at = std::max<std::size_t>(64, 2 * cache.tables.size());
   }
   return t;
+}
+
+PairTable::CacheStats PairTable::cacheStats() {
+  TableCache& cache = tableCache();
+  const std::lock_guard<std::mutex> lock(cache.mutex);
+  CacheStats s;
+  s.entries = cache.tables.size();
+  s.built = cache.built;
+  s.swept = cache.swept;
+  return s;
 }
 
 std::unique_ptr<const PairTable> PairTable::build(const RobotModel& model, int a, const LinkGeometry& ga, int b,

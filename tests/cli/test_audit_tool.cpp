@@ -138,6 +138,10 @@ TEST(AuditTool, ThreadsAndUsageErrors) {
   r = runTool("audit " + q(urdf) + " --samples 10 --srdf-out " + q(dir.path("no/such/folder/out.srdf")));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_MENTIONS(r.err, "cannot write " + dir.path("no/such/folder/out.srdf"));
+  // A report that cannot be written is an error too, never exit 0 (issue 43 §5).
+  r = runTool("audit " + q(urdf) + " --samples 10 --report " + q(dir.path("no/such/folder/report.md")));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_MENTIONS(r.err, "cannot write " + dir.path("no/such/folder/report.md"));
 }
 
 // --threads 600 started 600 threads (and aborted where they could not be created): the audit uses at

@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -320,3 +321,95 @@ TEST(PairTable, BudgetBringsTheDeadlineForward) {
   soon.deadline = before;
   EXPECT_EQ(soon.within(60.0).deadline, before);  // never later than it was
 }
+
+namespace clearway {
+namespace {
+
+using test::armScene;
+using test::TempDir;
+
+// A body attached to one link changes only the pairs it is in: every other pair's table is shared with the
+// robot it was attached to (the tables' cache is keyed by the two link geometries and the joints between
+// them), so that an edit costs its own pairs' tables only.
+TEST(PairTable, AttachingABodySharesEveryOtherPairsTable) {
+  TempDir dir;
+  const auto bare = Scene::load(dir.write("bare.yaml", armScene("", "")));
+  SceneDescription::AttachedSpec spec;
+  spec.link = "wrist_3_link";
+  spec.body.name = "tool";
+  spec.body.shape = Box(Vec3(0.02, 0.02, 0.05));
+  spec.body.pose = Pose::translation(Vec3(0, 0, 0.06));
+  const long long built_before = PairTable::cacheStats().built;
+  const auto held = bare->withAttached(spec);
+  const long long built = PairTable::cacheStats().built - built_before;
+  const RobotModel& m0 = bare->robot();
+  const RobotModel& m1 = held->robot();
+  const SelfCollision& s0 = bare->selfCollision();
+  const SelfCollision& s1 = held->selfCollision();
+  int shared = 0, with_tool = 0;
+  for (int k = 0; k < static_cast<int>(s1.pairs().size()); ++k) {
+    const LinkPair& p = s1.pairs()[k];
+    const std::string a = m1.link(p.a).name, b = m1.link(p.b).name;
+    if (a == "tool" || b == "tool") {
+      ++with_tool;
+      continue;
+    }
+    const auto it = std::find_if(s0.pairs().begin(), s0.pairs().end(),
+                                 [&](const LinkPair& q) { return m0.link(q.a).name == a && m0.link(q.b).name == b; });
+    ASSERT_NE(it, s0.pairs().end()) << a << " " << b;
+    const PairTable* before = s0.pairTable(static_cast<int>(it - s0.pairs().begin()));
+    EXPECT_EQ(s1.pairTable(k), before) << a << " " << b << ": built again";
+    shared += before != nullptr;
+  }
+  EXPECT_GT(shared, 3) << "too few tabled pairs to say anything";
+  EXPECT_GT(with_tool, 0);
+  EXPECT_LE(built, with_tool) << "only the new body's pairs are built";
+}
+
+// Loading sweeps the tables' cache (to drop those of robots gone) a few times per table, not once per table:
+// a sweep after every table made loading quartic in the links. A hub turning on a base, 48 blades turning
+// on the hub: each blade against the base is moved by two joints and gets a table. Counted, not timed.
+TEST(PairTable, LoadingSweepsTheCacheAFewTimesPerTable) {
+  TempDir dir;
+  const std::string limit = "<limit lower=\"-0.3\" upper=\"0.3\" effort=\"1\" velocity=\"1\"/>";
+  std::string urdf =
+      "<robot name=\"fan\"><link name=\"base\"><collision><geometry><box size=\"0.1 0.1 0.1\"/></geometry></collision>"
+      "</link><link name=\"hub\"><collision><origin xyz=\"0 0 0.2\"/><geometry><cylinder radius=\"0.05\" "
+      "length=\"0.1\"/>"
+      "</geometry></collision></link><joint name=\"spin\" type=\"revolute\"><parent link=\"base\"/><child "
+      "link=\"hub\"/>"
+      "<axis xyz=\"0 0 1\"/>" +
+      limit + "</joint>\n";
+  std::string group = "spin";
+  constexpr int kBlades = 48;
+  for (int i = 0; i < kBlades; ++i) {
+    const std::string n = std::to_string(i);
+    urdf += "<link name=\"blade" + n +
+            "\"><collision><origin xyz=\"0.3 0 0\"/><geometry><box size=\"0.2 0.01 0.01\"/>"
+            "</geometry></collision></link><joint name=\"j" +
+            n +
+            "\" type=\"revolute\"><parent link=\"hub\"/>"
+            "<child link=\"blade" +
+            n + "\"/><origin xyz=\"0 0 0.2\" rpy=\"0 0 " + std::to_string(2.0 * M_PI * i / kBlades) +
+            "\"/><axis xyz=\"1 0 0\"/>" + limit + "</joint>\n";
+    group += ", j" + n;
+  }
+  urdf += "</robot>\n";
+  const std::string path = dir.write("fan.urdf", urdf);
+  const PairTable::CacheStats before = PairTable::cacheStats();
+  const auto scene = Scene::load(dir.write(
+      "fan.yaml", "format: 1\nname: fan\nrobot:\n  urdf: " + path + "\n  group: [" + group + "]\nchecks: [self]\n"));
+  const PairTable::CacheStats after = PairTable::cacheStats();
+  const long long built = after.built - before.built;
+  int tabled = 0;
+  for (int k = 0; k < static_cast<int>(scene->selfCollision().pairs().size()); ++k)
+    tabled += scene->selfCollision().pairTable(k) != nullptr;
+  EXPECT_GE(tabled, kBlades / 2) << "the blades against the base should have tables";
+  // Each sweep visits the cache once it has doubled since the last: at most about twice every entry there
+  // was or came (a sweep per table visited about built · entries / 2).
+  EXPECT_LE(after.swept - before.swept, 2 * (static_cast<long long>(before.entries) + built) + 64)
+      << built << " tables built, " << tabled << " kept";
+}
+
+}  // namespace
+}  // namespace clearway

@@ -25,6 +25,8 @@ class RobotGeometry {
   const std::shared_ptr<const RobotModel>& modelPtr() const noexcept { return model_; }
   /// Link i's geometry, or null when the link has no collision element.
   const LinkGeometry* link(int i) const noexcept { return links_[i].get(); }
+  /// The same geometry of link i, shared (null for a link without geometry).
+  const std::shared_ptr<const LinkGeometry>& linkPtr(int i) const noexcept { return links_[i]; }
   /// Links that have geometry, in link order.
   const std::vector<int>& geometricLinks() const noexcept { return geometric_; }
 

@@ -68,12 +68,22 @@ class PairTable {
                                                 const Tolerances& tol, const std::vector<double>& held = {},
                                                 const PairTableOptions& options = {});
 
-  /// build() for the geometry's links a and b, or the table already built for them with the same
-  /// settings while the geometry lives (scenes sharing a loaded robot share their tables). Thread-safe.
+  /// build() for the geometry's links a and b, or the table already built for the same two link geometries
+  /// joined by the same joints with the same settings, while both live (scenes sharing a loaded robot, and
+  /// a robot and its edits with bodies attached elsewhere, share their tables). Thread-safe.
   static std::shared_ptr<const PairTable> shared(const std::shared_ptr<const RobotGeometry>& geometry, int a, int b,
                                                  double padding, GeometryMode mode, const Tolerances& tol,
                                                  const std::vector<double>& held = {},
                                                  const PairTableOptions& options = {});
+  /// The work of shared()'s cache since the program started, for tests: what it shares and what keeping it
+  /// costs are counts, not times.
+  struct CacheStats {
+    std::size_t entries = 0;  ///< tables (and pairs found to need none) held now
+    long long built = 0;      ///< calls that built a table (or found none was due) instead of sharing one
+    long long swept = 0;      ///< entries visited by the sweeps that drop those of link geometries gone
+  };
+  /// A snapshot of the counts (thread-safe).
+  static CacheStats cacheStats();
 
   /// The verdict at the full variable vector q (held variables at their held values): Free and Colliding
   /// hold at every configuration of the cell holding q; Unsure for the other cells, and for values outside
