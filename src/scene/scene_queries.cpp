@@ -23,12 +23,15 @@ using scene_detail::SceneScratch;
 
 namespace {
 
-// The scratch of a context; a default-made (or moved-from) one's is an empty scratch of this thread, whose
-// queries answer Invalid (no poses).
-SceneScratch& scratchOf(const std::unique_ptr<SceneScratch>& s) noexcept {
+// An empty scratch of this thread: a default-made (or moved-from) context's, whose queries answer Invalid
+// (no poses). Out of line, so that a context's own scratch costs no thread-local look-up.
+[[gnu::noinline]] SceneScratch& emptyScratch() noexcept {
   thread_local SceneScratch none;
-  return s ? *s : none;
+  return none;
 }
+
+// The scratch of a context.
+SceneScratch& scratchOf(const std::unique_ptr<SceneScratch>& s) noexcept { return s ? *s : emptyScratch(); }
 
 }  // namespace
 

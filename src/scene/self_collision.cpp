@@ -29,12 +29,12 @@ using scene_detail::SelfScratch;
 
 // The scratch of a context; a default-made (or moved-from) one's is an empty scratch of this thread, which
 // holds no warm starts, no balls and no room, so that its queries answer as a fresh context's.
-SelfScratch& scratchOf(std::unique_ptr<SelfScratch>& s) noexcept {
+[[gnu::noinline]] SelfScratch& emptyScratch() noexcept {  // (out of line: no thread-local look-up otherwise)
   thread_local SelfScratch none;
-  if (s) return *s;
   none.last_hit = -1;
   return none;
 }
+SelfScratch& scratchOf(std::unique_ptr<SelfScratch>& s) noexcept { return s ? *s : emptyScratch(); }
 
 }  // namespace
 

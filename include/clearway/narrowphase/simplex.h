@@ -36,8 +36,9 @@ inline void compactSimplex(Simplex& s, const double l[4]) noexcept {
 }
 
 /// Replaces the simplex by the smallest subset supporting its closest point to the origin and
-/// returns that point v. Afterwards n == 4 means the origin is enclosed.
-inline Vec3 reduceSimplex(Simplex& s) noexcept {
+/// returns that point v. Afterwards n == 4 means the origin is enclosed. (Always inlined: it is the step of
+/// every GJK loop, and a call there cost about 2% of a state check when the inliner chose otherwise.)
+[[gnu::always_inline]] inline Vec3 reduceSimplex(Simplex& s) noexcept {
   double l[4];
   closestWeights(s, l);
   compactSimplex(s, l);
