@@ -18,9 +18,13 @@ namespace clearway {
 template <class T>
 class PerThread {
  public:
+  /// A new owner, with no T on any thread.
   PerThread() : serial_(next()), alive_(std::make_shared<const char>(0)) {}
+  ///@{
+  /// A copy is a new owner (no T yet); an assignment keeps this one's identity and values.
   PerThread(const PerThread&) : PerThread() {}
-  PerThread& operator=(const PerThread&) { return *this; }  // (keeps its own identity)
+  PerThread& operator=(const PerThread&) { return *this; }
+  ///@}
 
   /// This thread's T, made by make() on the thread's first call (for this owner).
   template <class Make>
