@@ -120,6 +120,8 @@ std::shared_ptr<const Scene> Scene::load(const std::string& path, const SceneOpt
 }
 
 void Scene::init() {
+  static std::atomic<std::uint64_t> next_serial{1};
+  serial_ = next_serial++;
   const RobotModel& model = geometry_->model();
   const std::string& file = description_.file;
   auto fail = [&](const std::string& key, const std::string& reason) {

@@ -56,12 +56,27 @@ SceneContext Scene::makeContext() const {
   c.lane_q.reserve(base_q_.size() * KinematicLanes::kMaxLanes);
   for (int l = 0; l < KinematicLanes::kMaxLanes; ++l) c.lane_q.insert(c.lane_q.end(), base_q_.begin(), base_q_.end());
   c.lane_poses.resize(static_cast<std::size_t>(robot().linkCount()) * KinematicLanes::kMaxLanes);
+  c.owner = serial_;
   return SceneContext(std::move(scratch));
+}
+
+bool Scene::adopt(SceneScratch& ctx) const noexcept {
+  if (ctx.poses.size() != static_cast<std::size_t>(robot().linkCount()) || ctx.q.size() != base_q_.size())
+    return false;  // (another robot's, or a default-made context)
+  if (ctx.owner == serial_) return true;
+  std::copy(base_q_.begin(), base_q_.end(), ctx.q.begin());
+  const std::size_t nv = base_q_.size();
+  if (nv > 0 && ctx.lane_q.size() % nv == 0)
+    for (std::size_t at = 0; at < ctx.lane_q.size(); at += nv)
+      std::copy(base_q_.begin(), base_q_.end(), ctx.lane_q.begin() + static_cast<std::ptrdiff_t>(at));
+  ctx.env_last_hit = -1;
+  ctx.owner = serial_;
+  return true;
 }
 
 void Scene::computePoses(const double* state, SceneContext& context) const noexcept {
   SceneScratch& ctx = scratchOf(context.scratch_);
-  if (ctx.poses.size() == static_cast<std::size_t>(robot().linkCount())) place(state, ctx);  // (else not this scene's)
+  if (adopt(ctx)) place(state, ctx);  // (else another robot's)
 }
 
 void Scene::place(const double* state, SceneScratch& ctx) const noexcept {
@@ -122,7 +137,7 @@ bool Scene::checkState(const double* state, SceneScratch& ctx, CollisionReport* 
   CollisionReport& r = report ? *report : local;
   r = CollisionReport{};
   // (A context of another scene's robot, such as a World's before an attach, does not fit: refused.)
-  if (!withinBounds(state) || !withinTime(t) || ctx.poses.size() != static_cast<std::size_t>(robot().linkCount())) {
+  if (!withinBounds(state) || !withinTime(t) || !adopt(ctx)) {
     ++ctx.counters.invalid_states;
     r.kind = CollisionReport::Kind::Invalid;
     return false;
@@ -221,7 +236,8 @@ bool Scene::selfFree(const Pose* poses, const double* q, SceneScratch& ctx, Coll
 
 bool Scene::lanesFit(const SceneScratch& ctx) const noexcept {
   const RobotModel& model = robot();
-  return ctx.lanes && ctx.lanes->madeFor(model) && ctx.poses.size() == static_cast<std::size_t>(model.linkCount());
+  return ctx.lanes && ctx.lanes->madeFor(model) && ctx.poses.size() == static_cast<std::size_t>(model.linkCount()) &&
+         ctx.q.size() == base_q_.size();
 }
 
 void Scene::toLane(const double* state, int lane, SceneScratch& ctx, const double** lane_q,
@@ -248,6 +264,7 @@ int Scene::anyCollides(const double* states, int count, SceneContext& context, C
       if (!checkState(state(s), ctx, &r, time(s))) return s;
     return -1;
   }
+  adopt(ctx);  // (lanesFit: it fits)
   const Effects& fx = description_.effects;
   const double* lane_q[KinematicLanes::kMaxLanes];
   Pose* lane_poses[KinematicLanes::kMaxLanes];
@@ -291,6 +308,7 @@ void Scene::areFree(const double* states, int count, SceneContext& context, bool
       free[s] = checkState(states + static_cast<std::ptrdiff_t>(s) * dim, ctx, nullptr, t);
     return;
   }
+  adopt(ctx);  // (lanesFit: it fits)
   const Effects& fx = description_.effects;
   const int width = std::min(KinematicLanes::width(), KinematicLanes::kMaxLanes);
   const double* lane_q[KinematicLanes::kMaxLanes];
@@ -345,7 +363,7 @@ double Scene::clearance(const double* state, SceneContext& context, double* lowe
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const Effects& fx = description_.effects;
   if (!fx.clearance) return nan;
-  if (!withinBounds(state) || !withinTime(t) || ctx.poses.size() != static_cast<std::size_t>(robot().linkCount())) return nan;
+  if (!withinBounds(state) || !withinTime(t) || !adopt(ctx)) return nan;
   ++ctx.counters.clearance_queries;
   place(state, ctx);
   // Distances first; EPA only when something touches (then the value is minus the deepest penetration).

@@ -5,6 +5,7 @@
 #include <clearway/scene/scene.h>
 #include <clearway/scene/self_collision.h>
 
+#include <cstdint>
 #include <optional>
 #include <vector>
 
@@ -22,6 +23,7 @@ struct SceneScratch {
   std::optional<KinematicLanes> lanes;  // Scene::areFree's kinematics over lanes of states
   std::vector<double> lane_q;           // KinematicLanes::kMaxLanes joint vectors
   std::vector<Pose> lane_poses;         // KinematicLanes::kMaxLanes sets of link poses
+  std::uint64_t owner = 0;              // the serial of the scene whose held values q and lane_q hold
 };
 
 }  // namespace clearway::scene_detail

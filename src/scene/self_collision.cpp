@@ -1,6 +1,7 @@
 #include <clearway/scene/self_collision.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -18,6 +19,7 @@ struct SelfScratch {
   std::vector<std::uint8_t> bounds_apart;  // per pair: its bounding balls apart at this query's poses
   int last_hit = -1;                       // the pair (index into pairs()) that last collided, tried first; -1: none
   long long pair_tests = 0;  // pairs that reached the narrow phase (bounding spheres not apart), cumulative
+  std::uint64_t owner = 0;   // the serial of the checker that made it (its pairs are `bodies`' pairs)
 };
 
 }  // namespace scene_detail
@@ -48,7 +50,10 @@ long long SelfCollisionContext::pairTests() const noexcept { return scratch_ ? s
 
 SelfCollision::SelfCollision(std::shared_ptr<const RobotGeometry> geometry, const CollisionFilter& filter,
                              SelfCollisionOptions options)
-    : geometry_(std::move(geometry)), options_(std::move(options)) {
+    : geometry_(std::move(geometry)), options_(std::move(options)), serial_([] {
+        static std::atomic<std::uint64_t> next{1};
+        return next++;
+      }()) {
   if (!geometry_) throw std::invalid_argument("SelfCollision: null robot geometry");
   const int n = geometry_->model().linkCount();
   if (filter.linkCount() != n)
@@ -83,6 +88,7 @@ SelfCollision::SelfCollision(std::shared_ptr<const RobotGeometry> geometry, cons
 SelfCollisionContext SelfCollision::makeContext() const {
   auto scratch = std::make_unique<SelfScratch>();
   SelfScratch& c = *scratch;
+  c.owner = serial_;
   c.bodies.reserve(pairs_.size());
   for (const LinkPair& p : pairs_) c.bodies.emplace_back(*geometry_->link(p.a), *geometry_->link(p.b));
   c.balls = EnclosingBalls(*geometry_);
@@ -114,7 +120,9 @@ Screen SelfCollision::pairScreen(int k, const Pose* poses, SelfScratch& ctx, Enc
   if (balls && balls->apart(p.a, p.b, pair_padding_[k], options_.tolerances, options_.mode == GeometryMode::Mesh))
     return Screen::Apart;
   const IntersectQuery q{pair_padding_[k], options_.mode};
-  if (k < static_cast<int>(ctx.bodies.size())) return ctx.bodies[k].screen(poses[p.a], poses[p.b], options_.tolerances, q);
+  // (A context of another checker of the robot, whose pair k is another pair, asks a fresh pair.)
+  if (ctx.owner == serial_ && k < static_cast<int>(ctx.bodies.size()))
+    return ctx.bodies[k].screen(poses[p.a], poses[p.b], options_.tolerances, q);
   return BodyPair(*geometry_->link(p.a), *geometry_->link(p.b)).screen(poses[p.a], poses[p.b], options_.tolerances, q);
 }
 

@@ -234,7 +234,10 @@ class Scene {
   // A floating joint's quaternion (qx, qy, qz, qw) that the kinematics can normalise: its squares do not
   // add up to 0, as validateJointVector asks (a zero quaternion's poses are NaN).
   static bool rotates(const double* q) noexcept { return q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] > 0.0; }
-  // computePoses and isFree, given the context's scratch.
+  // True when the context fits this robot (its joint vector and poses); it then holds this scene's held
+  // values and no other scene's lead.
+  bool adopt(scene_detail::SceneScratch& ctx) const noexcept;
+  // computePoses and isFree, given the context's scratch (which adopt() accepted).
   void place(const double* state, scene_detail::SceneScratch& ctx) const noexcept;
   bool checkState(const double* state, scene_detail::SceneScratch& ctx, CollisionReport* report,
                   double t) const noexcept;
@@ -264,6 +267,9 @@ class Scene {
   // What a state entry may hold: the limits widened by kJointLimitTolerance, within ±kMaxJointValue.
   std::vector<double> valid_lower_, valid_upper_;
   std::vector<double> base_q_;  // held values and defaults; group entries overwritten per query
+  // Which scene a context serves: a context made (or last used) by another scene of this robot holds that
+  // scene's held values in its joint vectors, and its lead names that scene's links (adopt() resets them).
+  std::uint64_t serial_ = 0;
   std::vector<int> quaternions_;  // the state index of each floating joint's qx (qy, qz, qw follow)
   std::vector<int> moving_links_, env_links_;
   std::vector<double> link_padding_;

@@ -135,6 +135,9 @@ class SelfCollision {
   std::vector<std::shared_ptr<const PairTable>> tables_;  // per pair when options_.pair_tables
   std::vector<int> with_table_;                          // the pairs that have one
   SelfCollisionOptions options_;
+  // Which checker made a context: its warm starts (one BodyPair per pair, by index) serve only the checker
+  // whose pairs they were made for. A copy keeps it (the same pairs, the same shared geometry).
+  std::uint64_t serial_;
 };
 
 }  // namespace clearway
