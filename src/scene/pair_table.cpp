@@ -51,6 +51,20 @@ bool isAncestor(const RobotModel& model, int ancestor, int link) {
   return false;
 }
 
+// The joints from the upper of links a and b down to the other, root side first, and the upper link; −1
+// when neither is the other's ancestor (no chain: no table).
+int chainBetween(const RobotModel& model, int a, int b, std::vector<int>& chain) {
+  int up = a, down = b;
+  if (!isAncestor(model, a, b)) {
+    if (!isAncestor(model, b, a)) return -1;
+    std::swap(up, down);
+  }
+  chain.clear();
+  for (int l = down; l != up; l = model.parentLink(l)) chain.push_back(model.links()[l].parent_joint);
+  std::reverse(chain.begin(), chain.end());
+  return up;
+}
+
 // Builds one table: the chain up → down as fixed[0]·M₀(x₀)·fixed[1]·(M₁(x₁)·fixed[2]).
 struct Builder {
   const LinkGeometry& up;
@@ -164,17 +178,15 @@ std::vector<double> tableSettings(double padding, GeometryMode mode, const Toler
 // order (type, origin, axis, variable, mimic and the moving variable's limits); −1 when neither link is
 // the other's ancestor. Robots that agree on it give the same two link geometries the same table.
 void appendChain(const RobotModel& model, int a, int b, std::vector<double>& s) {
-  int up = a, down = b;
-  if (!isAncestor(model, a, b)) {
-    if (!isAncestor(model, b, a)) {
-      s.push_back(-1.0);
-      return;
-    }
-    std::swap(up, down);
+  std::vector<int> chain;
+  const int up = chainBetween(model, a, b, chain);
+  if (up < 0) {
+    s.push_back(-1.0);
+    return;
   }
   s.push_back(up == a ? 0.0 : 1.0);
-  for (int l = down; l != up; l = model.parentLink(l)) {
-    const Joint& j = model.joints()[model.links()[l].parent_joint];
+  for (int ji : chain) {
+    const Joint& j = model.joints()[ji];
     s.push_back(static_cast<double>(j.type));
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) s.push_back(j.origin.R(r, c));
@@ -232,14 +244,9 @@ std::unique_ptr<const PairTable> PairTable::build(const RobotModel& model, int a
                                                   const LinkGeometry& gb, double padding, GeometryMode mode,
                                                   const Tolerances& tol, const std::vector<double>& held,
                                                   const PairTableOptions& options) {
-  int up = a, down = b;
-  if (!isAncestor(model, a, b)) {
-    if (!isAncestor(model, b, a)) return nullptr;
-    std::swap(up, down);
-  }
   std::vector<int> chain;
-  for (int l = down; l != up; l = model.parentLink(l)) chain.push_back(model.links()[l].parent_joint);
-  std::reverse(chain.begin(), chain.end());
+  const int up = chainBetween(model, a, b, chain);
+  if (up < 0) return nullptr;
 
   const auto heldValue = [&](int var) {
     return var >= 0 && var < static_cast<int>(held.size()) && std::isfinite(held[var]) ? held[var] : NAN;
