@@ -5,6 +5,7 @@
 #include <clearway/body/proximity.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -25,6 +26,11 @@ constexpr std::size_t kWarmObstacles = 64;
 }  // namespace
 
 // ---- MotionChecker ------------------------------------------------------------------------------------
+
+std::uint64_t MotionChecker::nextSerial() noexcept {
+  static std::atomic<std::uint64_t> next{1};
+  return next++;
+}
 
 MotionChecker::Bodies MotionChecker::mergeBodies(const Scene& scene) {
   const RobotModel& model = scene.robot();
@@ -263,6 +269,7 @@ MotionContext::MotionContext(std::unique_ptr<motion_detail::Scratch> scratch) no
 MotionContext MotionChecker::makeContext() const {
   auto scratch = std::make_unique<motion_detail::Scratch>();
   motion_detail::Scratch& c = *scratch;
+  c.owner = serial_;
   c.scene = scene_->makeContext();
   c.full_q = c.scene.jointValues();
   c.poses.resize(scene_->robot().linkCount());
@@ -333,10 +340,11 @@ MotionResult MotionChecker::check(const double* q0, double t0, const double* q1,
     r.report.kind = CollisionReport::Kind::Invalid;
     return r;
   }
-  // A context made by a checker of another robot (a World before an attach, say), or of another group of
-  // this one (its state buffers sized for another dimension), does not fit: refused.
+  // A context made by another checker (of another robot: a World before an attach, say; of another group:
+  // its buffers sized for another dimension; or of the same robot elsewhere: its pairs and warm starts are
+  // that checker's items', perhaps freed with it) does not fit: refused.
   const std::size_t dim = static_cast<std::size_t>(scene_->dimension());
-  if (ctx.safe_until.size() != items_.size() ||
+  if (ctx.owner != serial_ || ctx.safe_until.size() != items_.size() ||
       ctx.poses.size() != static_cast<std::size_t>(scene_->robot().linkCount()) || ctx.q.size() != dim ||
       ctx.dq.size() != dim || ctx.probe_states.size() != motion_detail::kProbes * dim) {
     MotionResult r;

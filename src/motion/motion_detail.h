@@ -15,6 +15,9 @@ constexpr int kProbes = 4;
 
 // What one thread's checks of one MotionChecker keep between and within segments (MotionContext holds it).
 struct Scratch {
+  // The serial of the checker that made it: its pairs, warm starts and slots are that checker's items'
+  // (another checker's item k may be other geometry, or geometry that checker owned and freed).
+  std::uint64_t owner = 0;
   SceneContext scene;
   std::vector<double> q, dq;
   // The robot's full joint vector and every link's pose at the parameter the sweep last placed (the

@@ -317,6 +317,38 @@ TEST(MotionCertified, BadInput) {
   EXPECT_TRUE(beyond.check(from, far, bc).capped);
 }
 
+TEST(MotionCertified, AContextOfAnotherCheckerIsRefused) {
+  // Two scenes of one robot (the same items: a merged gripper body, its links against one obstacle): a
+  // context of the first scene's checker, warmed and then outliving its checker, holds pairs on geometry
+  // that checker owned and warm starts for its obstacle. The second refuses it: a collision, never free.
+  TempDir da, db;
+  const auto far = gripperScene(da, "{name: far, box: {size: [0.2, 0.2, 0.2]}, pose: {position: [0, 2.5, 0]}}",
+                                "[self, environment, continuous]");
+  const auto posts =
+      gripperScene(db, "{name: post, cylinder: {radius: 0.02, length: 1}, pose: {position: [0, -2.5, 0]}}",
+                   "[self, environment, continuous]");
+  const double q0[2] = {0, 0}, q1[2] = {0.3, 0.1};
+  MotionContext stale;
+  {
+    const MotionChecker first(far);
+    stale = first.makeContext();
+    ASSERT_TRUE(first.check(q0, q1, stale).free);
+  }
+  const MotionChecker second(posts);
+  MotionContext own = second.makeContext();
+  ASSERT_TRUE(second.check(q0, q1, own).free);
+  for (const bool locate : {true, false}) {
+    const MotionResult r = second.check(q0, q1, stale, locate);
+    EXPECT_FALSE(r.free);
+    EXPECT_EQ(r.report.kind, CollisionReport::Kind::Invalid);
+  }
+  // Another checker of the same scene is another checker; a copy shares the items, and the contexts.
+  const MotionChecker again(posts);
+  EXPECT_FALSE(again.check(q0, q1, own).free);
+  const MotionChecker copy = second;
+  EXPECT_TRUE(copy.check(q0, q1, own).free);
+}
+
 TEST(MotionCertified, ThreadsShareOneChecker) {
   TempDir dir;
   const auto scene = planarScene(

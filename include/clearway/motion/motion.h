@@ -29,6 +29,7 @@
 // number of distance queries ends them too (reported as a collision).
 #include <clearway/scene/scene.h>
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -168,7 +169,7 @@ struct Scratch;  // motion_detail.h
 
 /// One thread's scratch for MotionChecker::check (allocated once, then reused): made by the checking
 /// MotionChecker's makeContext(). Movable, not copyable; a default-made one is empty and only good for
-/// assigning to (a check given it reports a collision).
+/// assigning to (a check given it, or a context another checker made, reports a collision).
 class MotionContext {
  public:
   MotionContext() noexcept;
@@ -274,6 +275,9 @@ class MotionChecker {
   std::vector<MotionBound::PairPath> paths_;
   std::vector<std::vector<MotionBound::PairPath>> split_paths_;
   int env_begin_ = 0;        // the first environment item
+  // Names this checker's contexts (a copy shares its items, so its serial too).
+  std::uint64_t serial_ = nextSerial();
+  static std::uint64_t nextSerial() noexcept;
   CollisionReport rigid_collision_;  // a self pair within one rigid body that collides (then every state does)
   double obstacle_speed_ = 0.0;   // the fastest obstacle's speed (m/s)
   std::vector<int> quaternions_;  // state entries where a floating joint's quaternion starts (qx)
