@@ -125,7 +125,9 @@ struct Builder {
     q.mode = finest ? mode : GeometryMode::Hull;
     q.within = need;  // the triangles' question is whether they lie within it: no distance is measured
     q.near = 0.0;
-    if (pair.lowerBound(Pose::identity(), t, tol, q) > need) return PairTable::Verdict::Free;
+    // (At least `need`, not beyond it: a rung that proves enough answers enough itself, e.g. the parts' when
+    // every part is that far, and need holds the margin that makes "at least" certain.)
+    if (pair.lowerBound(Pose::identity(), t, tol, q) >= need) return PairTable::Verdict::Free;
     if (witness && mode == GeometryMode::Mesh) meshesIntersectExactly(up, Pose::identity(), down, t, tol, padding, witness);
     return PairTable::Verdict::Unsure;
   }

@@ -144,6 +144,30 @@ TEST(PairTable, Ur5CellsHold) {
   EXPECT_GT(t.free, 0);
 }
 
+// A cell whose bodies a rung proves at least the needed margin apart is Free: the rungs answer exactly
+// `enough` once they prove it (the parts do when every part is that far), and a table that asked for more
+// than that left such cells Unsure. On the UR5's forearm and wrist_2 (a table of two joints, its links
+// concave where they meet) that was 41% of random lookups Unsure instead of 28%, each costing a screen and
+// often a triangle search per state.
+TEST(PairTable, CellsTheRungsProveFarEnoughAreFree) {
+  CLEARWAY_SHARED_ROBOT_OR_SKIP(urdf, "ur5/ur5.urdf");
+  auto model = std::make_shared<const RobotModel>(loadRobot(urdf, ""));
+  const RobotGeometry geometry(model);
+  const int a = model->linkIndex("forearm_link"), b = model->linkIndex("wrist_2_link");
+  ASSERT_GE(a, 0);
+  ASSERT_GE(b, 0);
+  const auto table =
+      PairTable::build(*model, a, *geometry.link(a), b, *geometry.link(b), 0.0, GeometryMode::Mesh, Tolerances{});
+  ASSERT_TRUE(table);
+  std::mt19937_64 rng(16);
+  long unsure = 0;
+  const int states = 3000;
+  for (int s = 0; s < states; ++s)
+    unsure += table->lookup(randomConfiguration(*model, rng).data()) == PairTable::Verdict::Unsure;
+  std::printf("  forearm_link/wrist_2_link: %ld of %d lookups unsure\n", unsure, states);
+  EXPECT_LT(unsure, states * 3 / 10);
+}
+
 // freeAlong walks every cell a segment crosses: where it says free, every one of 4,000 points along the
 // segment looks up Free and the exact pair is apart there; and it says free for most segments whose points
 // all look up Free (the rest touch a cell not Free between two points).
