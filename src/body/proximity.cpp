@@ -514,21 +514,9 @@ DistanceResult swapped(DistanceResult r) noexcept {
 
 }  // namespace
 
-BodyPair::BodyPair(const LinkGeometry& a, const LinkGeometry& b, SimplexCache* hull_warm)
-    : a_(&a), b_(&b), warm_(hull_warm) {}
-
-BodyPair::BodyPair(const LinkGeometry& a, const Shape& b, SimplexCache* hull_warm)
-    : a_(&a), shape_(&b), warm_(hull_warm) {}
-
 void BodyPair::forget() noexcept {
   hullCache() = SimplexCache{};
   parts_stale_ = true;
-}
-
-bool BodyPair::intersects(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol,
-                          const IntersectQuery& q) noexcept {
-  if (shape_) return shapeIntersectsLink(*shape_, pose_b, *a_, pose_a, tol, q.mode, q.padding, &hullCache());
-  return meshesIntersect(*a_, pose_a, *b_, pose_b, tol, q.mode, q.padding, &hullCache());
 }
 
 Screen BodyPair::screen(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, const IntersectQuery& q) noexcept {

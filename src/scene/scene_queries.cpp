@@ -60,10 +60,11 @@ SceneContext Scene::makeContext() const {
   return SceneContext(std::move(scratch));
 }
 
-bool Scene::adopt(SceneScratch& ctx) const noexcept {
+// (Inline: every query asks it first, and nearly always of a context of its own. Only this file calls it.)
+inline bool Scene::adopt(SceneScratch& ctx) const noexcept {
+  if (ctx.owner == serial_) return true;  // (made or adopted by this scene: its sizes were checked then)
   if (ctx.poses.size() != static_cast<std::size_t>(robot().linkCount()) || ctx.q.size() != base_q_.size())
     return false;  // (another robot's, or a default-made context)
-  if (ctx.owner == serial_) return true;
   std::copy(base_q_.begin(), base_q_.end(), ctx.q.begin());
   const std::size_t nv = base_q_.size();
   if (nv > 0 && ctx.lane_q.size() % nv == 0)

@@ -152,10 +152,12 @@ class BodyPair {
   /// The pair of a and b (borrowed), with cold warm starts; allocates nothing. `hull_warm`, when given, is
   /// where the hulls' warm start lives (the caller's, so that it outlives a pair made for one query); such
   /// a pair keeps no warm starts of its own (its parts start cold).
-  BodyPair(const LinkGeometry& a, const LinkGeometry& b, SimplexCache* hull_warm = nullptr);
+  BodyPair(const LinkGeometry& a, const LinkGeometry& b, SimplexCache* hull_warm = nullptr)
+      : a_(&a), b_(&b), warm_(hull_warm) {}
   /// The link a against the convex shape b (placed by pose_b in every query), both borrowed; `hull_warm`
   /// as above.
-  BodyPair(const LinkGeometry& a, const Shape& b, SimplexCache* hull_warm = nullptr);
+  BodyPair(const LinkGeometry& a, const Shape& b, SimplexCache* hull_warm = nullptr)
+      : a_(&a), shape_(&b), warm_(hull_warm) {}
 
   /// The first body, as given.
   const LinkGeometry& a() const noexcept { return *a_; }
@@ -166,7 +168,11 @@ class BodyPair {
 
   /// True when the bodies (placed by the poses) are within q.padding of each other: meshesIntersect (or
   /// shapeIntersectsLink), warm. Never "free" by accident (non-finite input, a narrow-phase failure: true).
-  bool intersects(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, const IntersectQuery& q) noexcept;
+  /// (Inline: the environment makes a pair per obstacle and query, and most ask this alone.)
+  bool intersects(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, const IntersectQuery& q) noexcept {
+    if (shape_) return shapeIntersectsLink(*shape_, pose_b, *a_, pose_a, tol, q.mode, q.padding, &hullCache());
+    return meshesIntersect(*a_, pose_a, *b_, pose_b, tol, q.mode, q.padding, &hullCache());
+  }
   /// intersects() split in two: its rungs short of the triangles (screenMeshes, warm), then, for an Unsure
   /// pair, the triangles (meshesIntersectExactly). Together they answer as intersects() does.
   Screen screen(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, const IntersectQuery& q) noexcept;
