@@ -76,7 +76,7 @@ void EnclosingBalls::placeParts(int link) noexcept {
   l.parts_at = placement_;
 }
 
-bool EnclosingBalls::apart(int a, int b, double padding, const Tolerances& tol, bool parts) noexcept {
+bool EnclosingBalls::apart(int a, int b, double padding, const Tolerances& tol, GeometryMode mode) noexcept {
   const Link& la = links_[a];
   const Link& lb = links_[b];
   if (la.count == 0 || lb.count == 0 || !poses_) return false;  // (never placed: nothing proved)
@@ -88,7 +88,7 @@ bool EnclosingBalls::apart(int a, int b, double padding, const Tolerances& tol, 
     return (centers_[i] - centers_[j]).squaredNorm() > limit * limit;
   };
   if (ballsApart(la.first, lb.first)) return true;
-  if (!parts || (la.count == 1 && lb.count == 1)) return false;
+  if (mode == GeometryMode::Hull || (la.count == 1 && lb.count == 1)) return false;
   if (la.parts_at != placement_) placeParts(a);
   if (lb.parts_at != placement_) placeParts(b);
   // The union of a link's parts contains it: every part ball of one apart from every part ball of the other.

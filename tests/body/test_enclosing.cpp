@@ -58,7 +58,7 @@ TEST(EnclosingBalls, ApartOnlyWhereTheMeshesAreApart) {
     std::vector<Pose> poses(model->linkCount());
     std::mt19937_64 rng(7);
     const std::vector<int>& links = geometry.geometricLinks();
-    int apart = 0, by_parts = 0, pairs = 0;
+    int apart = 0, by_parts = 0, pairs = 0, hull_apart = 0;
     for (int s = 0; s < 150; ++s) {
       const std::vector<double> q = randomState(*model, rng);
       computeLinkPoses(*model, q.data(), poses.data());
@@ -69,6 +69,13 @@ TEST(EnclosingBalls, ApartOnlyWhereTheMeshesAreApart) {
           const LinkGeometry &ga = *geometry.link(a), &gb = *geometry.link(b);
           for (double padding : {0.0, 0.02}) {
             ++pairs;
+            // Hull mode: the bounding balls alone, which hold the hulls (the parts' balls need not).
+            if (balls.apart(a, b, padding, tol, GeometryMode::Hull)) {
+              ++hull_apart;
+              EXPECT_FALSE(meshesIntersect(ga, poses[a], gb, poses[b], tol, GeometryMode::Hull, padding))
+                  << urdf << ": the hulls of " << model->link(a).name << " and " << model->link(b).name
+                  << " called apart";
+            }
             if (!balls.apart(a, b, padding, tol)) continue;
             ++apart;
             const double centres = (poses[a] * ga.sphereCenter() - poses[b] * gb.sphereCenter()).norm();
@@ -96,6 +103,9 @@ TEST(EnclosingBalls, ApartOnlyWhereTheMeshesAreApart) {
     bool several = false;  // (a link of one primitive has one part: only its bounding ball)
     for (int a : links) several |= geometry.link(a)->parts().size() > 1;
     if (several) EXPECT_GT(by_parts, 0) << urdf << ": the parts' balls never clear a pair the bounding balls keep";
+    // Hull mode is the bounding balls alone: never more pairs, and fewer where parts' balls clear some.
+    EXPECT_LE(hull_apart, apart) << urdf;
+    if (several) EXPECT_LT(hull_apart, apart) << urdf << ": Hull mode asked the parts' balls";
     // A non-finite pose is never apart.
     poses[links.back()].t.x() = std::numeric_limits<double>::quiet_NaN();
     balls.place(poses.data());

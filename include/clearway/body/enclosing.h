@@ -30,10 +30,9 @@ class EnclosingBalls {
   void place(const Pose* link_poses) noexcept;
   /// True when links a and b, as last placed, are certainly more than `padding` metres apart (beyond the
   /// narrow phase's band: tol.gjk_absolute of their size). False proves nothing; a non-finite pose, or
-  /// a link without geometry, is never apart. With `parts` false only the bounding balls are compared:
-  /// they hold a link's convex hull, its parts' balls only its triangles and solids (Hull mode's geometry
-  /// is the hull).
-  bool apart(int a, int b, double padding, const Tolerances& tol, bool parts = true) noexcept;
+  /// a link without geometry, is never apart. In Hull mode only the bounding balls are compared: they hold a
+  /// link's convex hull, its parts' balls only its triangles and solids.
+  bool apart(int a, int b, double padding, const Tolerances& tol, GeometryMode mode = GeometryMode::Mesh) noexcept;
   /// For k < n: out[k] = 1 when links a[k] and b[k], as last placed, have bounding balls more than
   /// padding[k] apart beyond the band (apart()'s first test, for many pairs at once in SIMD lanes, the target
   /// chosen at run time as KinematicLanes' is), else 0, which proves nothing.
