@@ -1,7 +1,8 @@
 #pragma once
 // One value per thread for each owner (a scene, a checker, a world): what a const, thread-safe object
 // needs to keep scratch without asking its callers for a context.
-#include <atomic>
+#include <clearway/serial.h>
+
 #include <cstddef>
 #include <cstdint>
 #include <iterator>
@@ -19,7 +20,7 @@ template <class T>
 class PerThread {
  public:
   /// A new owner, with no T on any thread.
-  PerThread() : serial_(next()), alive_(std::make_shared<const char>(0)) {}
+  PerThread() : serial_(detail::nextSerial()), alive_(std::make_shared<const char>(0)) {}
   ///@{
   /// A copy is a new owner (no T yet); an assignment keeps this one's identity and values.
   PerThread(const PerThread&) : PerThread() {}
@@ -58,10 +59,6 @@ class PerThread {
   static Thread& thread() {
     thread_local Thread mine;
     return mine;
-  }
-  static std::uint64_t next() {
-    static std::atomic<std::uint64_t> counter{1};
-    return counter++;
   }
   std::uint64_t serial_;
   std::shared_ptr<const char> alive_;  // expires with the owner

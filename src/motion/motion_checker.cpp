@@ -5,7 +5,6 @@
 #include <clearway/body/proximity.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -26,11 +25,6 @@ constexpr std::size_t kWarmObstacles = 64;
 }  // namespace
 
 // ---- MotionChecker ------------------------------------------------------------------------------------
-
-std::uint64_t MotionChecker::nextSerial() noexcept {
-  static std::atomic<std::uint64_t> next{1};
-  return next++;
-}
 
 MotionChecker::Bodies MotionChecker::mergeBodies(const Scene& scene) {
   const RobotModel& model = scene.robot();

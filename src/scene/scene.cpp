@@ -3,6 +3,7 @@
 #include <clearway/scene/scene.h>
 
 #include <clearway/body/enclosing.h>
+#include <clearway/serial.h>
 #include <clearway/body/proximity.h>
 
 #include <clearway/per_thread.h>
@@ -16,7 +17,6 @@
 #include "exact_text.h"
 
 #include <algorithm>
-#include <atomic>
 #include <charconv>
 #include <cmath>
 #include <limits>
@@ -120,8 +120,7 @@ std::shared_ptr<const Scene> Scene::load(const std::string& path, const SceneOpt
 }
 
 void Scene::init() {
-  static std::atomic<std::uint64_t> next_serial{1};
-  serial_ = next_serial++;
+  serial_ = detail::nextSerial();
   const RobotModel& model = geometry_->model();
   const std::string& file = description_.file;
   auto fail = [&](const std::string& key, const std::string& reason) {

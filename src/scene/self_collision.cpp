@@ -1,7 +1,8 @@
 #include <clearway/scene/self_collision.h>
 
+#include <clearway/serial.h>
+
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -50,10 +51,7 @@ long long SelfCollisionContext::pairTests() const noexcept { return scratch_ ? s
 
 SelfCollision::SelfCollision(std::shared_ptr<const RobotGeometry> geometry, const CollisionFilter& filter,
                              SelfCollisionOptions options)
-    : geometry_(std::move(geometry)), options_(std::move(options)), serial_([] {
-        static std::atomic<std::uint64_t> next{1};
-        return next++;
-      }()) {
+    : geometry_(std::move(geometry)), options_(std::move(options)), serial_(detail::nextSerial()) {
   if (!geometry_) throw std::invalid_argument("SelfCollision: null robot geometry");
   const int n = geometry_->model().linkCount();
   if (filter.linkCount() != n)

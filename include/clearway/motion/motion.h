@@ -27,6 +27,7 @@
 // them more than padding + 2·contact_distance apart in every cell the segment crosses is not swept at all.
 // Every ball is at least contact_distance / B wide, so the loops end; a cap on the
 // number of distance queries ends them too (reported as a collision).
+#include <clearway/serial.h>
 #include <clearway/scene/scene.h>
 
 #include <cstdint>
@@ -276,8 +277,7 @@ class MotionChecker {
   std::vector<std::vector<MotionBound::PairPath>> split_paths_;
   int env_begin_ = 0;        // the first environment item
   // Names this checker's contexts (a copy shares its items, so its serial too).
-  std::uint64_t serial_ = nextSerial();
-  static std::uint64_t nextSerial() noexcept;
+  std::uint64_t serial_ = detail::nextSerial();
   CollisionReport rigid_collision_;  // a self pair within one rigid body that collides (then every state does)
   double obstacle_speed_ = 0.0;   // the fastest obstacle's speed (m/s)
   std::vector<int> quaternions_;  // state entries where a floating joint's quaternion starts (qx)
