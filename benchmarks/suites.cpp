@@ -229,8 +229,9 @@ void statesCase(const SuiteCase& c, const SuiteConfig& config, std::vector<Suite
 
 // ---- verdicts: every path to a state's verdict, state by state, against FCL -------------------------------
 
-// The same states through each way Clearway decides one: one per call with the clearance grid (built
-// first), one per call through the trees alone (an environment that never has a grid), and 64 to a call
+// The same states through each way Clearway decides one: one per call with the obstacles' boxes and the
+// clearance grid (built first), one per call with the grid alone (no boxes), one per call through the trees
+// alone (an environment that never has either), and 64 to a call
 // (Scene::areFree) with the lanes forced to every SIMD target this CPU runs. Each row is judged against
 // FCL's verdicts (without FCL: the trees'); and since a faster path may never change a verdict, a state
 // where any row differs from the first fails the case, naming it.
@@ -238,8 +239,13 @@ void verdictsCase(const SuiteCase& c, const SuiteConfig& config, std::vector<Sui
   const SceneDescription d = parseSceneFile(c.file);
   const auto scene = robots().scene(d);
   scene->environment().prepareClearanceGrid();
+  const Environment& env = scene->environment();
+  const Scene grid(d, scene->geometryPtr(), std::make_shared<const Environment>(env.withoutObstacleBoxes()),
+                   scene->options());
+  grid.environment().prepareClearanceGrid();
   const Scene trees(d, scene->geometryPtr(),
-                    std::make_shared<const Environment>(scene->environment().withoutClearanceGrid()), scene->options());
+                    std::make_shared<const Environment>(env.withoutClearanceGrid().withoutObstacleBoxes()),
+                    scene->options());
   Rng rng(caseSeed(config, c));
   const int n = scene->dimension();
   const std::size_t count = config.count;
@@ -253,8 +259,9 @@ void verdictsCase(const SuiteCase& c, const SuiteConfig& config, std::vector<Sui
     ns.push_back(timedNs(count, [&](std::size_t i) { verdict_of(i, colliding); }));
     found.emplace_back(std::move(mode), std::move(colliding));
   };
-  SceneContext ctx = scene->makeContext(), trees_ctx = trees.makeContext();
+  SceneContext ctx = scene->makeContext(), grid_ctx = grid.makeContext(), trees_ctx = trees.makeContext();
   measure("one-by-one", [&](std::size_t i, std::vector<char>& v) { v[i] = !scene->isFree(&states[i * n], ctx); });
+  measure("grid", [&](std::size_t i, std::vector<char>& v) { v[i] = !grid.isFree(&states[i * n], grid_ctx); });
   measure("trees", [&](std::size_t i, std::vector<char>& v) { v[i] = !trees.isFree(&states[i * n], trees_ctx); });
   constexpr std::size_t kBatch = 64;
   std::unique_ptr<bool[]> batch_free(new bool[kBatch]);
@@ -271,7 +278,7 @@ void verdictsCase(const SuiteCase& c, const SuiteConfig& config, std::vector<Sui
       for (std::size_t j = 0; j < k; ++j) v[i + j] = !batch_free[j];
     });
   }
-  std::vector<char> truth = found[1].second;
+  std::vector<char> truth = found[2].second;  // (the trees')
 #ifdef CLEARWAY_HAVE_FCL
   FclScene fcl(*scene);
   for (std::size_t i = 0; i < count; ++i) truth[i] = !fcl.isFree(&states[i * n]);

@@ -88,6 +88,18 @@ Environment Environment::withMap(std::shared_ptr<const OccupancyMap> map) const 
 void Environment::rescale() {
   scale_ = std::max(maxAbs(static_.bounds()), voxel_tree_ ? maxAbs(voxel_tree_->bounds()) : 0.0);
   if (clearance_) clearance_ = std::make_shared<Clearance>();  // (none stays none: withoutClearanceGrid)
+  boxes_.reset();
+  if (without_boxes_ || static_.size() > ObstacleBoxes::kMaxBoxes) return;
+  std::vector<ObstacleBoxes::Placed> boxes;
+  static_.forEach([&](const Static& s, const Aabb& box) {
+    if (s.voxel) {
+      boxes.push_back({Pose::identity(), box});
+    } else {
+      const Obstacle& o = *s.obstacle;  // (its box in its own frame: a mesh's of its hull)
+      boxes.push_back({o.pose, o.mesh ? o.mesh->bounds() : placedBox(o.shape, Pose::identity())});
+    }
+  });
+  boxes_ = ObstacleBoxes::build(boxes);
 }
 
 const ClearanceGrid* Environment::clearanceGrid() const noexcept {
@@ -118,6 +130,13 @@ void Environment::prepareClearanceGrid() const noexcept {
 Environment Environment::withoutClearanceGrid() const {
   Environment e = *this;
   e.clearance_.reset();
+  return e;
+}
+
+Environment Environment::withoutObstacleBoxes() const {
+  Environment e = *this;
+  e.without_boxes_ = true;
+  e.boxes_.reset();
   return e;
 }
 

@@ -164,18 +164,27 @@ bool Scene::environmentFree(const Pose* poses, SceneScratch& ctx, CollisionRepor
   const Effects& fx = description_.effects;
   if (fx.environment && !environment_->empty()) {
     const double time = fx.moving ? t : 0.0;
-    // Once the environment has its clearance grid, the enclosing balls (placed after the lead link for
-    // the self check too) clear most links with a look-up each: the bounding ball, else every part's ball
-    // (whose union holds the link, the inside of its closed meshes included, but not its hull).
+    // The enclosing balls (placed after the lead link for the self check too) clear most links with a
+    // test or a look-up each: the bounding ball against the obstacles' oriented boxes, then against the
+    // clearance grid once the environment has one: the bounding ball, else every part's ball (whose union
+    // holds the link, the inside of its closed meshes included, but not its hull).
     const Environment& env = *environment_;
     EnclosingBalls& balls = ctx.balls;
     const ClearanceGrid* grid = nullptr;
+    const ObstacleBoxes* boxes = nullptr;
+    const auto slackOf = [&](int i, const EnclosingBalls::Placed& bound) {
+      return env.linkSlack(link_padding_[i], bound.center.cwiseAbs().maxCoeff() + bound.radius, options_.tolerances);
+    };
+    const auto boxCleared = [&](int i) {
+      if (balls.ballCount(i) == 0) return false;
+      const EnclosingBalls::Placed bound = balls.placed(i, 0);
+      return boxes->ballClear(bound.center, bound.radius, slackOf(i, bound));
+    };
     const auto cleared = [&](int i) {
       const int n = balls.ballCount(i);
       if (n == 0) return false;
       const EnclosingBalls::Placed bound = balls.placed(i, 0);
-      const double slack = env.linkSlack(link_padding_[i], bound.center.cwiseAbs().maxCoeff() + bound.radius,
-                                         options_.tolerances);
+      const double slack = slackOf(i, bound);
       if (grid->lowerBound(bound.center) > bound.radius + slack) return true;
       // (Not in Hull mode, where linkIntersects tests the hull, which the parts' balls need not hold. Nor for
       // closed meshes, which they hold only grown: on the shared robots, whose links are all closed, the
@@ -189,6 +198,10 @@ bool Scene::environmentFree(const Pose* poses, SceneScratch& ctx, CollisionRepor
     };
     const auto hits = [&](int k) {
       const int i = env_links_[k];
+      if (boxes && boxCleared(i)) {
+        ++ctx.counters.environment.box_clears;
+        return false;
+      }
       if (grid && cleared(i)) {
         ++ctx.counters.environment.grid_clears;
         return false;
@@ -210,7 +223,8 @@ bool Scene::environmentFree(const Pose* poses, SceneScratch& ctx, CollisionRepor
     const int lead = ctx.env_last_hit >= 0 && ctx.env_last_hit < n ? ctx.env_last_hit : -1;
     if (lead >= 0 && hits(lead)) return false;  // (before the balls are placed: it probably still collides)
     grid = env.hasMovingObstacles() ? nullptr : env.clearanceGrid();
-    if (grid && !(balls_placed = ctx.balls.madeFor(*geometry_))) grid = nullptr;
+    boxes = env.obstacleBoxes();
+    if ((grid || boxes) && !(balls_placed = ctx.balls.madeFor(*geometry_))) grid = nullptr, boxes = nullptr;
     if (balls_placed) ctx.balls.place(poses);
     for (int k = 0; k < n; ++k)
       if (k != lead && hits(k)) return false;

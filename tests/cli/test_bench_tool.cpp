@@ -274,8 +274,8 @@ TEST(BenchTool, VerdictsTakeEveryPathOnBothFormsOfAProblem) {
   }
   ASSERT_EQ(modes.size(), 2u) << "box_panda_0001 and its OctoMap form";
   for (const auto& [subject, m] : modes) {
-    EXPECT_TRUE(m.count("one-by-one") && m.count("trees")) << subject;
-    EXPECT_EQ(m.size(), 2 + clearway::KinematicLanes::targets().size()) << subject << ": one batch row per SIMD target";
+    EXPECT_TRUE(m.count("one-by-one") && m.count("grid") && m.count("trees")) << subject;
+    EXPECT_EQ(m.size(), 3 + clearway::KinematicLanes::targets().size()) << subject << ": one batch row per SIMD target";
     EXPECT_TRUE(m.count(std::string("batch-") + clearway::KinematicLanes::targetName())) << subject;
   }
   fs::remove_all(dir);

@@ -2,10 +2,13 @@
 // (and the work it does not do), and the shared MotionBenchMaker problems.
 #include <clearway/motion/motion.h>
 #include <clearway/scene/scene.h>
+#include <clearway/kinematics/kinematic_lanes.h>
 
+#include "forced_target.h"
 #include "load/robot_files.h"
 
 #include <gtest/gtest.h>
+#include <hwy/targets.h>
 
 #include <algorithm>
 #include <array>
@@ -14,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <random>
 #include <regex>
 #include <sstream>
@@ -759,39 +763,64 @@ TEST(Scene, TheLinkThatHitLastGoesFirstAndNoVerdictChanges) {
   std::printf("the lead changed the reported link on %d colliding states\n", changed);
 }
 
-// The same states with the environment's clearance grid and without: every verdict, and what each report
-// names, equal; one at a time and batched. Half the states are random, half walk near obstacles.
-void expectGridKeepsVerdicts(const std::shared_ptr<const Scene>& with, const std::string& what, std::mt19937& rng,
-                             long long& clears) {
-  const auto without = with->withEnvironment(std::make_shared<Environment>(with->environment().withoutClearanceGrid()));
+// Which shortcut of the environment a verdict test compares: the clearance grid, or the obstacles' boxes.
+enum class Shortcut { Grid, Boxes };
+
+// The same states with one shortcut of the environment and without it: every verdict, and what each report
+// names, equal; one at a time and batched. Half the states are random, half walk near obstacles. The grid
+// is compared on a world without boxes (which would clear first), the boxes beside the grid, on each of
+// `targets` in turn (none: the CPU's own).
+void expectShortcutKeepsVerdicts(Shortcut shortcut, const std::shared_ptr<const Scene>& loaded, const std::string& what,
+                                 std::mt19937& rng, long long& clears, const std::vector<std::int64_t>& targets) {
+  const Environment& env = loaded->environment();
+  const auto with = shortcut == Shortcut::Grid
+                        ? loaded->withEnvironment(std::make_shared<Environment>(env.withoutObstacleBoxes()))
+                        : loaded;
+  const auto without = with->withEnvironment(std::make_shared<Environment>(
+      shortcut == Shortcut::Grid ? with->environment().withoutClearanceGrid() : env.withoutObstacleBoxes()));
   with->environment().prepareClearanceGrid();
-  ASSERT_NE(with->environment().clearanceGrid(), nullptr) << what;
-  SceneContext a = with->makeContext(), b = without->makeContext(), batched = with->makeContext();
-  const int d = with->dimension();
-  std::vector<double> q(d), states;
-  std::vector<char> verdicts;
-  for (int k = 0; k < 600; ++k) {
-    const bool jump = k % 2 == 0 || k % 20 == 1;
-    for (int i = 0; i < d; ++i) {
-      const double lo = std::max(with->lower(i), -M_PI), hi = std::min(with->upper(i), M_PI);
-      q[i] = jump ? std::uniform_real_distribution<double>(lo, hi)(rng)
-                  : std::clamp(q[i] + std::normal_distribution<double>(0.0, 0.1)(rng), with->lower(i), with->upper(i));
+  without->environment().prepareClearanceGrid();
+  if (shortcut == Shortcut::Grid) ASSERT_NE(with->environment().clearanceGrid(), nullptr) << what;
+  const bool has_boxes = with->environment().obstacleBoxes() != nullptr;
+  for (std::size_t t = 0; t < std::max<std::size_t>(targets.size(), 1); ++t) {
+    std::optional<test::ForcedTarget> forced;
+    if (!targets.empty()) forced.emplace(targets[t]);
+    const std::string where = what + (targets.empty() ? "" : std::string(", ") + hwy::TargetName(targets[t]));
+    SceneContext a = with->makeContext(), b = without->makeContext(), batched = with->makeContext();
+    const int d = with->dimension();
+    std::vector<double> q(d), states;
+    std::vector<char> verdicts;
+    for (int k = 0; k < 600; ++k) {
+      const bool jump = k % 2 == 0 || k % 20 == 1;
+      for (int i = 0; i < d; ++i) {
+        const double lo = std::max(with->lower(i), -M_PI), hi = std::min(with->upper(i), M_PI);
+        q[i] = jump
+                   ? std::uniform_real_distribution<double>(lo, hi)(rng)
+                   : std::clamp(q[i] + std::normal_distribution<double>(0.0, 0.1)(rng), with->lower(i), with->upper(i));
+      }
+      CollisionReport ra, rb;
+      const bool fa = with->isFree(q.data(), a, &ra), fb = without->isFree(q.data(), b, &rb);
+      ASSERT_EQ(fa, fb) << where << " state " << k;
+      EXPECT_EQ(ra.kind, rb.kind) << where << " state " << k;
+      EXPECT_EQ(ra.link, rb.link) << where << " state " << k;
+      EXPECT_EQ(ra.other_link, rb.other_link) << where << " state " << k;
+      states.insert(states.end(), q.begin(), q.end());
+      verdicts.push_back(fa);
     }
-    CollisionReport ra, rb;
-    const bool fa = with->isFree(q.data(), a, &ra), fb = without->isFree(q.data(), b, &rb);
-    ASSERT_EQ(fa, fb) << what << " state " << k;
-    EXPECT_EQ(ra.kind, rb.kind) << what << " state " << k;
-    EXPECT_EQ(ra.link, rb.link) << what << " state " << k;
-    EXPECT_EQ(ra.other_link, rb.other_link) << what << " state " << k;
-    states.insert(states.end(), q.begin(), q.end());
-    verdicts.push_back(fa);
+    std::unique_ptr<bool[]> free(new bool[verdicts.size()]);
+    with->areFree(states.data(), static_cast<int>(verdicts.size()), batched, free.get());
+    for (std::size_t k = 0; k < verdicts.size(); ++k)
+      ASSERT_EQ(free[k], verdicts[k] != 0) << where << " batched state " << k;
+    if (shortcut == Shortcut::Grid) {
+      EXPECT_EQ(b.counters().environment.grid_clears, 0) << where;
+      EXPECT_GT(a.counters().environment.grid_clears, 0) << where << ": the grid cleared no link";
+      clears += a.counters().environment.grid_clears;
+    } else {
+      EXPECT_EQ(b.counters().environment.box_clears, 0) << where;
+      if (has_boxes) EXPECT_GT(a.counters().environment.box_clears, 0) << where << ": the boxes cleared no link";
+      clears += a.counters().environment.box_clears;
+    }
   }
-  std::unique_ptr<bool[]> free(new bool[verdicts.size()]);
-  with->areFree(states.data(), static_cast<int>(verdicts.size()), batched, free.get());
-  for (std::size_t k = 0; k < verdicts.size(); ++k) ASSERT_EQ(free[k], verdicts[k] != 0) << what << " batched state " << k;
-  EXPECT_EQ(b.counters().environment.grid_clears, 0) << what;
-  EXPECT_GT(a.counters().environment.grid_clears, 0) << what << ": the grid cleared no link";
-  clears += a.counters().environment.grid_clears;
 }
 
 // Two open plates (0.2 m squares at z = ±0.5) as dir/plates.stl: one link of two parts whose hull is a
@@ -872,27 +901,48 @@ TEST(Scene, HullModeSelfPairsAreDecidedByTheHulls) {
   }
 }
 
-TEST(Scene, TheClearanceGridChangesNoVerdict) {
-  std::mt19937 rng(29);
-  long long clears = 0;
-  expectGridKeepsVerdicts(Scene::load(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/arm6_wall.yaml"), "arm6_wall",
-                          rng, clears);
-  // In Hull mode too, where a link's hull (which its parts' balls need not hold) decides.
+// A shortcut on arm6_wall and every shared family, in Mesh and Hull mode (where a link's hull, which its
+// parts' balls need not hold, decides). The grid in both forms; the boxes in the primitive form (a map's
+// voxels have none), on every SIMD target of the lanes in Mesh mode.
+void expectShortcutKeepsVerdicts(Shortcut shortcut, std::mt19937& rng, long long& clears) {
+  const std::vector<std::int64_t> targets =
+      shortcut == Shortcut::Boxes ? KinematicLanes::targets() : std::vector<std::int64_t>{};
+  const std::string arm6 = std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/arm6_wall.yaml";
   SceneOptions hull;
   hull.mode = GeometryMode::Hull;
-  expectGridKeepsVerdicts(Scene::load(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/arm6_wall.yaml", hull),
-                          "arm6_wall (hull)", rng, clears);
-  CLEARWAY_SHARED_SCENES_OR_SKIP();
+  expectShortcutKeepsVerdicts(shortcut, Scene::load(arm6), "arm6_wall", rng, clears, targets);
+  expectShortcutKeepsVerdicts(shortcut, Scene::load(arm6, hull), "arm6_wall (hull)", rng, clears, {});
+  if (!std::filesystem::is_directory(sharedScenes())) return;
   for (const auto& family : std::filesystem::directory_iterator(sharedScenes())) {
     if (!family.is_directory()) continue;
     const std::string stem = family.path().string() + "/" + family.path().filename().string() + "_0001";
-    for (const std::string form : {".yaml", ".octomap.yaml"})
-      if (std::filesystem::exists(stem + form)) {
-        expectGridKeepsVerdicts(Scene::load(stem + form), stem + form, rng, clears);
-        if (form == ".yaml") expectGridKeepsVerdicts(Scene::load(stem + form, hull), stem + form + " (hull)", rng, clears);
+    for (const std::string form : {".yaml", ".octomap.yaml"}) {
+      if (!std::filesystem::exists(stem + form)) continue;
+      if (shortcut == Shortcut::Boxes && form != ".yaml") {
+        EXPECT_EQ(Scene::load(stem + form)->environment().obstacleBoxes(), nullptr) << stem + form;
+        continue;
       }
+      expectShortcutKeepsVerdicts(shortcut, Scene::load(stem + form), stem + form, rng, clears, targets);
+      if (form == ".yaml")
+        expectShortcutKeepsVerdicts(shortcut, Scene::load(stem + form, hull), stem + form + " (hull)", rng, clears, {});
+    }
   }
+}
+
+TEST(Scene, TheClearanceGridChangesNoVerdict) {
+  std::mt19937 rng(29);
+  long long clears = 0;
+  expectShortcutKeepsVerdicts(Shortcut::Grid, rng, clears);
+  CLEARWAY_SHARED_SCENES_OR_SKIP();
   std::printf("the grid cleared %lld links\n", clears);
+}
+
+TEST(Scene, TheObstacleBoxesChangeNoVerdict) {
+  std::mt19937 rng(31);
+  long long clears = 0;
+  expectShortcutKeepsVerdicts(Shortcut::Boxes, rng, clears);
+  CLEARWAY_SHARED_SCENES_OR_SKIP();
+  std::printf("the obstacles' boxes cleared %lld links\n", clears);
 }
 
 // Found by fuzz_scene_edits: a floating joint's quaternion of zeros passed validState (the tool's check

@@ -18,6 +18,7 @@
 #include <clearway/tolerances.h>
 #include <clearway/detail/persistent_map.h>
 #include <clearway/environment/clearance_grid.h>
+#include <clearway/environment/obstacle_boxes.h>
 #include <clearway/tree/aabb_tree.h>
 #include <clearway/tree/versioned_tree.h>
 
@@ -78,6 +79,7 @@ struct EnvironmentCounters {
   long long penetration_tests = 0;  ///< EPA runs (only for the signed clearance of a colliding link)
   long long cast_tests = 0;      ///< GJK shape casts (translating links)
   long long grid_clears = 0;     ///< links the clearance grid cleared with no tree walk (Scene::isFree)
+  long long box_clears = 0;      ///< links the obstacles' oriented boxes cleared with no tree walk (Scene::isFree)
 };
 
 /// Where and when an Environment link query runs, beside what it asks (BodyPair's IntersectQuery,
@@ -136,6 +138,16 @@ class Environment {
   /// This world, never with a clearance grid, nor any world edited from it: every query walks the trees
   /// (for comparing verdicts and cost).
   Environment withoutClearanceGrid() const;
+  /// The static obstacles as oriented boxes (obstacle_boxes.h) while they are all there is to hit (no
+  /// obstacle moves, the map has no voxel) and few (ObstacleBoxes::kMaxBoxes), else null. Scene::isFree
+  /// asks them before the grid and the trees: a link whose bounding ball, grown by linkSlack, they clear is
+  /// free of this world.
+  const ObstacleBoxes* obstacleBoxes() const noexcept {
+    return moving_.empty() && !voxel_tree_ ? boxes_.get() : nullptr;
+  }
+  /// This world, never with the obstacles' boxes, nor any world edited from it (for comparing verdicts and
+  /// cost).
+  Environment withoutObstacleBoxes() const;
 
   /// This world with one obstacle more: O(log n). Throws std::invalid_argument for an empty name or one
   /// in use, or a non-finite pose or velocity.
@@ -231,7 +243,7 @@ class Environment {
     std::shared_ptr<const FreeSlot> next;
   };
   Environment withStatic(std::shared_ptr<const Obstacle> o) const;  // adds (name checked by the caller)
-  void rescale();  // after the static items changed: their scale, and a new (unbuilt) clearance grid
+  void rescale();  // after the static items changed: their scale, their boxes, a new (unbuilt) clearance grid
   // The culls' band: four times the narrow phase's, for the roundings of placing boxes in the world.
   static double cullBand(double scale, const Tolerances& tol) noexcept { return 4.0 * narrowBand(scale, tol); }
   // The clearance grid of one version of the static items, built at most once.
@@ -249,6 +261,8 @@ class Environment {
   int point_voxels_ = 0;
   std::shared_ptr<Clearance> clearance_;  // null: never a grid (withoutClearanceGrid), in edits too
   double scale_ = 0.0;            // the largest |coordinate| of the trees' bounds (sizes the rounding band)
+  std::shared_ptr<const ObstacleBoxes> boxes_;  // of this version's static items (null: too many, or none)
+  bool without_boxes_ = false;                  // withoutObstacleBoxes, in edits too
 };
 
 }  // namespace clearway
