@@ -387,6 +387,14 @@ double Environment::lowerBound(const LinkGeometry& link, const Pose& pose, const
     return 0.0;
   // (No clearance grid here: it exists only once enough queries were asked, and a bound it settled could
   // differ from the GJKs' within their relative error, so a segment's verdict would depend on history.)
+  // The obstacles' boxes exist from the start: a link whose bounding ball they clear by q.enough (and the
+  // band) is that far from every item, which is all that is asked; no walk, no GJK.
+  if (const ObstacleBoxes* boxes = obstacleBoxes(); boxes && std::isfinite(q.enough)) {
+    const Vec3 centre = pose * link.sphereCenter();
+    const double reach = ballReach(link, pose);
+    const double extent = centre.cwiseAbs().maxCoeff() + reach;
+    if (boxes->ballClear(centre, reach, linkSlack(q.enough, extent, tol))) return q.enough;
+  }
   // One walk: each item near the link climbs its own ladder, asked only to prove the least bound so far
   // (items certainly beyond it cannot lower it, and are not visited).
   double lower = q.enough;
