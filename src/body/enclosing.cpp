@@ -1,6 +1,8 @@
 // The enclosing layer (enclosing.h): balls placed once per link, compared per pair.
 #include <clearway/body/enclosing.h>
 #include <clearway/detail/margins.h>
+#include <clearway/body/link_geometry.h>
+#include <clearway/tree/oriented_box_test.h>
 
 #include <algorithm>
 #include <cmath>
@@ -76,27 +78,27 @@ void EnclosingBalls::placeParts(int link) noexcept {
   l.parts_at = placement_;
 }
 
-bool EnclosingBalls::apart(int a, int b, double padding, const Tolerances& tol, GeometryMode mode) noexcept {
+bool EnclosingBalls::apart(int a, int b, double padding, const Tolerances& tol) const noexcept {
   const Link& la = links_[a];
   const Link& lb = links_[b];
   if (la.count == 0 || lb.count == 0 || !poses_) return false;  // (never placed: nothing proved)
   // As spheresApart in proximity.cpp: the band grows with the coordinates' size; a NaN compares false.
   const double band = margins::narrowBand(tol.gjk_absolute);
-  const auto ballsApart = [&](int i, int j) {
-    const double reach = radii_[i] + radii_[j] + padding;
-    const double limit = reach + band * (norms_[i] + norms_[j] + reach);
-    return (centers_[i] - centers_[j]).squaredNorm() > limit * limit;
-  };
-  if (ballsApart(la.first, lb.first)) return true;
-  if (mode == GeometryMode::Hull || (la.count == 1 && lb.count == 1)) return false;
-  if (la.parts_at != placement_) placeParts(a);
-  if (lb.parts_at != placement_) placeParts(b);
-  // The union of a link's parts contains it: every part ball of one apart from every part ball of the other.
-  const int ia = la.first + (la.count > 1), ib = lb.first + (lb.count > 1);
-  for (int i = ia; i < la.first + la.count; ++i)
-    for (int j = ib; j < lb.first + lb.count; ++j)
-      if (!ballsApart(i, j)) return false;
-  return true;
+  const int i = la.first, j = lb.first;
+  const double reach = radii_[i] + radii_[j] + padding;
+  const double limit = reach + band * (norms_[i] + norms_[j] + reach);
+  if ((centers_[i] - centers_[j]).squaredNorm() > limit * limit) return true;
+  // Their boxes (of the hulls, in the links' frames) as oriented boxes, on their face axes: a few dozen
+  // operations, and tighter than balls for long links (a forearm beside a wrist). The band as
+  // screenMeshes' (proximity.cpp), whose test this is. (The parts' balls, asked here once, cleared 28 of
+  // the UR5's 51,300 random pairs the boxes kept, at hundreds of operations for every pair they kept.)
+  const LinkGeometry& ga = *geometry_->link(a);
+  const LinkGeometry& gb = *geometry_->link(b);
+  const Pose b_in_a = relativePose(poses_[a], poses_[b]);
+  if (!b_in_a.isFinite()) return false;
+  const double scale = ga.boundingRadius() + gb.boundingRadius() + b_in_a.t.norm();
+  const double slack = padding + band * (scale + padding);
+  return detail::OrientedBoxTest(b_in_a, slack, scale).separated<false>(ga.bounds(), gb.bounds());
 }
 
 }  // namespace clearway

@@ -114,8 +114,7 @@ bool SelfCollision::pairHits(int k, const Pose* poses, SelfScratch& ctx, Enclosi
 Screen SelfCollision::pairScreen(int k, const Pose* poses, SelfScratch& ctx, EnclosingBalls* balls) const noexcept {
   const LinkPair& p = pairs_[k];
   ++ctx.pair_tests;
-  // (Hull mode: the hulls decide, which the parts' balls need not hold.)
-  if (balls && balls->apart(p.a, p.b, pair_padding_[k], options_.tolerances, options_.mode)) return Screen::Apart;
+  if (balls && balls->apart(p.a, p.b, pair_padding_[k], options_.tolerances)) return Screen::Apart;
   const IntersectQuery q{pair_padding_[k], options_.mode};
   // (A context of another checker of the robot, whose pair k is another pair, asks a fresh pair.)
   if (ctx.owner == serial_ && k < static_cast<int>(ctx.bodies.size()))

@@ -1,9 +1,10 @@
 #pragma once
 // The enclosing layer: every link's bounding ball and its parts' balls (LinkGeometry::parts(), whose union
-// contains the link) placed in the world once per configuration. A pair of links is then cleared by
-// distance comparisons alone: its bounding balls apart, or every ball of one apart from every ball of the
-// other. Placing once per link instead of once per pair is what makes it cheap for robots with many
-// checked pairs; only pairs it cannot clear go on to the hulls and the triangles (proximity.h).
+// contains the link) placed in the world once per configuration. A pair of links is cleared by its bounding
+// balls apart, else by its hulls' boxes apart on a face axis; a link is cleared from the obstacles by its
+// balls' look-ups (Scene::isFree). Placing once per link instead of once per pair is what makes it cheap for
+// robots with many checked pairs; only pairs it cannot clear go on to the hulls and the triangles
+// (proximity.h).
 #include <clearway/body/robot_geometry.h>
 #include <clearway/detail/margins.h>
 #include <clearway/tolerances.h>
@@ -29,10 +30,10 @@ class EnclosingBalls {
   /// therefore stay unchanged until the next place().
   void place(const Pose* link_poses) noexcept;
   /// True when links a and b, as last placed, are certainly more than `padding` metres apart (beyond the
-  /// narrow phase's band: tol.gjk_absolute of their size). False proves nothing; a non-finite pose, or
-  /// a link without geometry, is never apart. In Hull mode only the bounding balls are compared: they hold a
-  /// link's convex hull, its parts' balls only its triangles and solids.
-  bool apart(int a, int b, double padding, const Tolerances& tol, GeometryMode mode = GeometryMode::Mesh) noexcept;
+  /// narrow phase's band: tol.gjk_absolute of their size): their bounding balls apart, or their hulls'
+  /// boxes apart on a face axis. Both hold the hulls, so the answer holds in every geometry mode. False
+  /// proves nothing; a non-finite pose, or a link without geometry, is never apart.
+  bool apart(int a, int b, double padding, const Tolerances& tol) const noexcept;
   /// For k < n: out[k] = 1 when links a[k] and b[k], as last placed, have bounding balls more than
   /// padding[k] apart beyond the band (apart()'s first test, for many pairs at once in SIMD lanes, the target
   /// chosen at run time as KinematicLanes' is), else 0, which proves nothing.
