@@ -830,75 +830,36 @@ TEST(MotionCertified, InsideAClosedMeshIsACollision) {
   }
 }
 
-// Certified motions with the environment's clearance grid (which settles a link's measurement when its
-// ball is beyond what the step needs) and without: the same verdicts on random segments of our arm and of
-// every shared family, primitive and OctoMap forms.
-TEST(MotionCertified, TheClearanceGridChangesNoVerdict) {
+// Our arm's scene and problem 0001 of every shared family in each of these forms (".yaml", ".octomap.yaml").
+std::vector<std::string> shortcutScenes(const std::vector<std::string>& forms) {
   std::vector<std::string> scenes = {std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/arm6_wall.yaml"};
   const std::string root = test::sharedPath("scenes");
   if (!root.empty())
     for (const auto& family : std::filesystem::directory_iterator(root)) {
       if (!family.is_directory()) continue;
       const std::string stem = family.path().string() + "/" + family.path().filename().string() + "_0001";
-      for (const std::string form : {".yaml", ".octomap.yaml"})
+      for (const std::string& form : forms)
         if (std::filesystem::exists(stem + form)) scenes.push_back(stem + form);
     }
-  std::mt19937 rng(31);
-  int colliding = 0, total = 0;
-  for (const std::string& path : scenes) {
-    const auto with = Scene::load(path);
-    const auto without = with->withEnvironment(std::make_shared<Environment>(with->environment().withoutClearanceGrid()));
-    with->environment().prepareClearanceGrid();
-    const MotionChecker a(with), b(without);
-    MotionContext ca = a.makeContext(), cb = b.makeContext();
-    SceneContext sc = with->makeContext();
-    const int d = with->dimension();
-    std::vector<double> q0(d), q1(d);
-    for (int k = 0; k < 40;) {
-      for (int i = 0; i < d; ++i) {
-        const double lo = std::max(with->lower(i), -M_PI), hi = std::min(with->upper(i), M_PI);
-        q0[i] = std::uniform_real_distribution<double>(lo, hi)(rng);
-        q1[i] = std::clamp(q0[i] + std::uniform_real_distribution<double>(-0.6, 0.6)(rng), lo, hi);
-      }
-      if (!with->isFree(q0.data(), sc) || !with->isFree(q1.data(), sc)) continue;
-      ++k;
-      const bool fa = a.check(q0.data(), q1.data(), ca, false).free, fb = b.check(q0.data(), q1.data(), cb, false).free;
-      ASSERT_EQ(fa, fb) << path << " segment " << k;
-      colliding += !fa;
-      ++total;
-    }
-  }
-  EXPECT_GT(colliding, 0) << "no segment collided: the test shows nothing near obstacles";
-  std::printf("%d of %d segments collide, with and without the grid\n", colliding, total);
-  CLEARWAY_REQUIRE_SHARED("scenes");  // (our arm is checked either way)
+  return scenes;
 }
 
-// Certified motions with the obstacles' boxes (which settle a link's measurement when its ball is beyond
-// what the step needs, before the walk over the obstacles) and without: the same verdicts, and where a
-// segment collides the same first contact and last valid parameter, on random segments of our arm and of
-// every shared family's primitive form (a map's voxels have no boxes).
-TEST(MotionCertified, TheObstacleBoxesChangeNoVerdict) {
-  std::vector<std::string> scenes = {std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/arm6_wall.yaml"};
-  const std::string root = test::sharedPath("scenes");
-  if (!root.empty())
-    for (const auto& family : std::filesystem::directory_iterator(root)) {
-      if (!family.is_directory()) continue;
-      const std::string path = family.path().string() + "/" + family.path().filename().string() + "_0001.yaml";
-      if (std::filesystem::exists(path)) scenes.push_back(path);
-    }
-  std::mt19937 rng(37);
-  int colliding = 0, total = 0;
+// Certified motions of each scene with its environment and with `without(environment)` (a shortcut taken
+// away): the same verdicts on `per_scene` random segments between free states, and on every other one
+// (located) the same first contact and last valid parameter. Counts the segments that collide.
+void expectShortcutKeepsMotions(const std::vector<std::string>& scenes, Environment (*without)(const Environment&),
+                                int per_scene, unsigned seed, int& colliding, int& total) {
+  std::mt19937 rng(seed);
   for (const std::string& path : scenes) {
     const auto with = Scene::load(path);
-    ASSERT_NE(with->environment().obstacleBoxes(), nullptr) << path;
-    const auto without =
-        with->withEnvironment(std::make_shared<Environment>(with->environment().withoutObstacleBoxes()));
-    const MotionChecker a(with), b(without);
+    const auto other = with->withEnvironment(std::make_shared<Environment>(without(with->environment())));
+    with->environment().prepareClearanceGrid();
+    const MotionChecker a(with), b(other);
     MotionContext ca = a.makeContext(), cb = b.makeContext();
     SceneContext sc = with->makeContext();
     const int d = with->dimension();
     std::vector<double> q0(d), q1(d);
-    for (int k = 0; k < 60;) {
+    for (int k = 0; k < per_scene;) {
       for (int i = 0; i < d; ++i) {
         const double lo = std::max(with->lower(i), -M_PI), hi = std::min(with->upper(i), M_PI);
         q0[i] = std::uniform_real_distribution<double>(lo, hi)(rng);
@@ -917,6 +878,30 @@ TEST(MotionCertified, TheObstacleBoxesChangeNoVerdict) {
       ++total;
     }
   }
+}
+
+// Certified motions with the environment's clearance grid (which settles a link's measurement when its
+// ball is beyond what the step needs) and without, on our arm and every shared family in both forms.
+TEST(MotionCertified, TheClearanceGridChangesNoVerdict) {
+  int colliding = 0, total = 0;
+  expectShortcutKeepsMotions(
+      shortcutScenes({".yaml", ".octomap.yaml"}), [](const Environment& e) { return e.withoutClearanceGrid(); }, 40, 31,
+      colliding, total);
+  EXPECT_GT(colliding, 0) << "no segment collided: the test shows nothing near obstacles";
+  std::printf("%d of %d segments collide, with and without the grid\n", colliding, total);
+  CLEARWAY_REQUIRE_SHARED("scenes");  // (our arm is checked either way)
+}
+
+// Certified motions with the obstacles' boxes (which settle a link's measurement when its ball is beyond
+// what the step needs, before the walk over the obstacles) and without, on our arm and every shared
+// family's primitive form (a map's voxels have no boxes).
+TEST(MotionCertified, TheObstacleBoxesChangeNoVerdict) {
+  int colliding = 0, total = 0;
+  const auto without = [](const Environment& e) {
+    EXPECT_NE(e.obstacleBoxes(), nullptr) << "a scene of primitives has no boxes";
+    return e.withoutObstacleBoxes();
+  };
+  expectShortcutKeepsMotions(shortcutScenes({".yaml"}), without, 60, 37, colliding, total);
   EXPECT_GT(colliding, 0) << "no segment collided: the test shows nothing near obstacles";
   std::printf("%d of %d segments collide, with and without the boxes\n", colliding, total);
   CLEARWAY_REQUIRE_SHARED("scenes");  // (our arm is checked either way)

@@ -903,8 +903,10 @@ TEST(Scene, HullModeSelfPairsAreDecidedByTheHulls) {
 
 // A shortcut on arm6_wall and every shared family, in Mesh and Hull mode (where a link's hull, which its
 // parts' balls need not hold, decides). The grid in both forms; the boxes in the primitive form (a map's
-// voxels have none), on every SIMD target of the lanes in Mesh mode.
-void expectShortcutKeepsVerdicts(Shortcut shortcut, std::mt19937& rng, long long& clears) {
+// voxels have none), on every SIMD target of the lanes in Mesh mode. Returns the links it cleared.
+long long expectShortcutKeepsVerdicts(Shortcut shortcut, unsigned seed) {
+  std::mt19937 rng(seed);
+  long long clears = 0;
   const std::vector<std::int64_t> targets =
       shortcut == Shortcut::Boxes ? KinematicLanes::targets() : std::vector<std::int64_t>{};
   const std::string arm6 = std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/arm6_wall.yaml";
@@ -912,7 +914,7 @@ void expectShortcutKeepsVerdicts(Shortcut shortcut, std::mt19937& rng, long long
   hull.mode = GeometryMode::Hull;
   expectShortcutKeepsVerdicts(shortcut, Scene::load(arm6), "arm6_wall", rng, clears, targets);
   expectShortcutKeepsVerdicts(shortcut, Scene::load(arm6, hull), "arm6_wall (hull)", rng, clears, {});
-  if (!std::filesystem::is_directory(sharedScenes())) return;
+  if (!std::filesystem::is_directory(sharedScenes())) return clears;
   for (const auto& family : std::filesystem::directory_iterator(sharedScenes())) {
     if (!family.is_directory()) continue;
     const std::string stem = family.path().string() + "/" + family.path().filename().string() + "_0001";
@@ -927,20 +929,17 @@ void expectShortcutKeepsVerdicts(Shortcut shortcut, std::mt19937& rng, long long
         expectShortcutKeepsVerdicts(shortcut, Scene::load(stem + form, hull), stem + form + " (hull)", rng, clears, {});
     }
   }
+  return clears;
 }
 
 TEST(Scene, TheClearanceGridChangesNoVerdict) {
-  std::mt19937 rng(29);
-  long long clears = 0;
-  expectShortcutKeepsVerdicts(Shortcut::Grid, rng, clears);
+  const long long clears = expectShortcutKeepsVerdicts(Shortcut::Grid, 29);
   CLEARWAY_SHARED_SCENES_OR_SKIP();
   std::printf("the grid cleared %lld links\n", clears);
 }
 
 TEST(Scene, TheObstacleBoxesChangeNoVerdict) {
-  std::mt19937 rng(31);
-  long long clears = 0;
-  expectShortcutKeepsVerdicts(Shortcut::Boxes, rng, clears);
+  const long long clears = expectShortcutKeepsVerdicts(Shortcut::Boxes, 31);
   CLEARWAY_SHARED_SCENES_OR_SKIP();
   std::printf("the obstacles' boxes cleared %lld links\n", clears);
 }
