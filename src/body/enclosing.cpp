@@ -1,8 +1,7 @@
 // The enclosing layer (enclosing.h): balls placed once per link, compared per pair.
 #include <clearway/body/enclosing.h>
 #include <clearway/detail/margins.h>
-#include <clearway/body/link_geometry.h>
-#include <clearway/tree/oriented_box_test.h>
+#include <clearway/body/proximity.h>
 
 #include <algorithm>
 #include <cmath>
@@ -89,16 +88,11 @@ bool EnclosingBalls::apart(int a, int b, double padding, const Tolerances& tol) 
   const double limit = reach + band * (norms_[i] + norms_[j] + reach);
   if ((centers_[i] - centers_[j]).squaredNorm() > limit * limit) return true;
   // Their boxes (of the hulls, in the links' frames) as oriented boxes, on their face axes: a few dozen
-  // operations, and tighter than balls for long links (a forearm beside a wrist). The band as
-  // screenMeshes' (proximity.cpp), whose test this is. (The parts' balls, asked here once, cleared 28 of
-  // the UR5's 51,300 random pairs the boxes kept, at hundreds of operations for every pair they kept.)
-  const LinkGeometry& ga = *geometry_->link(a);
-  const LinkGeometry& gb = *geometry_->link(b);
+  // operations, and tighter than balls for long links (a forearm beside a wrist). (The parts' balls, asked
+  // here once, cleared 28 of the UR5's 51,300 random pairs the boxes kept, at hundreds of operations for
+  // every pair they kept.)
   const Pose b_in_a = relativePose(poses_[a], poses_[b]);
-  if (!b_in_a.isFinite()) return false;
-  const double scale = ga.boundingRadius() + gb.boundingRadius() + b_in_a.t.norm();
-  const double slack = padding + band * (scale + padding);
-  return detail::OrientedBoxTest(b_in_a, slack, scale).separated<false>(ga.bounds(), gb.bounds());
+  return b_in_a.isFinite() && boxesApart(*geometry_->link(a), *geometry_->link(b), b_in_a, tol, padding);
 }
 
 }  // namespace clearway

@@ -226,9 +226,7 @@ Screen screenMeshes(const LinkGeometry& a, const Pose& pose_a, const LinkGeometr
                    tol))
     return Screen::Apart;
   const Pose b_in_a = relativePose(pose_a, pose_b);
-  const double scale = a.boundingRadius() + b.boundingRadius() + b_in_a.t.norm();
-  const double slack = padding + narrowBand(scale + padding, tol);
-  if (detail::OrientedBoxTest(b_in_a, slack, scale).separated<false>(a.bounds(), b.bounds())) return Screen::Apart;
+  if (boxesApart(a, b, b_in_a, tol, padding)) return Screen::Apart;
   SimplexCache scratch;
   SimplexCache& cache = hull_cache ? *hull_cache : scratch;
   const IntersectResult hulls = gjkIntersect(Margin<ConvexHull>{a.hull(), padding}, pose_a, b.hull(), pose_b, tol, cache);

@@ -5,6 +5,7 @@
 // it. A BodyPair keeps the pair's GJK warm starts from one query to the next.
 #include <clearway/body/link_geometry.h>
 #include <clearway/narrowphase/ray_cast.h>
+#include <clearway/tree/oriented_box_test.h>
 
 #include <limits>
 #include <vector>
@@ -32,6 +33,15 @@ enum class Screen : char { Apart, Touching, Unsure };
 Screen screenMeshes(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
                     const Tolerances& tol, GeometryMode mode, double padding = 0.0,
                     SimplexCache* hull_cache = nullptr) noexcept;
+/// screenMeshes' second rung, which the enclosing layer asks too: the links' hull boxes (bounds()) as
+/// oriented boxes are farther apart than `padding` and the band on one of their face axes. b_in_a: b's pose
+/// in a's frame, finite. (Inline: both ask it for most pairs they see.)
+inline bool boxesApart(const LinkGeometry& a, const LinkGeometry& b, const Pose& b_in_a, const Tolerances& tol,
+                       double padding) noexcept {
+  const double scale = a.boundingRadius() + b.boundingRadius() + b_in_a.t.norm();
+  const double slack = padding + narrowBand(scale + padding, tol);
+  return detail::OrientedBoxTest(b_in_a, slack, scale).separated<false>(a.bounds(), b.bounds());
+}
 /// The exact rung of meshesIntersect in Mesh mode (triangles, primitives, closed meshes as solids), for a pair
 /// the screen left Unsure; meshesIntersect's answer there.
 bool meshesIntersectExactly(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
