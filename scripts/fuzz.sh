@@ -5,8 +5,9 @@
 #   bash scripts/fuzz.sh [SECONDS] [TARGET...]      e.g.  bash scripts/fuzz.sh 3600 mesh_dae
 # FUZZ_SEED=N fixes libFuzzer's random seed (CI does, so that a run can be replayed; 0: a new one).
 # A crash, sanitizer report, undocumented exception, timeout (10 s) or memory blow-up (2 GB) is a
-# finding: the input is kept as build-fuzz/crashes/<target>-crash-* (or -timeout-, -oom-, -leak-),
-# the log as build-fuzz/logs/<target>.log, and the script exits 1 after running the other targets.
+# finding: the input is kept as build-fuzz/crashes/<target>-crash-* (or -timeout-, -oom-, -leak-) and
+# printed in base64, the log as build-fuzz/logs/<target>.log, and the script exits 1 after running the
+# other targets. A timeout counts only if the input, run again alone, times out again.
 # Interesting inputs found on the way stay in build-fuzz/corpus/<target>/ for the next run.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -67,9 +68,19 @@ for target in "${targets[@]}"; do
        -artifact_prefix="$BUILD/crashes/$target-" -print_final_stats=1 >"$log" 2>&1; then
     echo "fuzz $target: $(grep -oE 'Done [0-9]+ runs in [0-9]+ second' "$log" | tail -n 1 | sed 's/ second/ s/'), no finding"
   else
-    echo "fuzz $target: FINDING (log $log, input $(ls -t "$BUILD"/crashes/"$target"-* 2>/dev/null | head -n 1))"
+    unit=$(ls -t "$BUILD"/crashes/"$target"-* 2>/dev/null | head -n 1)
     grep -E 'ERROR|SUMMARY|finding|deadly|Test unit written' "$log" | head -n 8 | sed 's/^/  /'
-    failed+=("$target")
+    # The input goes into the log too, so that a finding on a machine we cannot reach can be replayed.
+    [ -z "$unit" ] || [ "$(stat -c %s "$unit")" -gt 16384 ] || { echo "  input (base64):"; base64 -w 120 "$unit" | sed 's/^/    /'; }
+    # A timeout is replayed alone, once: one that does not recur was a stalled machine, not a slow input
+    # (a slow input is slow again). It is said, and the input kept, but it fails nothing.
+    replay_start=$SECONDS
+    if [[ $unit == *-timeout-* ]] && timeout 120 "$exe" -timeout=10 -rss_limit_mb=2048 "$unit" >"$log.replay" 2>&1; then
+      echo "fuzz $target: a unit timed out, but alone it ran in $((SECONDS - replay_start)) s: not a finding (input kept: $unit)"
+    else
+      echo "fuzz $target: FINDING (log $log, input $unit)"
+      failed+=("$target")
+    fi
   fi
 done
 if [ ${#failed[@]} -gt 0 ]; then
