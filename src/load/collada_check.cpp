@@ -23,8 +23,6 @@ using tinyxml2::XMLElement;
 // The node hierarchy assimp builds, instances expanded: its recursion depth and its size.
 constexpr int kMaxNodeDepth = 256;
 constexpr std::int64_t kMaxExpandedNodes = 100000;
-// The triangles the instances may expand to, unless the file writes out more (see collada_check.h).
-constexpr std::uint64_t kMaxExpandedTriangles = std::uint64_t{1} << 20;
 
 std::uint64_t saturatingAdd(std::uint64_t a, std::uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; }
 
@@ -215,8 +213,8 @@ class Checker {
   // No cycle through <instance_node>, and a bounded hierarchy once instances are expanded: its depth, its
   // nodes, and the triangles its instances reach (each geometry's times the paths to it through the node
   // graph), within the limit unless the file writes out more triangles than that itself.
-  void checkNodes() {
-    triangle_limit_ = std::max(kMaxExpandedTriangles, written_triangles_);
+  void checkNodes(std::uint64_t max_expanded_triangles) {
+    triangle_limit_ = std::max(max_expanded_triangles, written_triangles_);
     for (const XMLElement* n : nodes_) expand(n, 1);
     // A visual scene is the root above its nodes (level 0): its nodes stand at level 1.
     for (const XMLElement* scene : visual_scenes_) expand(scene, 0);
@@ -406,12 +404,12 @@ class Checker {
   std::unordered_map<const XMLElement*, std::uint64_t> geometry_triangles_;
   std::uint64_t triangles_ = 0;          // of the <geometry> being visited
   std::uint64_t written_triangles_ = 0;  // of every <geometry>, each once
-  std::uint64_t triangle_limit_ = kMaxExpandedTriangles;
+  std::uint64_t triangle_limit_ = 0;     // (set by checkNodes)
 };
 
 }  // namespace
 
-void checkCollada(const std::string& path) {
+void checkCollada(const std::string& path, std::uint64_t max_expanded_triangles) {
   const std::string text = readRegularFile(path);
   tinyxml2::XMLDocument doc;
   if (doc.Parse(text.c_str(), text.size()) != tinyxml2::XML_SUCCESS)
@@ -423,7 +421,7 @@ void checkCollada(const std::string& path) {
   checker.visit(root);
   checker.checkAccessors();
   checker.checkMeshInputs();
-  checker.checkNodes();
+  checker.checkNodes(max_expanded_triangles);
 }
 
 }  // namespace clearway::detail

@@ -5,6 +5,7 @@
 // the array's end, a <skew> makes it abort and names read as positions crash it; a few kilobytes of
 // nodes instancing each other twice over expand to millions of triangles. This pass refuses such files
 // with the element, its line and the reason.
+#include <cstdint>
 #include <string>
 
 namespace clearway::detail {
@@ -17,13 +18,13 @@ namespace clearway::detail {
 /// or <IDREF_array>; two nodes, visual scenes, geometries or controllers with one id, or an instance
 /// naming (by name, for want of an id) several nodes; an <instance_node> that leads back to its own node
 /// or visual scene (assimp keeps a visual scene as a node, named by its id, its name or "Scene"); a node
-/// hierarchy, with its instances expanded, deeper than 256 levels or larger than 100,000 nodes; a node or visual scene whose
-/// instances reach more than 1,048,576 (2^20) triangles, each geometry counted once per path to it
-/// (polygons as the triangles they fan into), unless the file's geometries themselves hold more. The
-/// limit is 24 times the largest mesh of ../shared/robots (43,000 triangles): within it a mesh loads in
-/// a few seconds even in a sanitized build, past it in minutes and gigabytes (9.8 million triangles took
-/// 31 s and 805 MB in the ASan build, 2.5 million over 10 s in the fuzzer's); and it keeps the merged
-/// mesh far inside its 32-bit indices and the AABB tree's 2^30 items.
-void checkCollada(const std::string& path);
+/// hierarchy, with its instances expanded, deeper than 256 levels or larger than 100,000 nodes; a node or visual scene
+/// whose instances reach more than max_expanded_triangles (MeshOptions; 2^20 by default) triangles, each geometry
+/// counted once per path to it (polygons as the triangles they fan into), unless the file's geometries themselves hold
+/// more. The default is 24 times the largest mesh of ../shared/robots (43,000 triangles): within it a mesh loads in a
+/// few seconds even in a sanitized build, past it in minutes and gigabytes (9.8 million triangles took 31 s and 805 MB
+/// in the ASan build; 600,000 take 12 s in the fuzzer's, which sets a lower limit); and it keeps the merged mesh far
+/// inside its 32-bit indices and the AABB tree's 2^30 items.
+void checkCollada(const std::string& path, std::uint64_t max_expanded_triangles);
 
 }  // namespace clearway::detail

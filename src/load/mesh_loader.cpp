@@ -1,6 +1,6 @@
 // Mesh files → TriangleMesh: STL, OBJ and COLLADA through assimp, PLY through ply_reader.cpp. The reader
 // reads the file and triangulates it; everything that decides what the triangles *are* (node transforms,
-// unit and up axis, scale, welding, degenerate faces) is done here in double precision, so that the
+// unit and up axis, scale, welding, degenerate and repeated faces) is done here in double precision, so that the
 // result does not depend on the reader's choices beyond triangulation.
 #include <clearway/load/input_limits.h>
 #include <clearway/load/load_error.h>
@@ -19,6 +19,7 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
@@ -29,6 +30,7 @@
 #include <string>
 #include <system_error>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 namespace clearway {
@@ -107,6 +109,13 @@ struct PositionKey {
   double x, y, z;
   bool operator==(const PositionKey& o) const { return x == o.x && y == o.y && z == o.z; }
 };
+struct CornersHash {
+  std::size_t operator()(const std::array<std::int32_t, 3>& c) const noexcept {
+    std::uint64_t h = 1469598103934665603ull;
+    for (const std::int32_t i : c) h = (h ^ static_cast<std::uint32_t>(i)) * 1099511628211ull;
+    return static_cast<std::size_t>(h ^ (h >> 29));
+  }
+};
 struct PositionHash {
   std::size_t operator()(const PositionKey& k) const noexcept {
     std::uint64_t h = 1469598103934665603ull;
@@ -146,12 +155,21 @@ class Merger {
         ++degenerate;
         continue;
       }
+      // A triangle over the same three vertices as an earlier one adds no geometry; stacked copies (a few
+      // kilobytes of COLLADA instancing one mesh a thousand times) made every ray of the solids' tests
+      // cross them all, 8 s to build a link of 600,000 copies of one tetrahedron.
+      std::array<std::int32_t, 3> key = t;
+      std::sort(key.begin(), key.end());
+      if (!seen_.insert(key).second) {
+        ++repeated;
+        continue;
+      }
       mesh.triangles.push_back(t);
     }
   }
 
   TriangleMesh mesh;
-  std::size_t degenerate = 0, points_and_lines = 0;
+  std::size_t degenerate = 0, repeated = 0, points_and_lines = 0;
 
  private:
   void addMesh(const aiMesh& m, const Affine& world) {
@@ -200,6 +218,7 @@ class Merger {
   Vec3 scale_;
   std::vector<std::int32_t> index_;
   std::unordered_map<PositionKey, std::int32_t, PositionHash> welded_;
+  std::unordered_set<std::array<std::int32_t, 3>, CornersHash> seen_;  // the kept triangles' corners, sorted
 };
 
 // Edges (as sorted vertex pairs) with the number of triangles using them: one count per open or
@@ -266,7 +285,7 @@ void mergeThroughAssimp(const std::string& path, const std::string& ext, const M
                         const std::function<void(const std::string&)>& warn, Merger* merger) {
   Assimp::Importer importer;
   importer.SetIOHandler(new RegularFileIOSystem);  // the importer owns it
-  if (ext == "dae") detail::checkCollada(path);
+  if (ext == "dae") detail::checkCollada(path, options.max_expanded_triangles);
 
   // Only positions matter. Vertices are joined below by exact position, not by assimp's
   // JoinIdenticalVertices: on every mesh of ../shared/robots both give the same vertices, ours in a
@@ -366,6 +385,8 @@ TriangleMesh loadMesh(const std::string& path, const Vec3& scale, std::vector<st
   if (merger.points_and_lines > 0)
     warn(std::to_string(merger.points_and_lines) + " point and line primitives ignored");
   if (merger.degenerate > 0) warn(std::to_string(merger.degenerate) + " zero-area triangles dropped");
+  if (merger.repeated > 0)
+    warn(std::to_string(merger.repeated) + " repeated triangles dropped (the same three vertices as an earlier one)");
   if (mesh.triangles.empty()) throw LoadError(path, "", "empty mesh: no triangles");
 
   // Keep only vertices that some triangle uses (corners of dropped triangles may be left over).

@@ -211,6 +211,42 @@ TEST(MeshLoader, ZeroAreaTrianglesAreDroppedWithAWarning) {
   EXPECT_NE(warnings[0].find("2 zero-area triangles dropped"), std::string::npos) << warnings[0];
 }
 
+TEST(MeshLoader, RepeatedTrianglesAreDroppedWithAWarning) {
+  TempDir dir;
+  // The tetrahedron with one face written again as it is and once turned round: the same three vertices.
+  const std::string extra =
+      "facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0 1 0\nvertex 1 0 0\nendloop\nendfacet\n"
+      "facet normal 0 0 0\nouter loop\nvertex 1 0 0\nvertex 0 0 1\nvertex 0 1 0\nendloop\nendfacet\n";
+  std::vector<std::string> warnings;
+  const TriangleMesh m = loadMesh(dir.write("tet.stl", test::tetrahedronStl(extra)), Vec3::Ones(), &warnings);
+  EXPECT_EQ(m.triangles.size(), 4u);
+  EXPECT_TRUE(isClosed(m));
+  EXPECT_NEAR(signedVolume(m), 1.0 / 6.0, 1e-15);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("2 repeated triangles dropped"), std::string::npos) << warnings[0];
+
+  // A box instanced 2^12 times at one place (a few hundred bytes of nodes instancing each other twice)
+  // is one box.
+  std::string doubling = test::colladaBox({0, 0, 0}, {1, 1, 1}, "Z_UP");
+  std::string nodes = "<library_nodes>";
+  for (int k = 0; k < 12; ++k)
+    nodes += "<node id=\"d" + std::to_string(k) + "\"><instance_node url=\"#d" + std::to_string(k + 1) +
+             "\"/><instance_node url=\"#d" + std::to_string(k + 1) + "\"/></node>";
+  nodes += "<node id=\"d12\"><instance_geometry url=\"#g\"/></node></library_nodes>\n";
+  const std::string leaf = "<node id=\"n\"><instance_geometry url=\"#g\"/></node>";
+  const std::size_t at = doubling.find(leaf);
+  ASSERT_NE(at, std::string::npos);
+  doubling.replace(at, leaf.size(), "<node id=\"n\"><instance_node url=\"#d0\"/></node>");
+  doubling.insert(doubling.find("<library_visual_scenes>"), nodes);
+  warnings.clear();
+  const TriangleMesh stacked = loadMesh(dir.write("stacked.dae", doubling), Vec3::Ones(), &warnings);
+  EXPECT_EQ(stacked.triangles.size(), 12u);
+  EXPECT_NEAR(signedVolume(stacked), 1.0, 1e-12);
+  ASSERT_EQ(warnings.size(), 1u) << (warnings.empty() ? "" : warnings[0]);
+  EXPECT_NE(warnings[0].find(std::to_string(12 * 4095) + " repeated triangles dropped"), std::string::npos)
+      << warnings[0];
+}
+
 TEST(MeshLoader, OpenMeshIsReported) {
   TempDir dir;
   const std::string path = dir.write("open.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\n");

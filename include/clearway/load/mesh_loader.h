@@ -15,6 +15,9 @@ struct MeshOptions {
   /// COLLADA: rotate the mesh so that the file's `<up_axis>` becomes z. Off by default, to load meshes as
   /// ROS does (RViz, MoveIt): the coordinates as written, in the file's `<unit>`.
   bool honour_up_axis = false;
+  /// COLLADA: the most triangles a node's instances may expand to (each geometry counted once per path to
+  /// it), unless the file's geometries themselves hold more: a file past it is refused (LoadError).
+  std::uint64_t max_expanded_triangles = std::uint64_t{1} << 20;
 };
 
 /// Loads every mesh of a file (STL binary and ASCII, COLLADA and OBJ through assimp; PLY, ASCII or binary,
