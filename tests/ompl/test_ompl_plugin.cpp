@@ -196,6 +196,88 @@ TEST(OmplPlugin, MotionValidatorTakesTheShortWayAndReportsLastValid) {
   EXPECT_EQ(c.motion->counters().motions.load(), 4u);
 }
 
+// The validator remembers a thread's last 64 answers (OMPL's simplifier asks many segments again): an answer
+// given again equals the one a validator without that memory computes, a verdict alone never stands in for a
+// located contact, and an edit of the world forgets every answer.
+TEST(OmplPlugin, TheMotionValidatorRemembersItsLastAnswers) {
+  auto world = World::load(bundledScene());
+  const auto scene = world->current().scene;
+  auto si = std::make_shared<ob::SpaceInformation>(makeStateSpace(*scene));
+  const CollisionChecking c = setupCollisionChecking(si, world);
+  auto fresh_si = std::make_shared<ob::SpaceInformation>(makeStateSpace(*scene));
+  const CollisionChecking fresh = setupCollisionChecking(fresh_si, scene);  // asked each segment once
+  ompl::RNG::setSeed(11);
+  const ob::StateSamplerPtr sampler = si->allocStateSampler();
+  std::vector<ob::ScopedState<>> a, b;
+  for (int k = 0; k < 48; ++k) {
+    a.emplace_back(si->getStateSpace());
+    b.emplace_back(si->getStateSpace());
+    sampler->sampleUniform(a.back().get());
+    sampler->sampleUniform(b.back().get());
+  }
+  int colliding = 0;
+  for (int k = 0; k < 48; ++k) {
+    const bool locate = k % 2 == 0;
+    const MotionResult want = fresh.motion->check(a[k].get(), b[k].get(), locate);
+    const std::uint64_t kept = c.motion->counters().remembered.load();
+    const MotionResult first = c.motion->check(a[k].get(), b[k].get(), locate);
+    EXPECT_EQ(c.motion->counters().remembered.load(), kept) << "segment " << k;
+    const MotionResult again = c.motion->check(a[k].get(), b[k].get(), locate);
+    EXPECT_EQ(c.motion->counters().remembered.load(), kept + 1) << "segment " << k;
+    for (const MotionResult* got : {&first, &again}) {
+      ASSERT_EQ(got->free, want.free) << "segment " << k;
+      EXPECT_EQ(got->first_contact, want.first_contact) << "segment " << k;
+      EXPECT_EQ(got->last_valid, want.last_valid) << "segment " << k;
+      EXPECT_EQ(got->report.kind, want.report.kind) << "segment " << k;
+      EXPECT_EQ(got->report.link, want.report.link) << "segment " << k;
+    }
+    EXPECT_EQ(again.steps, 0) << "segment " << k;  // (no work for a remembered answer)
+    colliding += !want.free;
+  }
+  EXPECT_GT(colliding, 0);
+  EXPECT_LT(colliding, 48);
+  EXPECT_EQ(c.motion->counters().motions.load(), 96u);
+
+  // A colliding segment asked for its verdict alone, then for its first contact: computed again, and equal to
+  // the located answer of a validator that never saw it.
+  int k = 0;
+  while (k < 48 && fresh.motion->check(a[k].get(), b[k].get(), false).free) ++k;
+  ASSERT_LT(k, 48);
+  ob::ScopedState<> c0(si->getStateSpace()), c1(si->getStateSpace());
+  si->getStateSpace()->interpolate(a[k].get(), b[k].get(), 0.0, c0.get());  // (new states: not remembered yet)
+  si->copyState(c1.get(), b[k].get());
+  EXPECT_FALSE(c.motion->checkMotion(c0.get(), c1.get()));
+  const std::uint64_t kept = c.motion->counters().remembered.load();
+  std::pair<ob::State*, double> last(nullptr, -1.0);
+  EXPECT_FALSE(c.motion->checkMotion(c0.get(), c1.get(), last));
+  EXPECT_EQ(c.motion->counters().remembered.load(), kept);
+  EXPECT_EQ(last.second, fresh.motion->check(c0.get(), c1.get(), true).last_valid);
+  // Asked again for either, the located answer serves both.
+  EXPECT_FALSE(c.motion->checkMotion(c0.get(), c1.get()));
+  EXPECT_EQ(c.motion->counters().remembered.load(), kept + 1);
+
+  // A free segment, then an obstacle on it: the edited world's answer, not the one remembered.
+  int f = 0;
+  while (f < 48 && !fresh.motion->check(a[f].get(), b[f].get(), false).free) ++f;
+  ASSERT_LT(f, 48);
+  ASSERT_TRUE(c.motion->checkMotion(a[f].get(), b[f].get()));
+  std::vector<double> q(scene->dimension());
+  const StateMap map(*scene);
+  ob::ScopedState<> mid(si->getStateSpace());
+  si->getStateSpace()->interpolate(a[f].get(), b[f].get(), 0.5, mid.get());
+  map.toVector(mid.get(), q.data());
+  SceneContext ctx = scene->makeContext();
+  scene->computePoses(q.data(), ctx);
+  Obstacle ball;
+  ball.name = "ball";
+  ball.shape = Sphere(0.05);
+  ball.pose = Pose::translation(ctx.poses()[scene->robot().linkIndex("wrist_2_link")].t);
+  world->addObstacle(ball);
+  const std::uint64_t before_edit = c.motion->counters().remembered.load();
+  EXPECT_FALSE(c.motion->checkMotion(a[f].get(), b[f].get()));
+  EXPECT_EQ(c.motion->counters().remembered.load(), before_edit);
+}
+
 // Plans on the bundled scene with the given planner and checks the path independently: every segment
 // certified free, and dense samples along it valid.
 void planAndCertify(const std::function<ob::PlannerPtr(const ob::SpaceInformationPtr&)>& makePlanner,

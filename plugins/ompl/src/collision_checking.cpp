@@ -2,6 +2,8 @@
 
 #include <clearway/per_thread.h>
 
+#include "segment_memo.h"
+
 #include <ompl/base/spaces/RealVectorStateSpace.h>
 #include <ompl/base/spaces/SE2StateSpace.h>
 #include <ompl/base/spaces/SE3StateSpace.h>
@@ -29,6 +31,7 @@ struct MotionScratch {
   std::uint64_t version = 0;
   MotionContext ctx;
   std::vector<double> q0, q1;
+  SegmentMemo memo;  // this snapshot's last answers
 };
 
 }  // namespace ompl_detail
@@ -36,6 +39,7 @@ struct MotionScratch {
 namespace {
 
 using ompl_detail::MotionScratch;
+using ompl_detail::SegmentMemo;
 using ompl_detail::ValidityScratch;
 
 class Timer {
@@ -307,12 +311,21 @@ MotionResult ContinuousMotionValidator::check(const ob::State* s1, const ob::Sta
   MotionScratch& s = scratch_.get([] { return MotionScratch{}; });
   if (s.version != w.version) {
     const int n = w.scene->dimension();
-    s = MotionScratch{w.version, w.motion->makeContext(), std::vector<double>(n), std::vector<double>(n)};
+    s = MotionScratch{w.version, w.motion->makeContext(), std::vector<double>(n), std::vector<double>(n),
+                      SegmentMemo(n)};
   }
   map_.toVector(s1, s.q0.data());
   map_.toVector(s2, s.q1.data());
   map_.unwrap(s.q0.data(), s.q1.data());
-  return w.motion->check(s.q0.data(), s.q1.data(), s.ctx, locate_contact);
+  if (const MotionResult* kept = s.memo.find(s.q0.data(), s.q1.data(), locate_contact)) {
+    ++counters_.remembered;
+    MotionResult r = *kept;
+    r.steps = r.distance_queries = 0;  // (no work was done for this answer)
+    return r;
+  }
+  const MotionResult r = w.motion->check(s.q0.data(), s.q1.data(), s.ctx, locate_contact);
+  if (!r.capped) s.memo.keep(s.q0.data(), s.q1.data(), locate_contact, r);  // (a cap is no verdict to keep)
+  return r;
 }
 
 void ContinuousMotionValidator::count(bool free) const {

@@ -69,6 +69,9 @@ struct CheckerCounters {
   /// in those calls, summed over threads (ns).
   std::atomic<std::uint64_t> states{0}, motions{0}, nanoseconds{0};
   ///@}
+  /// Segments of `motions` answered from the thread's memo of its last 64: the same ends (bit for bit) on
+  /// the same snapshot of the world, as OMPL's path simplifier often asks again.
+  std::atomic<std::uint64_t> remembered{0};
 };
 
 /// ompl::base::StateValidityChecker over a Scene: isValid is Scene::isFree; clearance is
@@ -104,7 +107,9 @@ class ValidityChecker : public ompl::base::StateValidityChecker {
 /// ompl::base::MotionValidator that checks the whole segment (MotionMode::Certified: no tunnelling).
 /// checkMotion(s1, s2) asks for the verdict alone (the first contact found ends it); checkMotion(s1, s2,
 /// lastValid) locates the first contact, reports the fraction of the last valid state before it and
-/// writes that state when lastValid.first is given. Where the first says free, so does the second.
+/// writes that state when lastValid.first is given. Where the first says free, so does the second. Each
+/// thread remembers its last 64 answers: a segment asked again with the same ends on the same snapshot of
+/// the world gets the answer computed the first time, at once (counters().remembered).
 class ContinuousMotionValidator : public ompl::base::MotionValidator {
  public:
   /// The validator of one scene, checked with `options`. Throws std::invalid_argument when the scene has
