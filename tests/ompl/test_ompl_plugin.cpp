@@ -4,6 +4,7 @@
 #include <clearway/ompl/collision_checking.h>
 
 #include "load/robot_files.h"
+#include "ompl/obstacle_on_path.h"
 
 #include <ompl/base/spaces/RealVectorStateSpace.h>
 #include <ompl/base/spaces/SE2StateSpace.h>
@@ -237,6 +238,12 @@ TEST(OmplPlugin, TheMotionValidatorRemembersItsLastAnswers) {
   EXPECT_GT(colliding, 0);
   EXPECT_LT(colliding, 48);
   EXPECT_EQ(c.motion->counters().motions.load(), 96u);
+  // Not remembering (a benchmark timing the check itself), every answer is computed again.
+  c.motion->setRemembering(false);
+  const std::uint64_t kept_off = c.motion->counters().remembered.load();
+  EXPECT_GT(c.motion->check(a[0].get(), b[0].get(), true).steps, 0);
+  EXPECT_EQ(c.motion->counters().remembered.load(), kept_off);
+  c.motion->setRemembering(true);
 
   // A colliding segment asked for its verdict alone, then for its first contact: computed again, and equal to
   // the located answer of a validator that never saw it.
@@ -266,13 +273,7 @@ TEST(OmplPlugin, TheMotionValidatorRemembersItsLastAnswers) {
   ob::ScopedState<> mid(si->getStateSpace());
   si->getStateSpace()->interpolate(a[f].get(), b[f].get(), 0.5, mid.get());
   map.toVector(mid.get(), q.data());
-  SceneContext ctx = scene->makeContext();
-  scene->computePoses(q.data(), ctx);
-  Obstacle ball;
-  ball.name = "ball";
-  ball.shape = Sphere(0.05);
-  ball.pose = Pose::translation(ctx.poses()[scene->robot().linkIndex("wrist_2_link")].t);
-  world->addObstacle(ball);
+  world->addObstacle(test::ballAtLink(*scene, q, "wrist_2_link", 0.05));
   const std::uint64_t before_edit = c.motion->counters().remembered.load();
   EXPECT_FALSE(c.motion->checkMotion(a[f].get(), b[f].get()));
   EXPECT_EQ(c.motion->counters().remembered.load(), before_edit);
@@ -410,13 +411,7 @@ TEST(OmplPlugin, PlansAgainAfterAnEditWithoutNewSpaceInformation) {
   // A ball where the wrist is halfway along the first path.
   std::vector<double> q(scene->dimension());
   map.toVector(first.getState(first.getStateCount() / 2), q.data());
-  SceneContext ctx = scene->makeContext();
-  scene->computePoses(q.data(), ctx);
-  Obstacle ball;
-  ball.name = "ball";
-  ball.shape = Sphere(0.06);
-  ball.pose = Pose::translation(ctx.poses()[scene->robot().linkIndex("wrist_2_link")].t);
-  world->addObstacle(ball);
+  world->addObstacle(test::ballAtLink(*scene, q, "wrist_2_link", 0.06));
   EXPECT_FALSE(c.validity->isValid(first.getState(first.getStateCount() / 2)));
   bool first_blocked = false;
   for (std::size_t i = 0; i + 1 < first.getStateCount(); ++i)

@@ -4,6 +4,8 @@
 #include <clearway/motion/motion.h>
 #include <clearway/ompl/planning.h>
 
+#include "ompl/obstacle_on_path.h"
+
 #include <gtest/gtest.h>
 #include <ompl/util/Console.h>
 
@@ -157,12 +159,7 @@ TEST(Planning, PlansAroundAnObstacleOfAnEditedScene) {
   const std::size_t i = (first.stateCount() - 1) / 2;
   std::vector<double> mid(n);
   for (int k = 0; k < n; ++k) mid[k] = 0.5 * (first.path[i * n + k] + first.path[(i + 1) * n + k]);
-  SceneContext ctx = scene->makeContext();
-  scene->computePoses(mid.data(), ctx);
-  Obstacle ball;
-  ball.name = "ball";
-  ball.shape = Sphere(0.06);
-  ball.pose = Pose::translation(ctx.poses()[scene->robot().linkIndex("wrist_2_link")].t);
+  const Obstacle ball = test::ballAtLink(*scene, mid, "wrist_2_link", 0.06);
   const auto edited = scene->withEnvironment(std::make_shared<const Environment>(scene->environment().withObstacle(ball)));
   ASSERT_FALSE(edited->isFree(mid));
   const PlanResult second = plan(edited, request);

@@ -317,14 +317,15 @@ MotionResult ContinuousMotionValidator::check(const ob::State* s1, const ob::Sta
   map_.toVector(s1, s.q0.data());
   map_.toVector(s2, s.q1.data());
   map_.unwrap(s.q0.data(), s.q1.data());
-  if (const MotionResult* kept = s.memo.find(s.q0.data(), s.q1.data(), locate_contact)) {
+  const bool remembering = remembering_.load(std::memory_order_relaxed);
+  if (const MotionResult* kept = remembering ? s.memo.find(s.q0.data(), s.q1.data(), locate_contact) : nullptr) {
     ++counters_.remembered;
     MotionResult r = *kept;
     r.steps = r.distance_queries = 0;  // (no work was done for this answer)
     return r;
   }
   const MotionResult r = w.motion->check(s.q0.data(), s.q1.data(), s.ctx, locate_contact);
-  if (!r.capped) s.memo.keep(s.q0.data(), s.q1.data(), locate_contact, r);  // (a cap is no verdict to keep)
+  if (remembering && !r.capped) s.memo.keep(s.q0.data(), s.q1.data(), locate_contact, r);  // (a cap: no verdict)
   return r;
 }
 

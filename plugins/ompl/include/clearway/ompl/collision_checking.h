@@ -129,12 +129,16 @@ class ContinuousMotionValidator : public ompl::base::MotionValidator {
   const CheckerCounters& counters() const noexcept { return counters_; }
   /// The verdict on s1 → s2 with the contact (MotionChecker::check; locate_contact as there).
   MotionResult check(const ompl::base::State* s1, const ompl::base::State* s2, bool locate_contact = true) const;
+  /// Whether answers are remembered (on by default). Off, every call computes its answer: for timing the
+  /// check itself over segments asked more than once (a benchmark's passes), or counting its work.
+  void setRemembering(bool on) noexcept { remembering_ = on; }
 
  private:
   std::shared_ptr<World> world_;
   StateMap map_;
   PerThread<ompl_detail::MotionScratch> scratch_;  // each thread's context and state buffers
   mutable CheckerCounters counters_;
+  std::atomic<bool> remembering_{true};
   // OMPL's valid_ and invalid_ are plain integers that its benchmark tools read once planning is done;
   // parallel planners call checkMotion from several threads, so each update takes this lock.
   mutable std::mutex ompl_counters_;
