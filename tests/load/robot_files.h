@@ -56,14 +56,16 @@ inline std::string sharedRobot(const std::string& rel) { return sharedPath("robo
 /// Declares `var` = <shared>/robots/<rel>; a missing file skips the test, or fails it when CI=true.
 #define CLEARWAY_SHARED_ROBOT_OR_SKIP(var, rel) CLEARWAY_SHARED_OR_SKIP(var, "robots/" + std::string(rel))
 
-/// A closed unit-free tetrahedron as an ASCII STL (4 outward triangles).
+/// One facet of an ASCII STL with corners a, b, c (each "x y z").
+inline std::string stlFacet(const char* a, const char* b, const char* c) {
+  return std::string("facet normal 0 0 0\nouter loop\nvertex ") + a + "\nvertex " + b + "\nvertex " + c +
+         "\nendloop\nendfacet\n";
+}
+
+/// A closed unit-free tetrahedron as an ASCII STL (4 outward triangles), then extra_facets.
 inline std::string tetrahedronStl(const std::string& extra_facets = "") {
-  auto facet = [](const char* a, const char* b, const char* c) {
-    return std::string("facet normal 0 0 0\nouter loop\nvertex ") + a + "\nvertex " + b + "\nvertex " + c +
-           "\nendloop\nendfacet\n";
-  };
-  return "solid tet\n" + facet("0 0 0", "0 1 0", "1 0 0") + facet("0 0 0", "1 0 0", "0 0 1") +
-         facet("0 0 0", "0 0 1", "0 1 0") + facet("1 0 0", "0 1 0", "0 0 1") + extra_facets + "endsolid tet\n";
+  return "solid tet\n" + stlFacet("0 0 0", "0 1 0", "1 0 0") + stlFacet("0 0 0", "1 0 0", "0 0 1") +
+         stlFacet("0 0 0", "0 0 1", "0 1 0") + stlFacet("1 0 0", "0 1 0", "0 0 1") + extra_facets + "endsolid tet\n";
 }
 
 /// A COLLADA file holding one closed box [lo, hi] (outward triangles) in the file's coordinates, under a

@@ -199,9 +199,7 @@ TEST(MeshLoader, MeshesOfAFileAreMergedAndWeldedAcrossNodes) {
 TEST(MeshLoader, ZeroAreaTrianglesAreDroppedWithAWarning) {
   TempDir dir;
   // A closed tetrahedron plus a needle with two equal corners and a flat one with collinear corners.
-  const std::string extra =
-      "facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0 0 0\nvertex 1 0 0\nendloop\nendfacet\n"
-      "facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0.5 0 0\nvertex 1 0 0\nendloop\nendfacet\n";
+  const std::string extra = test::stlFacet("0 0 0", "0 0 0", "1 0 0") + test::stlFacet("0 0 0", "0.5 0 0", "1 0 0");
   std::vector<std::string> warnings;
   const TriangleMesh m = loadMesh(dir.write("tet.stl", test::tetrahedronStl(extra)), Vec3::Ones(), &warnings);
   EXPECT_EQ(m.triangles.size(), 4u);
@@ -214,9 +212,7 @@ TEST(MeshLoader, ZeroAreaTrianglesAreDroppedWithAWarning) {
 TEST(MeshLoader, RepeatedTrianglesAreDroppedWithAWarning) {
   TempDir dir;
   // The tetrahedron with one face written again as it is and once turned round: the same three vertices.
-  const std::string extra =
-      "facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0 1 0\nvertex 1 0 0\nendloop\nendfacet\n"
-      "facet normal 0 0 0\nouter loop\nvertex 1 0 0\nvertex 0 0 1\nvertex 0 1 0\nendloop\nendfacet\n";
+  const std::string extra = test::stlFacet("0 0 0", "0 1 0", "1 0 0") + test::stlFacet("1 0 0", "0 0 1", "0 1 0");
   std::vector<std::string> warnings;
   const TriangleMesh m = loadMesh(dir.write("tet.stl", test::tetrahedronStl(extra)), Vec3::Ones(), &warnings);
   EXPECT_EQ(m.triangles.size(), 4u);
