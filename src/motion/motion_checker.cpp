@@ -126,6 +126,16 @@ MotionChecker::MotionChecker(const MotionChecker& base, std::shared_ptr<const Sc
   for (const auto& o : scene_->environment().movingObstacles()) obstacle_speed_ = std::max(obstacle_speed_, o->velocity.norm());
 }
 
+MotionChecker::MotionChecker(const MotionChecker& base, MotionOptions options) : MotionChecker(base) {
+  const bool sampled = options.mode == MotionMode::Sampled, base_sampled = base.options_.mode == MotionMode::Sampled;
+  const bool tables = options.contact_distance != base.options_.contact_distance || sampled != base_sampled;
+  options_ = std::move(options);
+  validateOptions();
+  // (A context sized for base's mode, Cast's end poses, must not reach this one.)
+  serial_ = detail::nextSerial();
+  if (tables) buildItemTables();
+}
+
 void MotionChecker::validateOptions() const {
   if (!(options_.contact_distance > 0.0) || !std::isfinite(options_.contact_distance))
     throw std::invalid_argument("MotionChecker: contact_distance must be finite and > 0");

@@ -13,6 +13,13 @@ World::World(std::shared_ptr<const Scene> scene, MotionOptions motion) : motion_
   publish(std::move(scene), std::move(checker));
 }
 
+World::World(std::shared_ptr<const MotionChecker> motion) {
+  if (!motion) throw std::invalid_argument("World: null motion checker");
+  motion_options_ = motion->options();
+  std::shared_ptr<const Scene> scene = motion->scenePtr();
+  publish(std::move(scene), std::move(motion));
+}
+
 std::shared_ptr<World> World::load(const std::string& path, const SceneOptions& options, MotionOptions motion) {
   return std::make_shared<World>(Scene::load(path, options), motion);
 }

@@ -349,6 +349,57 @@ TEST(MotionCertified, AContextOfAnotherCheckerIsRefused) {
   EXPECT_TRUE(copy.check(q0, q1, own).free);
 }
 
+// A checker made from another with other options (plan() makes one per query, with its time limit) answers
+// as one built with those options: the same verdicts and the very same work, its pair tables built again
+// for another contact distance (a table built with the old one would skip a pair now within contact).
+TEST(MotionCertified, ACheckerWithOtherOptionsAnswersAsOneBuiltWithThem) {
+  const auto scene = Scene::load(test::sourceRobot("scenes/arm6_wall.yaml"));
+  const int n = scene->dimension();
+  std::mt19937 rng(23);
+  std::vector<std::vector<double>> q(121, std::vector<double>(n));
+  for (std::size_t k = 0; k < q.size(); ++k)
+    for (int i = 0; i < n; ++i)
+      q[k][i] = k == 0 ? 0.5 * (scene->lower(i) + scene->upper(i))
+                       : std::clamp(q[k - 1][i] + std::uniform_real_distribution<double>(-0.4, 0.4)(rng),
+                                    scene->lower(i), scene->upper(i));
+  MotionOptions wide, cast, sampled_options, one_query;
+  wide.contact_distance = 0.2;
+  cast.mode = MotionMode::Cast;
+  sampled_options.mode = MotionMode::Sampled;
+  sampled_options.resolution = 0.05;
+  one_query.max_queries = 1;
+  const MotionChecker base(scene);
+  const MotionChecker from_sampled(scene, sampled_options);
+  int differ = 0;  // segments checked at 20 cm otherwise than at 1 mm
+  for (const MotionOptions* o : {&wide, &cast, &sampled_options, &one_query}) {
+    for (const MotionChecker* b : {&base, &from_sampled}) {
+      const MotionChecker made(*b, *o), fresh(scene, *o);
+      MotionContext base_ctx = b->makeContext(), made_ctx = made.makeContext(), fresh_ctx = fresh.makeContext();
+      EXPECT_EQ(made.check(q[0].data(), q[1].data(), base_ctx).report.kind, CollisionReport::Kind::Invalid)
+          << "a context of the base fits the checker made from it";
+      for (std::size_t k = 0; k + 1 < q.size(); ++k)
+        for (const bool locate : {true, false}) {
+          const MotionResult a = made.check(q[k].data(), q[k + 1].data(), made_ctx, locate);
+          const MotionResult e = fresh.check(q[k].data(), q[k + 1].data(), fresh_ctx, locate);
+          ASSERT_EQ(a.free, e.free) << "segment " << k;
+          EXPECT_EQ(a.capped, e.capped) << "segment " << k;
+          EXPECT_EQ(a.first_contact, e.first_contact) << "segment " << k;
+          EXPECT_EQ(a.distance_queries, e.distance_queries) << "segment " << k;
+          EXPECT_EQ(a.steps, e.steps) << "segment " << k;
+          if (o == &wide && b == &base && locate) {
+            MotionContext ctx = base.makeContext();
+            const MotionResult narrow = base.check(q[k].data(), q[k + 1].data(), ctx);
+            differ += narrow.free != a.free || narrow.distance_queries != a.distance_queries;
+          }
+        }
+    }
+  }
+  EXPECT_GT(differ, 0) << "no segment tells 20 cm from 1 mm: the test cannot see the options";
+  MotionOptions bad;
+  bad.contact_distance = -1.0;
+  EXPECT_THROW(MotionChecker(base, bad), std::invalid_argument);
+}
+
 TEST(MotionCertified, ThreadsShareOneChecker) {
   TempDir dir;
   const auto scene = planarScene(

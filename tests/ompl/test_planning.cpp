@@ -112,7 +112,7 @@ TEST(Planning, BadRequestsNameTheField) {
   r = PlanRequest();
   r.goal = {0, 0, 0, 0, std::nan(""), 0};
   refused(r, "goal: ");
-  EXPECT_THROW(plan(nullptr, PlanRequest()), std::invalid_argument);
+  EXPECT_THROW(plan(std::shared_ptr<const Scene>(), PlanRequest()), std::invalid_argument);
   // A scene without a start needs one given.
   SceneDescription d = parseSceneFile(bundledScene());
   d.start.clear();
@@ -165,6 +165,43 @@ TEST(Planning, PlansAroundAnObstacleOfAnEditedScene) {
   const PlanResult second = plan(edited, request);
   expectCertified(edited, second, scene->description().start, scene->description().goal);
   EXPECT_NE(second.path, first.path);
+}
+
+// A checker built once plans as the scene does (the same path for the same seed: `clearway plan --runs` and
+// Python's plan reuse one), with its own options (its contact distance certifies the path); a Sampled
+// checker, which certifies nothing, is refused.
+TEST(Planning, ACheckerBuiltOncePlansAsItsScene) {
+  const auto scene = Scene::load(bundledScene());
+  PlanRequest request;
+  request.seed = 9;
+  request.time = 30;
+  const auto checker = std::make_shared<const MotionChecker>(scene);
+  const PlanResult first = plan(checker, request);
+  expectCertified(scene, first, scene->description().start, scene->description().goal);
+  EXPECT_EQ(first.path, plan(scene, request).path);
+  EXPECT_EQ(plan(checker, request).path, first.path);
+
+  MotionOptions wide;
+  wide.contact_distance = 0.05;
+  const auto wide_checker = std::make_shared<const MotionChecker>(scene, wide);
+  const PlanResult kept_off = plan(wide_checker, request);
+  ASSERT_TRUE(kept_off.solved()) << kept_off.message;
+  EXPECT_NE(kept_off.path, first.path) << "the contact distance of the checker given was not used";
+  const MotionChecker fresh(scene, wide);
+  MotionContext ctx = fresh.makeContext();
+  const int n = scene->dimension();
+  for (std::size_t i = 0; i + 1 < kept_off.stateCount(); ++i)
+    EXPECT_TRUE(fresh.check(&kept_off.path[i * n], &kept_off.path[(i + 1) * n], ctx).free) << "segment " << i;
+
+  MotionOptions sampled;
+  sampled.mode = MotionMode::Sampled;
+  try {
+    plan(std::make_shared<const MotionChecker>(scene, sampled), request);
+    ADD_FAILURE() << "a Sampled checker planned";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("checker"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(plan(std::shared_ptr<const MotionChecker>(), request), std::invalid_argument);
 }
 
 }  // namespace

@@ -166,6 +166,28 @@ TEST(WorldEdits, SharedPandaShelvesEditedAnswerAsAFreshScene) {
   }
 }
 
+// A world made from a built checker publishes that checker, and its edits keep the checker's options.
+TEST(WorldEdits, AWorldOfABuiltCheckerKeepsItsOptions) {
+  TempDir dir;
+  const std::shared_ptr<const Scene> scene = Scene::load(dir.write("w.yaml", armScene("", kWall)));
+  MotionOptions wide;
+  wide.contact_distance = 0.05;
+  const auto checker = std::make_shared<const MotionChecker>(scene, wide);
+  World world(checker);
+  EXPECT_EQ(world.current().motion, checker);
+  EXPECT_EQ(world.current().scene, scene);
+  EXPECT_EQ(world.version(), 1u);
+  Obstacle post;
+  post.name = "post";
+  post.shape = Cylinder(0.02, 1.0);
+  post.pose = Pose::translation(Vec3(-0.4, 0.0, 0.5));
+  world.addObstacle(post);
+  EXPECT_EQ(world.version(), 2u);
+  EXPECT_EQ(world.current().motion->options().contact_distance, 0.05);
+  EXPECT_EQ(world.current().scene->environment().obstacleCount(), scene->environment().obstacleCount() + 1);
+  EXPECT_THROW(World(std::shared_ptr<const MotionChecker>()), std::invalid_argument);
+}
+
 TEST(WorldEdits, OldSnapshotsStayWhole) {
   TempDir dir;
   auto world = World::load(dir.write("w.yaml", armScene("", kWall)));

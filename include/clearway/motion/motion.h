@@ -197,9 +197,16 @@ class MotionChecker {
   /// the same links checked against the environment, it shares base's merged bodies, bound and items, and
   /// only the obstacles' speed is read again; otherwise it is built as the constructor above builds it.
   MotionChecker(const MotionChecker& base, std::shared_ptr<const Scene> scene);
+  /// base's checker with other options: it shares base's merged bodies, bound and items (building those
+  /// costs up to a third of a second for a robot of large meshes), and builds its pair tables again only
+  /// for another contact distance or for Sampled mode against another. Throws std::invalid_argument for
+  /// options out of range. Contexts made by base do not fit it.
+  MotionChecker(const MotionChecker& base, MotionOptions options);
 
   /// The scene whose segments are checked.
   const Scene& scene() const noexcept { return *scene_; }
+  /// The same scene, shared.
+  const std::shared_ptr<const Scene>& scenePtr() const noexcept { return scene_; }
   /// The options the checker was built with.
   const MotionOptions& options() const noexcept { return options_; }
   /// The motion bound of the scene's group, with the merged bodies.

@@ -33,6 +33,9 @@ class World {
   /// The world of a built scene, with motions checked with `motion` options. Throws std::invalid_argument
   /// for options out of range (MotionChecker).
   explicit World(std::shared_ptr<const Scene> scene, MotionOptions motion = {});
+  /// The world of a built checker's scene, with motions checked by it (and by checkers made from it as
+  /// edits come: its options). Throws std::invalid_argument for a null checker.
+  explicit World(std::shared_ptr<const MotionChecker> motion);
   /// Scene::load + the constructor.
   static std::shared_ptr<World> load(const std::string& path, const SceneOptions& options = {},
                                      MotionOptions motion = {});

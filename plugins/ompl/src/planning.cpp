@@ -133,9 +133,16 @@ const char* toString(PlanStatus status) noexcept {
   return "?";
 }
 
-PlanResult plan(const std::shared_ptr<const Scene>& scene_ptr, const PlanRequest& request) {
-  if (!scene_ptr) throw std::invalid_argument("scene: none given");
-  const Scene& scene = *scene_ptr;
+PlanResult plan(const std::shared_ptr<const Scene>& scene, const PlanRequest& request) {
+  if (!scene) throw std::invalid_argument("scene: none given");
+  return plan(std::make_shared<const MotionChecker>(scene), request);
+}
+
+PlanResult plan(const std::shared_ptr<const MotionChecker>& checker, const PlanRequest& request) {
+  if (!checker) throw std::invalid_argument("checker: none given");
+  if (checker->options().mode == MotionMode::Sampled)
+    throw std::invalid_argument("checker: a Sampled checker cannot certify a path (Certified or Cast)");
+  const Scene& scene = checker->scene();
   const auto maker = std::find_if(planners().begin(), planners().end(),
                                   [&](const auto& p) { return p.first == request.planner; });
   if (maker == planners().end()) {
@@ -177,15 +184,18 @@ PlanResult plan(const std::shared_ptr<const Scene>& scene_ptr, const PlanRequest
   // and the final check.
   const auto deadline = std::make_shared<std::atomic<std::chrono::steady_clock::rep>>(
       std::numeric_limits<std::chrono::steady_clock::rep>::max());
-  MotionOptions motion_options;
-  motion_options.stop = [deadline] {
-    return std::chrono::steady_clock::now().time_since_epoch().count() > deadline->load(std::memory_order_relaxed);
+  MotionOptions motion_options = checker->options();
+  motion_options.stop = [deadline, also = checker->options().stop] {
+    return std::chrono::steady_clock::now().time_since_epoch().count() > deadline->load(std::memory_order_relaxed) ||
+           (also && also());
   };
   CollisionChecking checking;
   try {
     space = makeStateSpace(scene);
     setup = std::make_unique<og::SimpleSetup>(space);
-    checking = setupCollisionChecking(setup->getSpaceInformation(), scene_ptr, motion_options);
+    checking = setupCollisionChecking(
+        setup->getSpaceInformation(),
+        std::make_shared<World>(std::make_shared<const MotionChecker>(*checker, motion_options)));
   } catch (const std::invalid_argument&) {
     throw;
   } catch (const std::exception& e) {  // (ompl::Exception: a scene OMPL cannot plan in)

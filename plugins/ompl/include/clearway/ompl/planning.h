@@ -4,6 +4,7 @@
 // simplified and then checked again segment by segment with the certified check, so that a path
 // returned as certified is one. The tool and the Python module call this one function, so the same seed
 // gives them the same path.
+#include <clearway/motion/motion.h>
 #include <clearway/scene/scene.h>
 
 #include <cstdint>
@@ -81,5 +82,10 @@ const char* toString(PlanStatus status) noexcept;
 /// unseeded queries run side by side), so with a single-threaded planner the same seed gives the same
 /// path on every call. Thread-safe.
 PlanResult plan(const std::shared_ptr<const Scene>& scene, const PlanRequest& request);
+/// The same on checker's scene, its segments checked as checker checks them (its options; its stop
+/// condition, if any, is asked beside the time limit): a checker built once serves every query, where the
+/// overload above builds one per query (up to a third of a second for a robot of large meshes). Throws
+/// as the overload above, and for a Sampled checker (it certifies nothing).
+PlanResult plan(const std::shared_ptr<const MotionChecker>& checker, const PlanRequest& request);
 
 }  // namespace clearway
