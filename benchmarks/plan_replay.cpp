@@ -1,10 +1,11 @@
 // bench_plan_replay: where a planner's time goes, and what each checker costs on the very motions a planner
 // asks for. RRTConnect plans each problem with Clearway's validity checker and certified motion validator
-// (seeds 1..N); its solve time is split into motion checks, state checks and the rest (OMPL's own work, the
-// same for every checker). Every motion it asked for is then replayed, free and colliding ones apart:
-// certified (the verdict only, as planners ask), and OMPL's DiscreteMotionValidator at its default 1%
-// resolution over Clearway's state check and over FCL's (FclValidity). Ratios of one process's times;
-// the state and query counts do not depend on the machine.
+// (seeds 1..N), and OMPL's simplifySolution shortens each path; the time of each phase is split into
+// motion checks, state checks and the rest (OMPL's own work, the same for every checker). Every motion
+// either phase asked for is then replayed, by phase, free and colliding ones apart: certified (the verdict
+// only, as planners ask), and OMPL's DiscreteMotionValidator at its default 1% resolution over Clearway's
+// state check and over FCL's (FclValidity). Ratios of one process's times; the state and query counts do
+// not depend on the machine.
 //
 //   bench_plan_replay SEEDS SCENE.yaml...
 #include "fcl_ompl.h"
@@ -41,27 +42,33 @@ double microseconds(Clock::time_point since) {
   return std::chrono::duration<double, std::micro>(Clock::now() - since).count();
 }
 
+// The phases of a planning query: the planner's solve, then the simplification of its path.
+constexpr int kPhases = 2;
+const char* const kPhaseName[kPhases] = {"solve", "simplify"};
+
 struct Segment {
   std::vector<double> from, to;
+  int phase = 0;
 };
 
 // Times the inner motion validator and keeps every segment it is asked about.
 class Recorder : public ob::MotionValidator {
  public:
   Recorder(const ob::SpaceInformationPtr& si, ob::MotionValidatorPtr inner, const StateMap& map,
-           std::vector<Segment>& out, double& us)
-      : ob::MotionValidator(si), inner_(std::move(inner)), map_(map), out_(out), us_(us) {}
+           std::vector<Segment>& out, double* us, const int& phase)
+      : ob::MotionValidator(si), inner_(std::move(inner)), map_(map), out_(out), us_(us), phase_(phase) {}
   bool checkMotion(const ob::State* a, const ob::State* b) const override {
-    Segment s{std::vector<double>(map_.dimension()), std::vector<double>(map_.dimension())};
+    Segment s{std::vector<double>(map_.dimension()), std::vector<double>(map_.dimension()), phase_};
     map_.toVector(a, s.from.data());
     map_.toVector(b, s.to.data());
     map_.unwrap(s.from.data(), s.to.data());
     out_.push_back(std::move(s));
     const Clock::time_point t = Clock::now();
     const bool free = inner_->checkMotion(a, b);
-    us_ += microseconds(t);
+    us_[phase_] += microseconds(t);
     return free;
   }
+  // (Neither RRTConnect nor the simplifier asks for the last valid state: not recorded.)
   bool checkMotion(const ob::State* a, const ob::State* b, std::pair<ob::State*, double>& last) const override {
     return inner_->checkMotion(a, b, last);
   }
@@ -70,7 +77,8 @@ class Recorder : public ob::MotionValidator {
   ob::MotionValidatorPtr inner_;
   const StateMap& map_;
   std::vector<Segment>& out_;
-  double& us_;
+  double* us_;        // per phase
+  const int& phase_;  // the phase running
 };
 
 // Times and counts the inner validity checker's calls.
@@ -116,8 +124,8 @@ void replay(const std::string& file, int seeds) {
     throw std::invalid_argument(file + ": the scene needs a start and a goal of " + std::to_string(dimension) + " values");
   const StateMap map(*scene);
   std::vector<Segment> segments;
-  double solve_us = 0.0, motion_us = 0.0, state_us = 0.0;
-  int solved = 0;
+  double phase_us[kPhases] = {}, motion_us[kPhases] = {}, state_us[kPhases] = {};
+  int solved = 0, phase = 0;
   for (int seed = 1; seed <= seeds; ++seed) {
     ompl::RNG::setSeed(seed);
     og::SimpleSetup setup(clearway::makeStateSpace(*scene));
@@ -125,18 +133,27 @@ void replay(const std::string& file, int seeds) {
     const clearway::CollisionChecking cc = clearway::setupCollisionChecking(si, scene);
     auto counter = std::make_shared<Counter>(si, cc.validity);
     si->setStateValidityChecker(counter);
-    si->setMotionValidator(std::make_shared<Recorder>(si, cc.motion, map, segments, motion_us));
+    si->setMotionValidator(std::make_shared<Recorder>(si, cc.motion, map, segments, motion_us, phase));
     ob::ScopedState<> start(setup.getStateSpace()), goal(setup.getStateSpace());
     map.fromVector(d.start.data(), start.get());
     map.fromVector(d.goal.data(), goal.get());
     setup.setStartAndGoalStates(start, goal);
     setup.setPlanner(std::make_shared<og::RRTConnect>(si));
     setup.setup();
-    const Clock::time_point t = Clock::now();
+    phase = 0;
+    Clock::time_point t = Clock::now();
     // (A condition without a checking thread: SimpleSetup::solve(seconds) starts one, about a millisecond.)
-    solved += setup.solve(ob::timedPlannerTerminationCondition(30.0)) == ob::PlannerStatus::EXACT_SOLUTION;
-    solve_us += microseconds(t);
-    state_us += counter->us;
+    const bool exact = setup.solve(ob::timedPlannerTerminationCondition(30.0)) == ob::PlannerStatus::EXACT_SOLUTION;
+    phase_us[0] += microseconds(t);
+    state_us[0] += counter->us;
+    solved += exact;
+    if (!exact) continue;
+    phase = 1;
+    const double states_before = counter->us;
+    t = Clock::now();
+    setup.simplifySolution();
+    phase_us[1] += microseconds(t);
+    state_us[1] += counter->us - states_before;
   }
   // The replay: [free][kind] with kind 0 certified, 1 sampled over Clearway, 2 sampled over FCL. One checker
   // over all the segments at a time: interleaved per segment, each would evict the others' data.
@@ -147,17 +164,18 @@ void replay(const std::string& file, int seeds) {
   scene->environment().prepareClearanceGrid();
   Sampled ours(*scene, [&](const ob::SpaceInformationPtr& si) { return std::make_shared<clearway::ValidityChecker>(si, scene); });
   Sampled fcl(*scene, [&](const ob::SpaceInformationPtr& si) { return std::make_shared<clearway::bench::FclValidity>(si, scene); });
-  double us[2][3] = {}, queries[2] = {}, states[2] = {};
-  long count[2] = {};
+  // [phase][free][kind]
+  double us[kPhases][2][3] = {}, queries[kPhases][2] = {}, states[kPhases][2] = {};
+  long count[kPhases][2] = {};
   std::vector<int> is_free(segments.size());
   for (std::size_t i = 0; i < segments.size(); ++i) {
     const Clock::time_point t = Clock::now();
     const clearway::MotionResult r = certified.check(segments[i].from.data(), segments[i].to.data(), context, false);
     const double spent = microseconds(t);
-    const int f = is_free[i] = r.free ? 1 : 0;
-    ++count[f];
-    us[f][0] += spent;
-    queries[f] += r.distance_queries;
+    const int f = is_free[i] = r.free ? 1 : 0, p = segments[i].phase;
+    ++count[p][f];
+    us[p][f][0] += spent;
+    queries[p][f] += r.distance_queries;
   }
   ob::ScopedState<> a(ours.setup.getStateSpace()), b(ours.setup.getStateSpace());
   for (int kind = 1; kind <= 2; ++kind) {
@@ -168,28 +186,41 @@ void replay(const std::string& file, int seeds) {
       const long before = sampled.counter->calls;
       const Clock::time_point t = Clock::now();
       sampled.motion->checkMotion(a.get(), b.get());
-      us[is_free[i]][kind] += microseconds(t);
-      if (kind == 1) states[is_free[i]] += static_cast<double>(sampled.counter->calls - before);
+      const int p = segments[i].phase;
+      us[p][is_free[i]][kind] += microseconds(t);
+      if (kind == 1) states[p][is_free[i]] += static_cast<double>(sampled.counter->calls - before);
     }
   }
-  std::printf("%s: %d runs (%d solved), solve %.0f us per run: motion checks %.0f%%, state checks %.0f%%, the rest %.0f%%\n",
-              scene->name().c_str(), seeds, solved, solve_us / seeds, 100.0 * motion_us / solve_us,
-              100.0 * state_us / solve_us, 100.0 * (solve_us - motion_us - state_us) / solve_us);
-  for (int f = 1; f >= 0; --f) {
-    const double n = static_cast<double>(std::max(1L, count[f]));
-    std::printf("  %-9s %6ld motions: certified %6.1f us (%.1f queries) | 1%% sampled: %.1f states, over Clearway %6.1f us, "
-                "over FCL %7.1f us | FCL/certified %.2f\n",
-                f ? "free" : "colliding", count[f], us[f][0] / n, queries[f] / n, states[f] / n, us[f][1] / n,
-                us[f][2] / n, us[f][2] / std::max(1e-9, us[f][0]));
+  std::printf("%s: %d runs (%d solved)\n", scene->name().c_str(), seeds, solved);
+  // Planning over FCL, estimated per phase: its motion checks at the replays' ratio to the certified ones,
+  // its state checks at the sampled replays' ratio (FCL's state check to ours), the same rest. (The
+  // Recorder's copies count as the rest: well under 1%. The certified validator answers a segment asked
+  // again from its memory, which the replay does not: the ratio is of computed answers.)
+  double estimated[kPhases] = {};
+  for (int p = 0; p < kPhases; ++p) {
+    const double total = phase_us[p];
+    std::printf("  %-8s %8.0f us per run: motion checks %.0f%%, state checks %.0f%%, the rest %.0f%%\n", kPhaseName[p],
+                total / seeds, 100.0 * motion_us[p] / std::max(1e-9, total),
+                100.0 * state_us[p] / std::max(1e-9, total),
+                100.0 * (total - motion_us[p] - state_us[p]) / std::max(1e-9, total));
+    for (int f = 1; f >= 0; --f) {
+      const double n = static_cast<double>(std::max(1L, count[p][f]));
+      std::printf(
+          "    %-9s %6ld motions: certified %6.1f us (%.1f queries) | 1%% sampled: %.1f states, over Clearway "
+          "%6.1f us, over FCL %7.1f us | FCL/certified %.2f\n",
+          f ? "free" : "colliding", count[p][f], us[p][f][0] / n, queries[p][f] / n, states[p][f] / n, us[p][f][1] / n,
+          us[p][f][2] / n, us[p][f][2] / std::max(1e-9, us[p][f][0]));
+    }
+    const double certified_all = us[p][0][0] + us[p][1][0], fcl_all = us[p][0][2] + us[p][1][2],
+                 ours_all = us[p][0][1] + us[p][1][1];
+    const double motion_ratio = fcl_all / std::max(1e-9, certified_all),
+                 state_ratio = fcl_all / std::max(1e-9, ours_all);
+    estimated[p] = motion_ratio * motion_us[p] + state_ratio * state_us[p] + (total - motion_us[p] - state_us[p]);
+    std::printf("    all motions: FCL/certified %.2f; %s over FCL, estimated: %.2f\n", motion_ratio, kPhaseName[p],
+                estimated[p] / std::max(1e-9, total));
   }
-  // Planning over FCL, estimated from this solve: its motion checks at the replays' ratio to the certified
-  // ones, its state checks at the sampled replays' ratio (FCL's state check to ours), the same rest. (The
-  // Recorder's copies count as the rest: well under 1%.)
-  const double certified_all = us[0][0] + us[1][0], fcl_all = us[0][2] + us[1][2], ours_all = us[0][1] + us[1][1];
-  const double motion_ratio = fcl_all / std::max(1e-9, certified_all), state_ratio = fcl_all / std::max(1e-9, ours_all);
-  const double rest = solve_us - motion_us - state_us;
-  std::printf("  all motions: FCL/certified %.2f; planning, estimated: %.2f\n", motion_ratio,
-              (motion_ratio * motion_us + state_ratio * state_us + rest) / std::max(1e-9, solve_us));
+  std::printf("  end to end (solve and simplify), over FCL, estimated: %.2f\n",
+              (estimated[0] + estimated[1]) / std::max(1e-9, phase_us[0] + phase_us[1]));
 }
 
 }  // namespace
