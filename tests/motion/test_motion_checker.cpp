@@ -349,19 +349,26 @@ TEST(MotionCertified, AContextOfAnotherCheckerIsRefused) {
   EXPECT_TRUE(copy.check(q0, q1, own).free);
 }
 
+// A random walk of `count` states in 0.4 rad steps from the middle of the limits: on arm6_wall, some
+// segments free, some meeting the wall or the arm itself.
+std::vector<std::vector<double>> randomWalk(const Scene& scene, std::size_t count, unsigned seed) {
+  std::mt19937 rng(seed);
+  const int n = scene.dimension();
+  std::vector<std::vector<double>> q(count, std::vector<double>(n));
+  for (std::size_t k = 0; k < q.size(); ++k)
+    for (int i = 0; i < n; ++i)
+      q[k][i] = k == 0 ? 0.5 * (scene.lower(i) + scene.upper(i))
+                       : std::clamp(q[k - 1][i] + std::uniform_real_distribution<double>(-0.4, 0.4)(rng),
+                                    scene.lower(i), scene.upper(i));
+  return q;
+}
+
 // A checker made from another with other options (plan() makes one per query, with its time limit) answers
 // as one built with those options: the same verdicts and the very same work, its pair tables built again
 // for another contact distance (a table built with the old one would skip a pair now within contact).
 TEST(MotionCertified, ACheckerWithOtherOptionsAnswersAsOneBuiltWithThem) {
   const auto scene = Scene::load(test::sourceRobot("scenes/arm6_wall.yaml"));
-  const int n = scene->dimension();
-  std::mt19937 rng(23);
-  std::vector<std::vector<double>> q(121, std::vector<double>(n));
-  for (std::size_t k = 0; k < q.size(); ++k)
-    for (int i = 0; i < n; ++i)
-      q[k][i] = k == 0 ? 0.5 * (scene->lower(i) + scene->upper(i))
-                       : std::clamp(q[k - 1][i] + std::uniform_real_distribution<double>(-0.4, 0.4)(rng),
-                                    scene->lower(i), scene->upper(i));
+  const std::vector<std::vector<double>> q = randomWalk(*scene, 121, 23);
   MotionOptions wide, cast, sampled_options, one_query;
   wide.contact_distance = 0.2;
   cast.mode = MotionMode::Cast;
@@ -428,15 +435,7 @@ TEST(MotionCertified, VerdictDependsOnlyOnTheSegment) {
   // segments that pass within the contact distance. Free segments take the very same queries.
   const auto scene = Scene::load(test::sourceRobot("scenes/arm6_wall.yaml"));
   const MotionChecker certified(scene);
-  const int n = scene->dimension();
-  std::mt19937 rng(17);
-  // A random walk of 0.4 rad steps: some segments free, some meeting the wall or the arm itself.
-  std::vector<std::vector<double>> q(201, std::vector<double>(n));
-  for (std::size_t k = 0; k < q.size(); ++k)
-    for (int i = 0; i < n; ++i)
-      q[k][i] = k == 0 ? 0.5 * (scene->lower(i) + scene->upper(i))
-                       : std::clamp(q[k - 1][i] + std::uniform_real_distribution<double>(-0.4, 0.4)(rng), scene->lower(i),
-                                    scene->upper(i));
+  const std::vector<std::vector<double>> q = randomWalk(*scene, 201, 17);
   MotionContext forward = certified.makeContext(), backward = certified.makeContext();
   std::vector<MotionResult> a(200), b(200);
   for (int k = 0; k < 200; ++k) a[k] = certified.check(q[k].data(), q[k + 1].data(), forward);

@@ -199,8 +199,8 @@ class MotionChecker {
   MotionChecker(const MotionChecker& base, std::shared_ptr<const Scene> scene);
   /// base's checker with other options: it shares base's merged bodies, bound and items (building those
   /// costs up to a third of a second for a robot of large meshes), and builds its pair tables again only
-  /// for another contact distance or for Sampled mode against another. Throws std::invalid_argument for
-  /// options out of range. Contexts made by base do not fit it.
+  /// for another contact distance, or where one of the two modes is Sampled and the other is not. Throws
+  /// std::invalid_argument for options out of range. Contexts made by base do not fit it.
   MotionChecker(const MotionChecker& base, MotionOptions options);
 
   /// The scene whose segments are checked.
