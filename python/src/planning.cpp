@@ -143,8 +143,9 @@ void bindPlanning(py::module_& m) {
       "a PlanResult (.solved, .path as (N, dof), timings, counts); an unsolved query is a PlanResult too. time: "
       "seconds the planner may take, in (0, 1e6]. seed: with a single-threaded planner, the same seed gives the same "
       "path here and from `clearway plan --seed`; None continues OMPL's sequence. start, goal: (dof,) states "
-      "(default: the scene file's). Runs with the GIL released. ValueError for an unknown planner, a bad time or "
-      "seed, or an invalid start or goal.");
+      "(default: the scene file's). The scene keeps the motion checker its first plan builds (the robot's setup, up "
+      "to a third of a second), so later plans on it cost only the query. Runs with the GIL released. ValueError for "
+      "an unknown planner, a bad time or seed, or an invalid start or goal.");
 }
 
 }  // namespace clearway::python
