@@ -1,9 +1,15 @@
 // Cores: balls certainly inside a link's solids. Two bodies whose cores overlap share interior points, so
 // they collide at any padding: one distance comparison decides what the exact triangles would spend many
-// box and triangle tests on (deeply interpenetrating links, a link deep in an obstacle). A mesh core's
-// centre is inside the solids (not in a cavity) along three ray directions that all decide, and its radius
-// stays below the centre's distance to every triangle of the link, so the ball crosses no surface: being
-// connected, it lies inside. Primitives are solids, and their cores are inscribed balls.
+// box and triangle tests on (interpenetrating links, a link in an obstacle). A mesh core's centre is inside
+// the solids (not in a cavity) along three ray directions that all decide, and its radius stays below the
+// centre's distance to every triangle of the link, so the ball crosses no surface: being connected, it
+// lies inside. Primitives are solids, and their cores are inscribed balls.
+//
+// Which balls: first the largest few (a hill climb from a coarse grid), which settle deep contacts and let
+// a pair table call whole cells colliding; then balls that hug the surface, chosen greedily from a finer
+// grid so that as many points of the surface as possible lie within a small reach of one: a shallow
+// contact is settled once a core of each body reaches into the other. Which balls are chosen changes how
+// many contacts they settle, never whether a settled one is real.
 #include <clearway/body/link_geometry.h>
 
 #include <clearway/detail/margins.h>
@@ -23,6 +29,17 @@ constexpr int kClimbSteps = 6;
 // only while it is at least kSmallest of the largest core: tiny balls cost a comparison and decide little.
 constexpr double kNewReach = 0.5;
 constexpr double kSmallest = 0.1;
+// The largest cores are at most this many; the surface's fill the rest, up to kMaxCores.
+constexpr int kLargest = 8;
+// The surface's: candidate centres per link (a grid over its closed pieces' boxes), points of the surface
+// that the choice tries to reach (spaced kSampleSpacing of the link's bounding ball apart, at most
+// kMaxSamples of them), and how near a core must come to a point to reach it (a share of the bounding ball).
+constexpr double kSurfaceCandidates = 1000;
+constexpr double kSampleSpacing = 0.05;
+constexpr std::size_t kMaxSamples = 2000;
+constexpr double kReach = 0.03;
+// A surface core is chosen only while it reaches at least this many points no chosen core reaches.
+constexpr int kMinGain = 2;
 
 // The distance from p to segment ab, given a − p and b − p (a point-sized segment: the distance to a).
 double segmentDistance(const Vec3& a, const Vec3& b) noexcept {
@@ -121,7 +138,7 @@ void LinkGeometry::findCores() {
         }
     std::sort(mine.begin(), mine.end(), [](const Ball& x, const Ball& y) { return x.radius > y.radius; });
     // The best few climb (as many as the piece's share of the link allows, up to twice the cores kept).
-    const std::size_t climbers = std::clamp(static_cast<int>(2 * kMaxCores * share) + 1, 1, 2 * kMaxCores);
+    const std::size_t climbers = std::clamp(static_cast<int>(2 * kLargest * share) + 1, 1, 2 * kLargest);
     if (mine.size() > climbers) mine.resize(climbers);
     // Climb: move each centre along the axes while its clearance grows (a bounded number of halvings).
     for (Ball& b : mine) {
@@ -145,23 +162,151 @@ void LinkGeometry::findCores() {
   std::sort(candidates.begin(), candidates.end(), [](const Ball& x, const Ball& y) { return x.radius > y.radius; });
   for (const Ball& c : candidates) {
     if (!(c.radius > 0.0) || !c.center.allFinite()) continue;
-    if (static_cast<int>(cores_.size()) == kMaxCores) break;
+    if (static_cast<int>(cores_.size()) == kLargest) break;
     if (!cores_.empty() && c.radius < kSmallest * cores_.front().radius) break;
     const bool adds = std::all_of(cores_.begin(), cores_.end(), [&](const Ball& k) {
       return (c.center - k.center).norm() + kNewReach * c.radius > k.radius;
     });
     if (adds) cores_.push_back(c);
   }
+  addSurfaceCores(m);
+  groupCores();
+}
+
+void LinkGeometry::groupCores() {
+  // Halved at the median of the longest side of their centres' box until at most 8 remain: neighbours
+  // share a group, so a test of the group's ball skips the cores far from where two bodies meet.
+  constexpr int kGroup = 8;
+  std::vector<std::pair<int, int>> todo{{0, static_cast<int>(cores_.size())}};
+  while (!todo.empty()) {
+    const auto [first, count] = todo.back();
+    todo.pop_back();
+    if (count == 0) continue;
+    Aabb box;
+    for (int i = first; i < first + count; ++i) box.grow(cores_[i].center);
+    if (count > kGroup) {
+      int axis = 0;
+      box.extents().maxCoeff(&axis);
+      const auto begin = cores_.begin() + first;
+      std::nth_element(begin, begin + count / 2, begin + count,
+                       [axis](const Ball& x, const Ball& y) { return x.center[axis] < y.center[axis]; });
+      todo.emplace_back(first, count / 2);
+      todo.emplace_back(first + count / 2, count - count / 2);
+      continue;
+    }
+    // (The group's ball only skips tests: its rounding can cost a proof, never make one.)
+    CoreGroup g{box.center(), 0.0, first, count};
+    for (int i = first; i < first + count; ++i)
+      g.radius = std::max(g.radius, (cores_[i].center - g.center).norm() + cores_[i].radius);
+    core_groups_.push_back(g);
+  }
+  std::sort(core_groups_.begin(), core_groups_.end(),
+            [](const CoreGroup& x, const CoreGroup& y) { return x.first < y.first; });
+}
+
+void LinkGeometry::addSurfaceCores(double m) {
+  if (solid_boxes_.empty() || triangles_.empty()) return;
+  // Only where every reading of "inside" agrees: shells nested as one solid (the winding number decides),
+  // or shells wound outward whose boxes are apart. A finer grid finds the places where the readings part
+  // (on the shared UR5's inner_finger_fine.STL, two inward-wound shells whose rays read inside have winding
+  // number 0), and a core must hold in every reading.
+  const bool outward = std::all_of(solid_sign_.begin(), solid_sign_.end(), [](std::int8_t s) { return s > 0; });
+  bool apart = true;
+  for (std::size_t i = 0; i < solid_boxes_.size() && apart; ++i)
+    for (std::size_t j = i + 1; j < solid_boxes_.size() && apart; ++j)
+      apart = !overlaps(solid_boxes_[i], solid_boxes_[j]);
+  if (!nested_ && !(outward && apart)) return;
+  // The candidates: a grid over each closed piece's box, as fine as its share of the link's volume allows.
+  double volume = 0.0;
+  for (const Aabb& box : solid_boxes_) volume += box.extents().prod();
+  std::vector<Ball> candidates;
+  for (const Aabb& box : solid_boxes_) {
+    const Vec3 e = box.extents();
+    const double share = volume > 0.0 ? e.prod() / volume : 1.0;
+    const double spacing = std::cbrt(std::max(e.prod(), 1e-300) / std::max(1.0, kSurfaceCandidates * share));
+    int n[3];
+    for (int a = 0; a < 3; ++a) n[a] = std::clamp(static_cast<int>(std::ceil(e[a] / spacing)), 1, 64);
+    for (int i = 0; i < n[0]; ++i)
+      for (int j = 0; j < n[1]; ++j)
+        for (int k = 0; k < n[2]; ++k) {
+          const Vec3 f((i + 0.5) / n[0], (j + 0.5) / n[1], (k + 0.5) / n[2]);
+          const Vec3 p = box.min + f.cwiseProduct(e);
+          if (!surelyInside(p)) continue;
+          // (The cutoff caps deep centres' balls, which stay inside: the distance answered is at most the true one.)
+          const double r = surfaceDistance(p, 4.0 * spacing) - m;
+          if (r > 0.0 && p.allFinite()) candidates.push_back({p, r});
+        }
+  }
+  // The points to reach: on every triangle, a grid of about kSampleSpacing (then thinned to kMaxSamples).
+  const double spacing = kSampleSpacing * sphere_radius_;
+  std::vector<Vec3> samples;
+  for (const Triangle& t : triangles_) {
+    const double edge = std::max({(t.v[1] - t.v[0]).norm(), (t.v[2] - t.v[1]).norm(), (t.v[0] - t.v[2]).norm()});
+    const int steps = std::clamp(static_cast<int>(std::ceil(edge / spacing)), 1, 16);
+    for (int a = 0; a <= steps; ++a)
+      for (int b = 0; a + b <= steps; ++b)
+        samples.push_back(t.v[0] + (t.v[1] - t.v[0]) * (double(a) / steps) + (t.v[2] - t.v[0]) * (double(b) / steps));
+  }
+  if (samples.size() > kMaxSamples) {
+    const std::size_t stride = (samples.size() + kMaxSamples - 1) / kMaxSamples;
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < samples.size(); i += stride) samples[kept++] = samples[i];
+    samples.resize(kept);
+  }
+  const double reach = kReach * sphere_radius_;
+  const auto reaches = [&](const Ball& b, const Vec3& p) { return (p - b.center).norm() <= b.radius + reach; };
+  std::vector<char> reached(samples.size(), 0);
+  for (const Ball& c : cores_)
+    for (std::size_t i = 0; i < samples.size(); ++i) reached[i] |= reaches(c, samples[i]);
+  const auto gain = [&](const Ball& b) {
+    int g = 0;
+    for (std::size_t i = 0; i < samples.size(); ++i) g += !reached[i] && reaches(b, samples[i]);
+    return g;
+  };
+  // Greedy, lazily: a candidate's gain only falls as cores are chosen, so one whose recomputed gain still
+  // tops the others' last known gains is the best.
+  std::vector<std::pair<int, int>> heap;  // (gain when last computed, candidate)
+  for (std::size_t c = 0; c < candidates.size(); ++c) heap.emplace_back(gain(candidates[c]), static_cast<int>(c));
+  std::make_heap(heap.begin(), heap.end());
+  while (static_cast<int>(cores_.size()) < kMaxCores && !heap.empty() && heap.front().first >= kMinGain) {
+    std::pop_heap(heap.begin(), heap.end());
+    const int c = heap.back().second;
+    heap.pop_back();
+    const int now = gain(candidates[c]);
+    if (!heap.empty() && now < heap.front().first) {
+      heap.emplace_back(now, c);
+      std::push_heap(heap.begin(), heap.end());
+      continue;
+    }
+    if (now < kMinGain) break;
+    cores_.push_back(candidates[c]);
+    for (std::size_t i = 0; i < samples.size(); ++i) reached[i] |= reaches(candidates[c], samples[i]);
+  }
 }
 
 bool coresOverlap(const LinkGeometry& a, const LinkGeometry& b, const Pose& b_in_a) noexcept {
   if (a.cores().empty() || b.cores().empty()) return false;
   const double m = margin(a.boundingRadius() + b.boundingRadius() + b_in_a.t.norm());
-  for (const LinkGeometry::Ball& cb : b.cores()) {
-    const Vec3 c = b_in_a * cb.center;
-    for (const LinkGeometry::Ball& ca : a.cores()) {
-      const double reach = ca.radius + cb.radius - m;
-      if (reach > 0.0 && (c - ca.center).squaredNorm() < reach * reach) return true;
+  // a's cores lie in its solids, so in its hull's box: a core of b that does not reach the box meets none.
+  const Vec3 box_center = a.bounds().center(), box_half = a.bounds().halfExtents();
+  const auto reachesBox = [&](const Vec3& c, double r) {
+    return ((c - box_center).cwiseAbs() - box_half).cwiseMax(0.0).squaredNorm() < r * r;
+  };
+  for (const LinkGeometry::CoreGroup& g : b.coreGroups()) {
+    if (!reachesBox(b_in_a * g.center, g.radius)) continue;
+    for (int k = g.first; k < g.first + g.count; ++k) {
+      const LinkGeometry::Ball& cb = b.cores()[k];
+      const Vec3 c = b_in_a * cb.center;
+      if (!reachesBox(c, cb.radius)) continue;
+      for (const LinkGeometry::CoreGroup& h : a.coreGroups()) {
+        const double near = h.radius + cb.radius;
+        if (!((c - h.center).squaredNorm() < near * near)) continue;
+        for (int i = h.first; i < h.first + h.count; ++i) {
+          const LinkGeometry::Ball& ca = a.cores()[i];
+          const double reach = ca.radius + cb.radius - m;
+          if (reach > 0.0 && (c - ca.center).squaredNorm() < reach * reach) return true;
+        }
+      }
     }
   }
   return false;
@@ -171,10 +316,15 @@ bool coreMeetsShape(const Shape& shape, const Pose& shape_in_link, const LinkGeo
   if (link.cores().empty()) return false;
   const Pose link_in_shape = shape_in_link.inverse();
   const double m = margin(link.boundingRadius() + shape_in_link.t.norm() + boundingRadius(shape));
-  for (const LinkGeometry::Ball& c : link.cores()) {
-    const Vec3 p = link_in_shape * c.center;
-    const double d = std::visit(PointDistance{p}, shape);
-    if (d < c.radius - m) return true;  // (a NaN distance decides nothing)
+  for (const LinkGeometry::CoreGroup& g : link.coreGroups()) {
+    const Vec3 gp = link_in_shape * g.center;
+    if (std::visit(PointDistance{gp}, shape) >= g.radius) continue;  // (NaN: the group is tested)
+    for (int k = g.first; k < g.first + g.count; ++k) {
+      const LinkGeometry::Ball& c = link.cores()[k];
+      const Vec3 p = link_in_shape * c.center;
+      const double d = std::visit(PointDistance{p}, shape);
+      if (d < c.radius - m) return true;  // (a NaN distance decides nothing)
+    }
   }
   return false;
 }

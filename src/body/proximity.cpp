@@ -215,6 +215,20 @@ double partsBound(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry&
   }
   return best;
 }
+
+// True when a core of one link meets a primitive of the other (b_in_a: b's pose in a's frame, finite).
+bool coreInPrimitive(const LinkGeometry& a, const LinkGeometry& b, const Pose& b_in_a) noexcept {
+  if (!b.cores().empty() && !a.primitives().empty()) {
+    const Pose a_in_b = b_in_a.inverse();
+    for (const LinkGeometry::Primitive& p : a.primitives())
+      if (coreMeetsShape(p.shape, a_in_b * p.pose, b)) return true;
+  }
+  if (!a.cores().empty())
+    for (const LinkGeometry::Primitive& p : b.primitives())
+      if (coreMeetsShape(p.shape, b_in_a * p.pose, a)) return true;
+  return false;
+}
+
 }  // namespace
 
 Screen screenMeshes(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
@@ -232,8 +246,9 @@ Screen screenMeshes(const LinkGeometry& a, const Pose& pose_a, const LinkGeometr
   const IntersectResult hulls = gjkIntersect(Margin<ConvexHull>{a.hull(), padding}, pose_a, b.hull(), pose_b, tol, cache);
   if (!hulls.intersecting) return Screen::Apart;
   if (mode == GeometryMode::Hull) return Screen::Touching;
-  // Overlapping cores settle deep contacts before the triangle search, which is slowest exactly there.
-  if (coresOverlap(a, b, b_in_a)) return Screen::Touching;
+  // Overlapping cores settle contacts before the triangle search, which is slowest exactly there; so does
+  // a core of one link inside a primitive of the other (a solid, whose own distance is exact).
+  if (coresOverlap(a, b, b_in_a) || coreInPrimitive(a, b, b_in_a)) return Screen::Touching;
   return Screen::Unsure;
 }
 

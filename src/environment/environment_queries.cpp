@@ -274,17 +274,26 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
   found = -1;
   // A core of the link meeting an occupied voxel settles it without the triangle search.
   const double core_margin = margins::kSlack * (1.0 + scale_ + extent);
-  for (const LinkGeometry::Ball& core : link.cores()) {
-    const Vec3 c = pose * core.center;
-    const double r = core.radius - core_margin;
-    if (!(r > 0.0)) continue;
+  // (A voxel within r of c, found in the voxel tree.)
+  const auto voxelWithin = [&](const Vec3& c, double r) {
+    int at = -1;
     voxel_tree.query(Aabb::fromCenterHalf(c, Vec3::Constant(r)), [&](std::int32_t v) {
       const Aabb& b = voxels[v];
-      if (((c - b.center()).cwiseAbs() - b.halfExtents()).cwiseMax(0.0).norm() >= r) return false;
-      found = v;
+      if (!(((c - b.center()).cwiseAbs() - b.halfExtents()).cwiseMax(0.0).norm() < r)) return false;
+      at = v;
       return true;
     });
-    if (found >= 0) return voxelHit(found);
+    return at;
+  };
+  for (const LinkGeometry::CoreGroup& g : link.coreGroups()) {
+    if (voxelWithin(pose * g.center, g.radius) < 0) continue;  // (a filter: no voxel near any of its cores)
+    for (int k = g.first; k < g.first + g.count; ++k) {
+      const LinkGeometry::Ball& core = link.cores()[k];
+      const double r = core.radius - core_margin;
+      if (!(r > 0.0)) continue;
+      found = voxelWithin(pose * core.center, r);
+      if (found >= 0) return voxelHit(found);
+    }
   }
   const std::vector<Triangle>& tris = link.triangles();
   forEachOverlap(

@@ -53,7 +53,10 @@ TEST(Cores, LieInsideGeneratedMeshes) {
     expectCoresInside(g, name);
   }
   // The sphere's largest core is most of it (a climb that found nothing would leave grid-sized balls).
-  EXPECT_GT(LinkGeometry(tree_ref::uvSphere(0.1, 10, 16)).cores().front().radius, 0.08);
+  const LinkGeometry sphere(tree_ref::uvSphere(0.1, 10, 16));
+  double largest = 0.0;
+  for (const LinkGeometry::Ball& c : sphere.cores()) largest = std::max(largest, c.radius);
+  EXPECT_GT(largest, 0.08);
   // An open mesh is a surface: no cores.
   TriangleMesh open = tree_ref::uvSphere(0.1, 10, 16);
   open.triangles.pop_back();
@@ -128,7 +131,53 @@ TEST(Cores, OverlapOnlyWhereTheReferenceCollides) {
       }
     }
   std::printf("  cores decide %d of %d colliding poses\n", overlaps, collide);
-  EXPECT_GT(overlaps, collide / 4);
+  // (Shallow contacts are settled by the cores that hug the surface, not by the largest.)
+  EXPECT_GT(overlaps, collide * 3 / 4);
+}
+
+// The groups cover the cores in order, at most eight each, and each group's ball holds its cores.
+TEST(Cores, GroupsHoldTheirCores) {
+  std::vector<LinkGeometry> geoms;
+  for (const auto& [name, mesh] : tree_ref::closedSamples()) geoms.emplace_back(mesh);
+  for (const LinkGeometry& g : geoms) {
+    int next = 0;
+    for (const LinkGeometry::CoreGroup& group : g.coreGroups()) {
+      EXPECT_EQ(group.first, next);
+      EXPECT_GE(group.count, 1);
+      EXPECT_LE(group.count, 8);
+      for (int k = group.first; k < group.first + group.count; ++k) {
+        const LinkGeometry::Ball& c = g.cores()[k];
+        EXPECT_LE((c.center - group.center).norm() + c.radius, group.radius * (1 + 1e-12));
+      }
+      next = group.first + group.count;
+    }
+    EXPECT_EQ(next, static_cast<int>(g.cores().size()));
+  }
+}
+
+// A mesh link dipping a few millimetres into a thin plate (a primitive link, whose inscribed balls lie far
+// from the contact): a core of the mesh inside the plate settles the pair before the triangles.
+TEST(Cores, ACoreInsideAnotherLinksPrimitiveSettlesThePair) {
+  std::vector<CollisionElement> plate_element(1);
+  plate_element[0].primitive = Shape(Box(Vec3(0.3, 0.3, 0.01)));
+  const LinkGeometry plate(plate_element, {});
+  const LinkGeometry ball(tree_ref::uvSphere(0.1, 24, 32));
+  const Tolerances tol;
+  int settled = 0;
+  for (const double depth : {0.003, 0.006, 0.01}) {
+    // Above the plate's face, away from its inscribed balls (on its x axis), sunk `depth` into it.
+    const Pose above = Pose::translation(Vec3(0.05, 0.2, 0.01 + 0.1 - depth));
+    const Screen s = screenMeshes(plate, Pose::identity(), ball, above, tol, GeometryMode::Mesh);
+    EXPECT_NE(s, Screen::Apart) << depth;
+    EXPECT_FALSE(coresOverlap(plate, ball, above)) << depth;  // (the inscribed balls are not what decides)
+    settled += s == Screen::Touching;
+    EXPECT_TRUE(meshesIntersect(plate, Pose::identity(), ball, above, tol, GeometryMode::Mesh)) << depth;
+  }
+  EXPECT_GE(settled, 2);
+  // Just clear of the plate, nothing is settled as touching.
+  EXPECT_NE(
+      screenMeshes(plate, Pose::identity(), ball, Pose::translation(Vec3(0.05, 0.2, 0.111)), tol, GeometryMode::Mesh),
+      Screen::Touching);
 }
 
 // A core inside a box, sphere or capsule obstacle is a collision; beside one it decides nothing.

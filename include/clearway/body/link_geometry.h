@@ -108,12 +108,23 @@ class LinkGeometry {
     Vec3 center;    ///< link frame
     double radius;  ///< metres
   };
-  /// At most this many cores per link: a pair compares up to kMaxCores² of them, which must stay cheap
-  /// beside the hull test they follow.
-  static constexpr int kMaxCores = 8;
-  /// Balls wholly inside the link's solids (closed meshes and primitives), largest first: two bodies whose
-  /// cores overlap share interior points, so they collide at any padding. Empty when the link has no solid.
+  /// At most this many cores per link: the largest few, then balls hugging the surface (a pair compares
+  /// those of one that reach the other's box with all of the other's, after the hull test).
+  static constexpr int kMaxCores = 32;
+  /// Balls wholly inside the link's solids (closed meshes and primitives), by group (coreGroups()): two
+  /// bodies whose cores overlap share interior points, so they collide at any padding. Empty when the link
+  /// has no solid.
   const std::vector<Ball>& cores() const noexcept { return cores_; }
+  /// Neighbouring cores, [first, first + count) of cores(), and a ball holding them all (link frame): a test
+  /// that the ball cannot pass skips the group.
+  struct CoreGroup {
+    Vec3 center;       ///< link frame
+    double radius;     ///< metres: every core of the group lies within it
+    int first;         ///< the group's first core in cores()
+    int count;         ///< how many cores it has, in order from first
+  };
+  /// The cores' groups, at most eight cores each, covering cores() in order.
+  const std::vector<CoreGroup>& coreGroups() const noexcept { return core_groups_; }
   /// How far every part's ball must grow for their union to hold the whole link, the inside of its closed
   /// meshes included (the parts hold only their surfaces): 0 for a link without closed meshes or with one
   /// part, a proven small margin for one with them, +∞ where no proof was found (then only the bounding
@@ -129,6 +140,8 @@ class LinkGeometry {
   void buildParts();
   void findSolids();
   void findCores();
+  void addSurfaceCores(double margin);
+  void groupCores();
   double coverSolids() const;
   // The distance from p to the nearest triangle, or `cutoff` when none is nearer.
   double surfaceDistance(const Vec3& p, double cutoff) const noexcept;
@@ -157,6 +170,7 @@ class LinkGeometry {
   bool nested_ = false;                  // the wound shells nest as one solid: the winding number decides
   std::vector<Vec3> probes_;
   std::vector<Ball> cores_;
+  std::vector<CoreGroup> core_groups_;
   // partBallMargin once proven (NaN before). Copies keep it; two threads asking at once both prove it, to the
   // same value.
   struct Proven {
