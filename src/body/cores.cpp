@@ -116,6 +116,20 @@ double LinkGeometry::surfaceDistance(const Vec3& p, double cutoff) const noexcep
   return cutoff;
 }
 
+bool LinkGeometry::coreCentre(const Vec3& p) const noexcept {
+  if (!surelyInside(p)) return false;
+  if (nested_) return true;  // (the winding number decides, as the rays read it)
+  // Otherwise the rays read p inside one shell on its own. In shells wound outward only, that is a winding
+  // number of at least 1 too; an inward-wound or unwound shell can part the readings (on the shared UR5's
+  // inner_finger_fine.STL, inward-wound shells hold points of winding number 0), and a core must hold in
+  // every reading: no centre within such a shell's box.
+  for (std::size_t s = 0; s < solid_boxes_.size(); ++s)
+    if (solid_sign_[s] <= 0 &&
+        !((p.array() < solid_boxes_[s].min.array()).any() || (p.array() > solid_boxes_[s].max.array()).any()))
+      return false;
+  return true;
+}
+
 void LinkGeometry::findCores() {
   const double m = margin(bounding_radius_);
   std::vector<Ball> candidates;
@@ -127,7 +141,7 @@ void LinkGeometry::findCores() {
     const Aabb& box = solid_boxes_[s];
     const double share = volume > 0.0 ? box.extents().prod() / volume : 1.0;
     const int grid = std::clamp(static_cast<int>(std::cbrt(kCandidates * share)), 2, 6);
-    const auto inside = [&](const Vec3& p) { return surelyInside(p); };
+    const auto inside = [&](const Vec3& p) { return coreCentre(p); };
     std::vector<Ball> mine;
     for (int i = 0; i < grid; ++i)
       for (int j = 0; j < grid; ++j)
@@ -147,7 +161,9 @@ void LinkGeometry::findCores() {
         for (int d = 0; d < 6; ++d) {
           Vec3 p = b.center;
           p[d / 2] += d % 2 ? -step : step;
-          const double r = clearance(p);
+          // (The distance to the surface moves by at most the step: a search cut off just beyond b's radius
+          // plus the step answers the distance itself, and far sooner.)
+          const double r = surfaceDistance(p, 2.0 * (b.radius + step));
           if (r > b.radius && inside(p)) b = {p, r};
         }
     }
@@ -206,16 +222,6 @@ void LinkGeometry::groupCores() {
 
 void LinkGeometry::addSurfaceCores(double m) {
   if (solid_boxes_.empty() || triangles_.empty()) return;
-  // Only where every reading of "inside" agrees: shells nested as one solid (the winding number decides),
-  // or shells wound outward whose boxes are apart. A finer grid finds the places where the readings part
-  // (on the shared UR5's inner_finger_fine.STL, two inward-wound shells whose rays read inside have winding
-  // number 0), and a core must hold in every reading.
-  const bool outward = std::all_of(solid_sign_.begin(), solid_sign_.end(), [](std::int8_t s) { return s > 0; });
-  bool apart = true;
-  for (std::size_t i = 0; i < solid_boxes_.size() && apart; ++i)
-    for (std::size_t j = i + 1; j < solid_boxes_.size() && apart; ++j)
-      apart = !overlaps(solid_boxes_[i], solid_boxes_[j]);
-  if (!nested_ && !(outward && apart)) return;
   // The candidates: a grid over each closed piece's box, as fine as its share of the link's volume allows.
   double volume = 0.0;
   for (const Aabb& box : solid_boxes_) volume += box.extents().prod();
@@ -231,7 +237,7 @@ void LinkGeometry::addSurfaceCores(double m) {
         for (int k = 0; k < n[2]; ++k) {
           const Vec3 f((i + 0.5) / n[0], (j + 0.5) / n[1], (k + 0.5) / n[2]);
           const Vec3 p = box.min + f.cwiseProduct(e);
-          if (!surelyInside(p)) continue;
+          if (!coreCentre(p)) continue;
           // (The cutoff caps deep centres' balls, which stay inside: the distance answered is at most the true one.)
           const double r = surfaceDistance(p, 4.0 * spacing) - m;
           if (r > 0.0 && p.allFinite()) candidates.push_back({p, r});

@@ -140,6 +140,8 @@ class LinkGeometry {
   void buildParts();
   void findSolids();
   void findCores();
+  // True when p may centre a core: inside the solids in every reading (the rays', the winding number's).
+  bool coreCentre(const Vec3& p) const noexcept;
   void addSurfaceCores(double margin);
   void groupCores();
   double coverSolids() const;
