@@ -41,6 +41,12 @@ constexpr double kReach = 0.03;
 // A surface core is chosen only while it reaches at least this many points no chosen core reaches.
 constexpr int kMinGain = 2;
 
+// ceil(x) within [1, most] (NaN: 1), cast only once in range.
+int cellsFor(double x, int most) noexcept {
+  const double c = std::ceil(x);
+  return !(c >= 1.0) ? 1 : c >= most ? most : static_cast<int>(c);
+}
+
 // The distance from p to segment ab, given a − p and b − p (a point-sized segment: the distance to a).
 double segmentDistance(const Vec3& a, const Vec3& b) noexcept {
   const Vec3 e = b - a;
@@ -231,7 +237,11 @@ void LinkGeometry::addSurfaceCores(double m) {
     const double share = volume > 0.0 ? e.prod() / volume : 1.0;
     const double spacing = std::cbrt(std::max(e.prod(), 1e-300) / std::max(1.0, kSurfaceCandidates * share));
     int n[3];
-    for (int a = 0; a < 3; ++a) n[a] = std::clamp(static_cast<int>(std::ceil(e[a] / spacing)), 1, 64);
+    for (int a = 0; a < 3; ++a) n[a] = cellsFor(e[a] / spacing, 64);
+    // (A flat or tiny piece's grid is cut back to its share: many small shells must not cost many points each.)
+    const double limit = 2.0 * kSurfaceCandidates * share + 1.0;
+    while (static_cast<double>(n[0]) * n[1] * n[2] > limit) *std::max_element(n, n + 3) -= 1;
+    if (kSurfaceCandidates * share < 1.0) continue;  // (under a thousandth of the volume: too small to matter)
     for (int i = 0; i < n[0]; ++i)
       for (int j = 0; j < n[1]; ++j)
         for (int k = 0; k < n[2]; ++k) {
@@ -243,21 +253,24 @@ void LinkGeometry::addSurfaceCores(double m) {
           if (r > 0.0 && p.allFinite()) candidates.push_back({p, r});
         }
   }
-  // The points to reach: on every triangle, a grid of about kSampleSpacing (then thinned to kMaxSamples).
+  // The points to reach: on every triangle, a grid of about kSampleSpacing, every stride-th kept so that at
+  // most about kMaxSamples are (counted first: a million long triangles must not make a hundred million).
   const double spacing = kSampleSpacing * sphere_radius_;
-  std::vector<Vec3> samples;
-  for (const Triangle& t : triangles_) {
+  const auto steps = [&](const Triangle& t) {
     const double edge = std::max({(t.v[1] - t.v[0]).norm(), (t.v[2] - t.v[1]).norm(), (t.v[0] - t.v[2]).norm()});
-    const int steps = std::clamp(static_cast<int>(std::ceil(edge / spacing)), 1, 16);
-    for (int a = 0; a <= steps; ++a)
-      for (int b = 0; a + b <= steps; ++b)
-        samples.push_back(t.v[0] + (t.v[1] - t.v[0]) * (double(a) / steps) + (t.v[2] - t.v[0]) * (double(b) / steps));
-  }
-  if (samples.size() > kMaxSamples) {
-    const std::size_t stride = (samples.size() + kMaxSamples - 1) / kMaxSamples;
-    std::size_t kept = 0;
-    for (std::size_t i = 0; i < samples.size(); i += stride) samples[kept++] = samples[i];
-    samples.resize(kept);
+    return cellsFor(edge / spacing, 16);
+  };
+  std::size_t total = 0;
+  for (const Triangle& t : triangles_) total += static_cast<std::size_t>((steps(t) + 1) * (steps(t) + 2) / 2);
+  const std::size_t stride = std::max<std::size_t>(1, (total + kMaxSamples - 1) / kMaxSamples);
+  std::vector<Vec3> samples;
+  std::size_t at = 0;
+  for (const Triangle& t : triangles_) {
+    const int n = steps(t);
+    for (int a = 0; a <= n; ++a)
+      for (int b = 0; a + b <= n; ++b, ++at)
+        if (at % stride == 0)
+          samples.push_back(t.v[0] + (t.v[1] - t.v[0]) * (double(a) / n) + (t.v[2] - t.v[0]) * (double(b) / n));
   }
   const double reach = kReach * sphere_radius_;
   const auto reaches = [&](const Ball& b, const Vec3& p) { return (p - b.center).norm() <= b.radius + reach; };
