@@ -130,9 +130,7 @@ bool LinkGeometry::coreCentre(const Vec3& p) const noexcept {
   // inner_finger_fine.STL, inward-wound shells hold points of winding number 0), and a core must hold in
   // every reading: no centre within such a shell's box.
   for (std::size_t s = 0; s < solid_boxes_.size(); ++s)
-    if (solid_sign_[s] <= 0 &&
-        !((p.array() < solid_boxes_[s].min.array()).any() || (p.array() > solid_boxes_[s].max.array()).any()))
-      return false;
+    if (solid_sign_[s] <= 0 && solid_boxes_[s].contains(p)) return false;
   return true;
 }
 
@@ -261,7 +259,10 @@ void LinkGeometry::addSurfaceCores(double m) {
     return cellsFor(edge / spacing, 16);
   };
   std::size_t total = 0;
-  for (const Triangle& t : triangles_) total += static_cast<std::size_t>((steps(t) + 1) * (steps(t) + 2) / 2);
+  for (const Triangle& t : triangles_) {
+    const int n = steps(t);
+    total += static_cast<std::size_t>((n + 1) * (n + 2) / 2);
+  }
   const std::size_t stride = std::max<std::size_t>(1, (total + kMaxSamples - 1) / kMaxSamples);
   std::vector<Vec3> samples;
   std::size_t at = 0;
@@ -275,8 +276,10 @@ void LinkGeometry::addSurfaceCores(double m) {
   const double reach = kReach * sphere_radius_;
   const auto reaches = [&](const Ball& b, const Vec3& p) { return (p - b.center).norm() <= b.radius + reach; };
   std::vector<char> reached(samples.size(), 0);
-  for (const Ball& c : cores_)
-    for (std::size_t i = 0; i < samples.size(); ++i) reached[i] |= reaches(c, samples[i]);
+  const auto markReached = [&](const Ball& b) {
+    for (std::size_t i = 0; i < samples.size(); ++i) reached[i] |= reaches(b, samples[i]);
+  };
+  for (const Ball& c : cores_) markReached(c);
   const auto gain = [&](const Ball& b) {
     int g = 0;
     for (std::size_t i = 0; i < samples.size(); ++i) g += !reached[i] && reaches(b, samples[i]);
@@ -299,7 +302,7 @@ void LinkGeometry::addSurfaceCores(double m) {
     }
     if (now < kMinGain) break;
     cores_.push_back(candidates[c]);
-    for (std::size_t i = 0; i < samples.size(); ++i) reached[i] |= reaches(candidates[c], samples[i]);
+    markReached(candidates[c]);
   }
 }
 
