@@ -170,6 +170,28 @@ double partsLowerBound(const LinkGeometry& a, const Pose& pose_a, const LinkGeom
   return d;
 }
 
+bool partsApart(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                const Tolerances& tol, const double* need_b, int* first) noexcept {
+  const int na = static_cast<int>(a.parts().size()), nb = static_cast<int>(b.parts().size());
+  if (!pose_a.isFinite() || !pose_b.isFinite() || na == 0 || nb == 0) return false;
+  for (int j = 0; j < nb; ++j)
+    if (!(need_b[j] >= 0.0) || !std::isfinite(need_b[j])) return false;
+  const int start = first && *first >= 0 && *first < na * nb ? *first : 0;
+  for (int k = 0; k < na * nb; ++k) {
+    const int at = (start + k) % (na * nb), i = at / nb, j = at % nb;
+    const LinkGeometry::Part& pa = a.parts()[i];
+    const LinkGeometry::Part& pb = b.parts()[j];
+    if ((pose_a * pa.center - pose_b * pb.center).norm() - pa.radius - pb.radius >= need_b[j]) continue;
+    SimplexCache cache;  // (only "at least need" is asked: GJK stops there)
+    if (!(gjkLowerBound(pa.hull, pose_a, pb.hull, pose_b, tol, cache, need_b[j], 0.0) >= need_b[j])) {
+      if (first) *first = at;
+      return false;
+    }
+  }
+  // The parts hold the surfaces, not a closed mesh's inside.
+  return (a.solidCount() == 0 && b.solidCount() == 0) || !linkContained(a, b, relativePose(pose_a, pose_b));
+}
+
 namespace {
 double partsBound(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
                   const Tolerances& tol, double enough, double relative, SimplexCache* caches) noexcept {

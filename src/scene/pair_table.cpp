@@ -86,14 +86,35 @@ struct Builder {
     return p;
   }
 
-  // The largest distance of the lower link's hull from joint k's axis, with the joints below k at x.
-  double reach(std::size_t k, const double* x) const {
+  // The largest distance of the points of `hull` (the lower link's, or a part's) from joint k's axis, with
+  // the joints below k at x.
+  double reach(std::size_t k, const double* x, const ConvexHull& hull) const {
     if (moved[k].joint->type == JointType::Prismatic) return 1.0;
     Pose below = fixed[k + 1];
     for (std::size_t i = k + 1; i < moved.size(); ++i) below = below * jointMotion(*moved[i].joint, x[i]) * fixed[i + 1];
     double r = 0.0;
-    for (const Vec3& v : down.hull().vertices()) r = std::max(r, axisDistance(below * v, moved[k].joint->axis));
+    for (const Vec3& v : hull.vertices()) r = std::max(r, axisDistance(below * v, moved[k].joint->axis));
     return r * margins::kBeyond + margins::kRounding;
+  }
+  double reach(std::size_t k, const double* x) const { return reach(k, x, down.hull()); }
+
+  // True when every part of the lower link, moved by its own δ over the cell (a part near the axes moves
+  // far less than the link's farthest point), stays beyond the padding: then the pair is apart in the
+  // cell. Only in Mesh mode: the parts hold the triangles, not the hull that Hull mode checks.
+  std::vector<double> part_reach_last;  // ρ of the lowest moved joint, per part of the lower link
+  std::vector<double> part_need;        // scratch
+  int near_parts = -1;                  // the part pair too near in the last cell, tested first in the next
+  bool partsFree(const double* x, const double* h, const Pose& t, double margin) {
+    const std::vector<LinkGeometry::Part>& parts = down.parts();
+    if (mode != GeometryMode::Mesh || parts.size() < 2 || up.parts().empty()) return false;
+    part_need.assign(parts.size(), padding + margin);
+    for (std::size_t j = 0; j < parts.size(); ++j) {
+      for (std::size_t k = 0; k < moved.size(); ++k) {
+        const double r = k + 1 == moved.size() ? part_reach_last[j] : reach(k, x, parts[j].hull);
+        part_need[j] += (h[k] * margins::kBeyond + kValueSlack) * r;
+      }
+    }
+    return partsApart(up, Pose::identity(), down, t, tol, part_need.data(), &near_parts);
   }
 
   // The verdict for the cell centred at x with half-widths h; for an Unsure one, when `witness` is given,
@@ -139,6 +160,7 @@ struct Builder {
     // (At least `need`, not beyond it: a rung that proves enough answers enough itself, e.g. the parts' when
     // every part is that far, and need holds the margin that makes "at least" certain.)
     if (pair.lowerBound(Pose::identity(), t, tol, q) >= need) return PairTable::Verdict::Free;
+    if (partsFree(x, h, t, margin)) return PairTable::Verdict::Free;
     if (witness && mode == GeometryMode::Mesh) meshesIntersectExactly(up, Pose::identity(), down, t, tol, padding, witness);
     return PairTable::Verdict::Unsure;
   }
@@ -312,6 +334,8 @@ std::unique_ptr<const PairTable> PairTable::build(const RobotModel& model, int a
   {
     const double x[2] = {0.0, 0.0};
     bld.reach_last = bld.reach(dims - 1, x);
+    for (const LinkGeometry::Part& part : bld.down.parts())
+      bld.part_reach_last.push_back(bld.reach(dims - 1, x, part.hull));
   }
   const auto width = [&](int k) { return (bld.moved[k].hi - bld.moved[k].lo) / t->n_[k]; };
   const int n0 = t->n_[0], n1 = dims == 2 ? t->n_[1] : 1;

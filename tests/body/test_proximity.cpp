@@ -2,7 +2,7 @@
 // tests/tree/mesh_reference.h, `within` decides as the reference does, Hull mode is never tighter than
 // Mesh mode, forgetting the warm starts gives a fresh pair's answers bit for bit, a distance with a cutoff
 // is meshDistance's, a link against a convex shape answers as the shape queries, a cast never passes the
-// first contact, and bad input is never "far".
+// first contact, and bad input is never "far"; partsApart holds each part to its own need.
 #include <clearway/body/proximity.h>
 
 #include <gtest/gtest.h>
@@ -388,6 +388,73 @@ TEST(BodyPair, NeverFarByAccident) {
   EXPECT_EQ(inside.distance(Pose(), Pose(), tol, cut).distance, 0.0);
   cut.cutoff = nan;
   EXPECT_TRUE(pair.distance(Pose(), Pose::translation(Vec3(5, 0, 0)), tol, cut).mayCollide());
+}
+
+// partsApart: each of b's parts is held to its own need (a far part may move farther than a near one), a
+// true answer never claims more than the brute-force distance, a link inside a closed mesh is never apart,
+// and bad input is never apart.
+TEST(PartsApart, EachPartAgainstItsOwnNeed) {
+  const Tolerances tol;
+  // A dumbbell: a ball at the origin and a cube 0.2 along x. A plate 0.05 beyond the cube's far face (and
+  // ~0.2 from the ball): the cube's parts may move 0.04, the ball's 0.15, but the cube's not 0.06.
+  const TriangleMesh dumbbell = tree_ref::joined(tree_ref::uvSphere(0.04, 6, 10),
+                                                 tree_ref::gridBox(Vec3(0.03, 0.03, 0.03), 2), Vec3(0.2, 0.0, 0.0));
+  const LinkGeometry b(dumbbell), a(tree_ref::gridBox(Vec3(0.002, 0.1, 0.1), 2));
+  ASSERT_GE(b.parts().size(), 2u);
+  const Pose plate = Pose::translation(Vec3(0.2 + 0.03 + 0.05 + 0.002, 0.0, 0.0));
+  const auto needs = [&](double near, double far) {
+    std::vector<double> need;
+    for (const LinkGeometry::Part& p : b.parts()) need.push_back(p.center.x() > 0.1 ? near : far);
+    return need;
+  };
+  EXPECT_TRUE(partsApart(a, plate, b, Pose(), tol, needs(0.04, 0.15).data()));
+  EXPECT_FALSE(partsApart(a, plate, b, Pose(), tol, needs(0.06, 0.15).data()));
+  EXPECT_FALSE(partsApart(a, plate, b, Pose(), tol, needs(0.04, 0.3).data()));
+  int first = -1;  // the pair too near is remembered, and the next query starts from it
+  EXPECT_FALSE(partsApart(a, plate, b, Pose(), tol, needs(0.06, 0.15).data(), &first));
+  EXPECT_GE(first, 0);
+  EXPECT_TRUE(partsApart(a, plate, b, Pose(), tol, needs(0.04, 0.15).data(), &first));
+
+  // Random poses: apart at x means the meshes are at least x apart.
+  const std::vector<Named> m = meshes();
+  std::mt19937_64 rng(21);
+  int apart = 0, cases = 0;
+  for (const Named& na : m) {
+    for (const Named& nb : m) {
+      const LinkGeometry ga(na.mesh), gb(nb.mesh);
+      const double reach = 1.2 * (tree_ref::meshRadius(na.mesh) + tree_ref::meshRadius(nb.mesh));
+      for (int c = 0; c < 10; ++c, ++cases) {
+        const Pose pa = randomPose(rng, 0.1);
+        Pose pb = randomPose(rng, reach);
+        pb.t += pa.t;
+        const double ref = tree_ref::meshDistance(tree_ref::place(na.mesh, pa), tree_ref::place(nb.mesh, pb));
+        const double x = std::uniform_real_distribution<double>(0.0, 0.05)(rng);
+        const std::vector<double> need(gb.parts().size(), x);
+        if (partsApart(ga, pa, gb, pb, tol, need.data())) {
+          ++apart;
+          EXPECT_GE(ref, x - kBand) << na.name << " vs " << nb.name << " case " << c;
+        }
+      }
+    }
+  }
+  std::printf("  %d of %d random cases apart\n", apart, cases);
+  EXPECT_GT(apart, cases / 4);
+
+  // Inside a closed mesh: the surfaces are far apart, the solids are not.
+  const LinkGeometry ball(tree_ref::uvSphere(0.3, 10, 16)), cube(tree_ref::gridBox(Vec3(0.01, 0.01, 0.01), 1));
+  const std::vector<double> zero(cube.parts().size(), 0.0), one(ball.parts().size(), 0.0);
+  EXPECT_FALSE(partsApart(ball, Pose(), cube, Pose(), tol, zero.data()));
+  EXPECT_FALSE(partsApart(cube, Pose(), ball, Pose(), tol, one.data()));
+  // Bad input.
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> bad = needs(0.04, 0.15);
+  bad.back() = nan;
+  EXPECT_FALSE(partsApart(a, plate, b, Pose(), tol, bad.data()));
+  bad.back() = -1.0;
+  EXPECT_FALSE(partsApart(a, plate, b, Pose(), tol, bad.data()));
+  Pose broken = plate;
+  broken.t.y() = nan;
+  EXPECT_FALSE(partsApart(a, broken, b, Pose(), tol, needs(0.0, 0.0).data()));
 }
 
 }  // namespace

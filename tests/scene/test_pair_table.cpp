@@ -148,7 +148,8 @@ TEST(PairTable, Ur5CellsHold) {
 // `enough` once they prove it (the parts do when every part is that far), and a table that asked for more
 // than that left such cells Unsure. On the UR5's forearm and wrist_2 (a table of two joints, its links
 // concave where they meet) that was 41% of random lookups Unsure instead of 28%, each costing a screen and
-// often a triangle search per state.
+// often a triangle search per state. Each part of the lower link moved by its own δ (parts near the axes
+// move less than the link's farthest point) took that to 12%.
 TEST(PairTable, CellsTheRungsProveFarEnoughAreFree) {
   CLEARWAY_SHARED_ROBOT_OR_SKIP(urdf, "ur5/ur5.urdf");
   auto model = std::make_shared<const RobotModel>(loadRobot(urdf, ""));
@@ -165,7 +166,7 @@ TEST(PairTable, CellsTheRungsProveFarEnoughAreFree) {
   for (int s = 0; s < states; ++s)
     unsure += table->lookup(randomConfiguration(*model, rng).data()) == PairTable::Verdict::Unsure;
   std::printf("  forearm_link/wrist_2_link: %ld of %d lookups unsure\n", unsure, states);
-  EXPECT_LT(unsure, states * 3 / 10);
+  EXPECT_LT(unsure, states * 3 / 20);
 }
 
 // freeAlong walks every cell a segment crosses: where it says free, every one of 4,000 points along the

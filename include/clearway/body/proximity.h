@@ -69,6 +69,15 @@ bool trianglesTouch(const LinkGeometry& a, const Pose& pose_a, const LinkGeometr
 double partsLowerBound(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
                        const Tolerances& tol, double enough, double relative, SimplexCache* caches = nullptr) noexcept;
 
+/// True when each convex part j of b is certified at least need_b[j] metres from every part of a (part
+/// balls, then GJK lower bounds) and neither link lies inside the other's closed meshes: every point of b's
+/// part j may then move by need_b[j] without b's triangles and primitives reaching a's, whatever the other
+/// parts do. False proves nothing (nor does a NaN or negative need, or a non-finite pose). `first`
+/// (optional): the part pair to test first (i·nb + j), set to the one that was too near when false: a
+/// query at a neighbouring pose then usually ends at once.
+bool partsApart(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                const Tolerances& tol, const double* need_b, int* first = nullptr) noexcept;
+
 /// The same for a convex shape (an obstacle, a primitive) against a link: hull first, then (Mesh mode)
 /// the shape's box in the link frame against the triangle tree, and the link's primitives.
 bool shapeIntersectsLink(const Shape& shape, const Pose& pose_shape, const LinkGeometry& link, const Pose& pose_link,

@@ -6,8 +6,12 @@
 // the lower link moves, relative to the upper one, by at most δ = Σ h_k·ρ_k as the variables range over
 // the cell, where ρ_k is the largest distance of the lower link's hull from joint k's axis (exact for the
 // lower joint, whose axis the hull turns about; at the cell's value of the lower joint for the upper
-// one), or 1 for a slide. So a pair certified more than padding + δ apart at c is apart everywhere in the
-// cell (Free), and a pair whose cores overlap by more than δ at c overlaps everywhere in it (Colliding).
+// one: turn the upper joint first, then the lower, and the two legs' bounds add up), or 1 for a slide. So
+// a pair certified more than padding + δ apart at c is apart everywhere in the cell (Free), and a pair
+// whose cores overlap by more than δ at c overlaps everywhere in it (Colliding). In Mesh mode each convex
+// part of the lower link (LinkGeometry::parts) also has its own δ from its own reaches, and a cell where
+// every part is that far from the upper link's parts is Free too: near a joint, the near part lies close
+// to the axes and moves far less than the link's farthest point.
 // Other cells are Unsure and the pair is checked as before, after one triangle test of the pair that
 // touched at the cell's centre. A coarse grid is refined where it is unsure.
 #include <clearway/body/proximity.h>
