@@ -33,11 +33,11 @@ struct PairTableOptions {
   int coarse_one = 64, fine_one = 16;   ///< a pair moved by one variable
   ///@}
   ///@{
-  int coarse_two = 16, fine_two = 4;    ///< a pair moved by two
+  int coarse_two = 16, fine_two = 8;  ///< a pair moved by two
   ///@}
   /// Cell centres checked at most, per table (each a distance query at load): a level of halving that
   /// would pass it is not begun, and its cells stay Unsure.
-  long max_checks = 20000;
+  long max_checks = 50000;
   /// No table for a pair whose probe (one coarse cell in 4 per variable) settles less than this share.
   double min_probe_share = 0.25;
   ///@{
