@@ -253,6 +253,14 @@ bool coreInPrimitive(const LinkGeometry& a, const LinkGeometry& b, const Pose& b
 
 }  // namespace
 
+namespace {
+// Past this many triangles in either link, a pair the hulls and cores leave is screened by its convex parts
+// before the triangle search, which near a fine mesh visits a great many triangles. Below it the search is
+// cheap, and a pair that touches would pay the parts for nothing (on the shared Panda's self-colliding
+// states, +5% instructions when every pair was screened so).
+constexpr std::size_t kPartsScreenTriangles = 4096;
+}  // namespace
+
 Screen screenMeshes(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
                     const Tolerances& tol, GeometryMode mode, double padding, SimplexCache* hull_cache) noexcept {
   if (!pose_a.isFinite() || !pose_b.isFinite() || !validPadding(padding)) return Screen::Touching;
@@ -271,6 +279,12 @@ Screen screenMeshes(const LinkGeometry& a, const Pose& pose_a, const LinkGeometr
   // Overlapping cores settle contacts before the triangle search, which is slowest exactly there; so does
   // a core of one link inside a primitive of the other (a solid, whose own distance is exact).
   if (coresOverlap(a, b, b_in_a) || coreInPrimitive(a, b, b_in_a)) return Screen::Touching;
+  if (std::max(a.triangles().size(), b.triangles().size()) > kPartsScreenTriangles &&
+      (a.parts().size() > 1 || b.parts().size() > 1)) {
+    const double scale = a.boundingRadius() + b.boundingRadius() + b_in_a.t.norm();
+    const double need = (padding + narrowBand(scale + padding, tol)) * margins::kBeyond;
+    if (partsLowerBound(a, pose_a, b, pose_b, tol, need, 0.0) >= need) return Screen::Apart;
+  }
   return Screen::Unsure;
 }
 

@@ -162,6 +162,37 @@ TEST(BodyPair, ScreenThenTrianglesAnswerAsIntersects) {
   EXPECT_GT(counts[2], 0);
 }
 
+// A fine mesh (past 4096 triangles) whose hull and cores leave a pair unsettled is screened by its convex
+// parts before the triangle search: a ball in a ring's hole is apart without a triangle visited, a bead
+// inside the ring's tube is not (the solids meet), and the screen never calls apart what the brute-force
+// distance does not.
+TEST(BodyPair, FineMeshesAreScreenedByTheirParts) {
+  const TriangleMesh ring = tree_ref::torus(0.12, 0.03, 100, 50), ball_mesh = tree_ref::uvSphere(0.02, 6, 10);
+  const LinkGeometry a(ring), ball(ball_mesh), bead(tree_ref::uvSphere(0.01, 6, 10));
+  ASSERT_GT(a.triangles().size(), 4096u);
+  ASSERT_GT(a.parts().size(), 1u);
+  const Tolerances tol;
+  EXPECT_EQ(screenMeshes(a, Pose(), ball, Pose(), tol, GeometryMode::Mesh, 0.0), Screen::Apart);
+  EXPECT_EQ(screenMeshes(a, Pose(), ball, Pose(), tol, GeometryMode::Hull, 0.0), Screen::Touching);
+  const Pose in_tube = Pose::translation(Vec3(0.12, 0.0, 0.0));
+  EXPECT_NE(screenMeshes(a, Pose(), bead, in_tube, tol, GeometryMode::Mesh, 0.0), Screen::Apart);
+  EXPECT_TRUE(meshesIntersect(a, Pose(), bead, in_tube, tol, GeometryMode::Mesh, 0.0));
+  std::mt19937_64 rng(23);
+  int apart = 0;
+  for (int c = 0; c < 60; ++c) {
+    const Pose pb = randomPose(rng, 0.17);
+    const double padding = c % 4 == 0 ? 0.01 : 0.0;
+    if (screenMeshes(a, Pose(), ball, pb, tol, GeometryMode::Mesh, padding) != Screen::Apart) continue;
+    ++apart;
+    EXPECT_GT(tree_ref::meshDistance(tree_ref::place(ring, Pose()), tree_ref::place(ball_mesh, pb)), padding - kBand)
+        << "case " << c;
+    const Vec3 o = pb.t;  // (the ball's centre: apart, it lies outside the tube)
+    EXPECT_GT(std::hypot(std::hypot(o.x(), o.y()) - 0.12, o.z()), 0.03) << "case " << c;
+  }
+  std::printf("  %d of 60 poses near the ring screened apart\n", apart);
+  EXPECT_GT(apart, 0);
+}
+
 // The convex side (a link against an obstacle's primitive or a voxel's box) answers as the shape queries it
 // climbs to: intersects is shapeIntersectsLink's answer, the screen and the exact rung together the same,
 // the bound never exceeds shapeLinkDistance's distance and is tight within the relative error, `within`
