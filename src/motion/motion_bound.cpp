@@ -13,7 +13,6 @@
 namespace clearway {
 
 using motion_detail::referenceState;
-using motion_detail::rigidAnchors;
 
 // ---- MotionBound --------------------------------------------------------------------------------------
 
@@ -185,7 +184,7 @@ MotionBound::Tables::Tables(const Scene& scene, const std::vector<Body>& bodies)
         if (joint_var_[e] >= 0) return false;
       return true;
     };
-    const std::vector<int> anchor = rigidAnchors(scene);  // (the same rigid bodies MotionChecker merges)
+    const std::vector<int>& anchor = scene.rigidAnchors();  // (the same rigid bodies MotionChecker merges)
     for (int j = 0; j < joints; ++j) {
       const Joint& joint = model.joint(j);
       if (!still(j) || joint.parent_link < 0 || joint.child_link < 0) continue;

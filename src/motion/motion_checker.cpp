@@ -15,7 +15,6 @@ namespace clearway {
 
 using motion_detail::alignedUnit;
 using motion_detail::referenceState;
-using motion_detail::rigidAnchors;
 
 namespace {
 
@@ -29,7 +28,7 @@ constexpr std::size_t kWarmObstacles = 64;
 MotionChecker::Bodies MotionChecker::mergeBodies(const Scene& scene) {
   const RobotModel& model = scene.robot();
   Bodies out;
-  out.anchor = rigidAnchors(scene);
+  out.anchor = scene.rigidAnchors();
   out.index.assign(model.linkCount(), -1);
   std::vector<std::vector<int>> members(model.linkCount());
   for (const int l : scene.geometry().geometricLinks()) members[out.anchor[l]].push_back(l);

@@ -95,27 +95,6 @@ inline std::vector<double> referenceState(const Scene& scene) {
   return q;
 }
 
-// Per link: the link nearest the root that it moves rigidly with (joined by joints the group does not move).
-inline std::vector<int> rigidAnchors(const Scene& scene) {
-  const RobotModel& model = scene.robot();
-  std::vector<char> in_group(model.variableCount(), 0);
-  for (const int v : scene.groupVariables()) in_group[v] = 1;
-  const auto still = [&](const Joint& joint) {
-    const Joint& owner = joint.isMimic() ? model.joint(joint.mimic.joint) : joint;
-    for (int k = 0; owner.first_variable >= 0 && k < jointVariableCount(owner.type); ++k)
-      if (in_group[owner.first_variable + k]) return false;
-    return true;
-  };
-  std::vector<int> anchor(model.linkCount());
-  for (int l = 0; l < model.linkCount(); ++l) {
-    int a = l;
-    while (model.link(a).parent_joint >= 0 && still(model.joint(model.link(a).parent_joint))) a = model.parentLink(a);
-    anchor[l] = a;
-  }
-  return anchor;
-}
-
-
 // The unit quaternions of q0[0..3] and q1[0..3], the second on the first's side (the short arc).
 inline void alignedUnit(const double* q0, const double* q1, Eigen::Vector4d& a, Eigen::Vector4d& b) noexcept {
   a = Eigen::Vector4d(q0[0], q0[1], q0[2], q0[3]);

@@ -5,6 +5,8 @@
 #include <clearway/body/enclosing.h>
 #include <clearway/serial.h>
 #include <clearway/body/proximity.h>
+#include <clearway/detail/margins.h>
+#include <clearway/tree/aabb.h>
 
 #include <clearway/per_thread.h>
 
@@ -245,9 +247,11 @@ void Scene::init() {
     for (int k = 0; k < jointVariableCount(owner.type) && owner.first_variable >= 0; ++k)
       if (taken[owner.first_variable + k]) joint_moves[j] = 1;
   }
+  rigid_anchor_.assign(model.linkCount(), 0);
   for (int i = 1; i < model.linkCount(); ++i) {
     const int j = model.link(i).parent_joint;
     moves[i] = moves[model.parentLink(i)] || joint_moves[j];
+    rigid_anchor_[i] = joint_moves[j] ? i : rigid_anchor_[model.parentLink(i)];
   }
   for (int i : geometry_->geometricLinks())
     if (moves[i]) moving_links_.push_back(i);
@@ -299,6 +303,46 @@ void Scene::initEnvironment() {
   static_clearance_ = static_clearance_lower_ = std::numeric_limits<double>::infinity();
   std::vector<Pose> poses(model.linkCount());
   computeLinkPoses(model, base_q_.data(), poses.data());
+  // The rigid bodies among them, in the order of their first member.
+  env_bodies_.clear();
+  env_order_.clear();
+  {
+    std::vector<int> body_of(model.linkCount(), -1);
+    std::vector<std::vector<int>> members;
+    for (int k = 0; k < static_cast<int>(env_links_.size()); ++k) {
+      int& b = body_of[rigid_anchor_[env_links_[k]]];
+      if (b < 0) {
+        b = static_cast<int>(members.size());
+        members.emplace_back();
+      }
+      members[b].push_back(k);
+    }
+    for (const std::vector<int>& m : members) {
+      EnvBody body;
+      body.anchor = rigid_anchor_[env_links_[m[0]]];
+      body.first = static_cast<int>(env_order_.size());
+      body.count = static_cast<int>(m.size());
+      env_order_.insert(env_order_.end(), m.begin(), m.end());
+      if (m.size() > 1) {  // each member's bounding ball in the anchor's frame (fixed: no joint between moves)
+        Aabb box;
+        std::vector<std::pair<Vec3, double>> balls;
+        for (const int k : m) {
+          const int i = env_links_[k];
+          const LinkGeometry& g = *geometry_->link(i);
+          balls.emplace_back(relativePose(poses[body.anchor], poses[i]) * g.sphereCenter(), g.sphereRadius());
+          box.grow(balls.back().first - Vec3::Constant(balls.back().second));
+          box.grow(balls.back().first + Vec3::Constant(balls.back().second));
+          body.padding = std::max(body.padding, link_padding_[i]);
+        }
+        body.center = box.center();
+        for (const auto& [c, r] : balls) body.radius = std::max(body.radius, (c - body.center).norm() + r);
+        // (Grown past the rounding of the relative poses here and of the members' own placement by the
+        // forward kinematics, both chains of a few products of magnitudes within this ball.)
+        body.radius = margins::roundedUp(body.radius * margins::kBeyond, body.center.norm() + body.radius);
+      }
+      env_bodies_.push_back(body);
+    }
+  }
   if (description_.effects.environment && static_collision_.kind == CollisionReport::Kind::None &&
       !environment_->hasMovingObstacles())
     for (int i : geometry_->geometricLinks()) {

@@ -4,6 +4,7 @@
 
 #include <clearway/body/enclosing.h>
 #include <clearway/body/link_geometry.h>
+#include <clearway/detail/margins.h>
 #include <clearway/per_thread.h>
 #include <clearway/kinematics/forward_kinematics.h>
 #include <clearway/load/input_limits.h>
@@ -217,6 +218,24 @@ bool Scene::environmentFree(const Pose* poses, SceneScratch& ctx, CollisionRepor
       ctx.env_last_hit = k;
       return true;
     };
+    // A rigid body of several links: its one ball (which holds every member's bounding ball) cleared by the
+    // boxes or the grid clears them all.
+    const auto bodyCleared = [&](const EnvBody& body) {
+      if (body.count < 2 || !(grid || boxes) || !std::isfinite(body.radius)) return false;
+      const Pose& anchor = poses[body.anchor];
+      const Vec3 center = anchor * body.center;
+      const double radius = margins::roundedUp(body.radius, body.center.norm() + body.radius + anchor.t.norm());
+      const double slack = env.linkSlack(body.padding, center.cwiseAbs().maxCoeff() + radius, options_.tolerances);
+      if (boxes && boxes->ballClear(center, radius, slack)) {
+        ctx.counters.environment.box_clears += body.count;
+        return true;
+      }
+      if (grid && grid->lowerBound(center) > radius + slack) {
+        ctx.counters.environment.grid_clears += body.count;
+        return true;
+      }
+      return false;
+    };
     // The link that met an obstacle last goes first: a planner's next state is near its last, and the links
     // before it in order would each be tested for nothing. Each link is still tested once at most.
     const int n = static_cast<int>(env_links_.size());
@@ -226,8 +245,11 @@ bool Scene::environmentFree(const Pose* poses, SceneScratch& ctx, CollisionRepor
     boxes = env.obstacleBoxes();
     if ((grid || boxes) && !(balls_placed = ctx.balls.madeFor(*geometry_))) grid = nullptr, boxes = nullptr;
     if (balls_placed) ctx.balls.place(poses);
-    for (int k = 0; k < n; ++k)
-      if (k != lead && hits(k)) return false;
+    for (const EnvBody& body : env_bodies_) {
+      if (bodyCleared(body)) continue;
+      for (int m = body.first; m < body.first + body.count; ++m)
+        if (env_order_[m] != lead && hits(env_order_[m])) return false;
+    }
   }
   return true;
 }

@@ -978,5 +978,46 @@ TEST(Scene, AZeroQuaternionIsAnInvalidState) {
   }
 }
 
+// rigidAnchors: each link moves rigidly with its anchor at every state (the UR5's gripper and wrist sensor
+// with wrist_3_link), an anchor's own joint is one the group moves (or it is the root), and the scene's
+// environment check, which clears such a body with one ball, answers as before (the shortcut tests above).
+TEST(Scene, LinksMoveRigidlyWithTheirAnchors) {
+  CLEARWAY_SHARED_OR_SKIP(file, "scenes/box_ur5/box_ur5_0001.yaml");
+  const auto scene = Scene::load(file);
+  const RobotModel& model = scene->robot();
+  const std::vector<int>& anchor = scene->rigidAnchors();
+  ASSERT_EQ(anchor.size(), static_cast<std::size_t>(model.linkCount()));
+  const int wrist = model.linkIndex("wrist_3_link");
+  for (const char* name : {"fts_robotside", "robotiq_85_base_link", "robotiq_85_left_finger_tip_link"})
+    EXPECT_EQ(anchor[model.linkIndex(name)], wrist) << name;
+  EXPECT_EQ(anchor[wrist], wrist);
+  SceneContext ctx = scene->makeContext();
+  std::mt19937 rng(37);
+  std::vector<std::vector<Pose>> seen;
+  for (int s = 0; s < 20; ++s) {
+    std::vector<double> q(scene->dimension());
+    for (int i = 0; i < scene->dimension(); ++i)
+      q[i] = std::uniform_real_distribution<double>(std::max(scene->lower(i), -M_PI),
+                                                    std::min(scene->upper(i), M_PI))(rng);
+    scene->computePoses(q.data(), ctx);
+    std::vector<Pose> relative;
+    for (int l = 0; l < model.linkCount(); ++l)
+      relative.push_back(relativePose(ctx.poses()[anchor[l]], ctx.poses()[l]));
+    seen.push_back(relative);
+  }
+  for (int l = 0; l < model.linkCount(); ++l) {
+    for (std::size_t s = 1; s < seen.size(); ++s) {
+      EXPECT_LT((seen[s][l].t - seen[0][l].t).norm(), 1e-12) << model.link(l).name;
+      EXPECT_LT((seen[s][l].R - seen[0][l].R).norm(), 1e-12) << model.link(l).name;
+    }
+    const int a = anchor[l];
+    if (a != 0) {
+      const std::vector<int>& group = scene->groupVariables();
+      const Joint& j = model.joint(model.link(a).parent_joint);
+      EXPECT_NE(std::find(group.begin(), group.end(), j.first_variable), group.end()) << model.link(l).name;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace clearway

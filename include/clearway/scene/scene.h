@@ -175,6 +175,10 @@ class Scene {
 
   /// Links checked against the environment at every state (static links are checked once, at construction).
   const std::vector<int>& environmentLinks() const noexcept { return env_links_; }
+  /// Per link: the link nearest the root that it moves rigidly with at every state (joined to it by joints
+  /// the group does not move); the link itself when the group moves its own joint, and the root for links
+  /// that never move.
+  const std::vector<int>& rigidAnchors() const noexcept { return rigid_anchor_; }
   /// Metres of padding around link i.
   double linkPadding(int i) const noexcept { return link_padding_[i]; }
   /// A collision no state can undo (between links that never move, or a static link and a static
@@ -272,6 +276,20 @@ class Scene {
   std::uint64_t serial_ = 0;
   std::vector<int> quaternions_;  // the state index of each floating joint's qx (qy, qz, qw follow)
   std::vector<int> moving_links_, env_links_;
+  std::vector<int> rigid_anchor_;  // per link: see rigidAnchors()
+  // The links checked against the environment, by rigid body (links joined by joints the group does not
+  // move: a gripper's links on its flange): env_order_[first, first + count) are a body's members (indices
+  // in env_links_), and a body of several has one ball in its anchor's frame that holds every member's
+  // bounding ball, so the obstacles' boxes or the clearance grid clear them all with one test.
+  struct EnvBody {
+    int anchor = -1;
+    Vec3 center = Vec3::Zero();  // anchor frame
+    double radius = 0.0;
+    double padding = 0.0;  // the largest of its members'
+    int first = 0, count = 0;
+  };
+  std::vector<EnvBody> env_bodies_;
+  std::vector<int> env_order_;
   std::vector<double> link_padding_;
   CollisionReport static_collision_;  // a collision no state can undo (static links), found at construction
   CollisionReport self_static_collision_;  // the part of it among the robot's own links
