@@ -326,8 +326,10 @@ void Scene::initEnvironment() {
       if (m.size() > 1) {  // each member's bounding ball in the anchor's frame (fixed: no joint between moves)
         Aabb box;
         std::vector<std::pair<Vec3, double>> balls;
+        double world = poses[body.anchor].t.norm();  // the magnitudes the relative poses were computed from
         for (const int k : m) {
           const int i = env_links_[k];
+          world = std::max(world, poses[body.anchor].t.norm() + poses[i].t.norm());
           const LinkGeometry& g = *geometry_->link(i);
           balls.emplace_back(relativePose(poses[body.anchor], poses[i]) * g.sphereCenter(), g.sphereRadius());
           box.grow(balls.back().first - Vec3::Constant(balls.back().second));
@@ -336,9 +338,9 @@ void Scene::initEnvironment() {
         }
         body.center = box.center();
         for (const auto& [c, r] : balls) body.radius = std::max(body.radius, (c - body.center).norm() + r);
-        // (Grown past the rounding of the relative poses here and of the members' own placement by the
-        // forward kinematics, both chains of a few products of magnitudes within this ball.)
-        body.radius = margins::roundedUp(body.radius * margins::kBeyond, body.center.norm() + body.radius);
+        // (Grown past the rounding of the relative poses here, chains of a few products of the base state's
+        // world magnitudes; the members' placement at each state adds the anchor's, at the query.)
+        body.radius = margins::roundedUp(body.radius * margins::kBeyond, body.center.norm() + body.radius + world);
       }
       env_bodies_.push_back(body);
     }
