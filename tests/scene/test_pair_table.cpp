@@ -90,6 +90,16 @@ Tally checkTables(const RobotModel& model, const SelfCollision& checker, int sta
   return t;
 }
 
+// The table of two named links of `model`, with the default options (null when a name is unknown or the
+// pair gets none).
+std::unique_ptr<const PairTable> tableOf(const std::shared_ptr<const RobotModel>& model, const char* a_name,
+                                         const char* b_name, GeometryMode mode) {
+  const RobotGeometry geometry(model);
+  const int a = model->linkIndex(a_name), b = model->linkIndex(b_name);
+  if (a < 0 || b < 0) return nullptr;
+  return PairTable::build(*model, a, *geometry.link(a), b, *geometry.link(b), 0.0, mode, Tolerances{});
+}
+
 TEST(PairTable, PandaCellsHoldWhatTheyCertify) {
   CLEARWAY_SHARED_ROBOT_OR_SKIP(urdf, "panda/panda.urdf");
   auto model = std::make_shared<const RobotModel>(loadRobot(urdf, ""));
@@ -153,12 +163,7 @@ TEST(PairTable, Ur5CellsHold) {
 TEST(PairTable, CellsTheRungsProveFarEnoughAreFree) {
   CLEARWAY_SHARED_ROBOT_OR_SKIP(urdf, "ur5/ur5.urdf");
   auto model = std::make_shared<const RobotModel>(loadRobot(urdf, ""));
-  const RobotGeometry geometry(model);
-  const int a = model->linkIndex("forearm_link"), b = model->linkIndex("wrist_2_link");
-  ASSERT_GE(a, 0);
-  ASSERT_GE(b, 0);
-  const auto table =
-      PairTable::build(*model, a, *geometry.link(a), b, *geometry.link(b), 0.0, GeometryMode::Mesh, Tolerances{});
+  const auto table = tableOf(model, "forearm_link", "wrist_2_link", GeometryMode::Mesh);
   ASSERT_TRUE(table);
   std::mt19937_64 rng(16);
   long unsure = 0;
@@ -176,19 +181,13 @@ TEST(PairTable, CellsTheRungsProveFarEnoughAreFree) {
 TEST(PairTable, APairNearAtEveryStateIsTabulatedPartByPart) {
   CLEARWAY_SHARED_ROBOT_OR_SKIP(urdf, "ur5/ur5.urdf");
   auto model = std::make_shared<const RobotModel>(loadRobot(urdf, ""));
-  const RobotGeometry geometry(model);
-  const int a = model->linkIndex("base_link"), b = model->linkIndex("upper_arm_link");
-  ASSERT_GE(a, 0);
-  ASSERT_GE(b, 0);
-  const auto table =
-      PairTable::build(*model, a, *geometry.link(a), b, *geometry.link(b), 0.0, GeometryMode::Mesh, Tolerances{});
+  const auto table = tableOf(model, "base_link", "upper_arm_link", GeometryMode::Mesh);
   ASSERT_TRUE(table) << "no table for base_link/upper_arm_link";
   std::printf("  base_link/upper_arm_link: %.1f%% of the range certified, %d cells checked\n",
               100.0 * table->certifiedShare(), table->cellsChecked());
   EXPECT_GT(table->certifiedShare(), 0.75);
   // Hull mode cannot split the link: its parts do not hold the hull.
-  const auto hull =
-      PairTable::build(*model, a, *geometry.link(a), b, *geometry.link(b), 0.0, GeometryMode::Hull, Tolerances{});
+  const auto hull = tableOf(model, "base_link", "upper_arm_link", GeometryMode::Hull);
   EXPECT_TRUE(!hull || hull->certifiedShare() < table->certifiedShare());
 }
 
