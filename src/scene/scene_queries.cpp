@@ -173,19 +173,20 @@ bool Scene::environmentFree(const Pose* poses, SceneScratch& ctx, CollisionRepor
     EnclosingBalls& balls = ctx.balls;
     const ClearanceGrid* grid = nullptr;
     const ObstacleBoxes* boxes = nullptr;
-    const auto slackOf = [&](int i, const EnclosingBalls::Placed& bound) {
-      return env.linkSlack(link_padding_[i], bound.center.cwiseAbs().maxCoeff() + bound.radius, options_.tolerances);
+    // The slack a ball is cleared with: the padding, and the narrow phase's band for its coordinates.
+    const auto slackOf = [&](double padding, const Vec3& center, double radius) {
+      return env.linkSlack(padding, center.cwiseAbs().maxCoeff() + radius, options_.tolerances);
     };
     const auto boxCleared = [&](int i) {
       if (balls.ballCount(i) == 0) return false;
       const EnclosingBalls::Placed bound = balls.placed(i, 0);
-      return boxes->ballClear(bound.center, bound.radius, slackOf(i, bound));
+      return boxes->ballClear(bound.center, bound.radius, slackOf(link_padding_[i], bound.center, bound.radius));
     };
     const auto cleared = [&](int i) {
       const int n = balls.ballCount(i);
       if (n == 0) return false;
       const EnclosingBalls::Placed bound = balls.placed(i, 0);
-      const double slack = slackOf(i, bound);
+      const double slack = slackOf(link_padding_[i], bound.center, bound.radius);
       if (grid->lowerBound(bound.center) > bound.radius + slack) return true;
       // (Not in Hull mode, where linkIntersects tests the hull, which the parts' balls need not hold. Nor for
       // closed meshes, which they hold only grown: on the shared robots, whose links are all closed, the
@@ -225,7 +226,7 @@ bool Scene::environmentFree(const Pose* poses, SceneScratch& ctx, CollisionRepor
       const Pose& anchor = poses[body.anchor];
       const Vec3 center = anchor * body.center;
       const double radius = margins::roundedUp(body.radius, body.center.norm() + body.radius + anchor.t.norm());
-      const double slack = env.linkSlack(body.padding, center.cwiseAbs().maxCoeff() + radius, options_.tolerances);
+      const double slack = slackOf(body.padding, center, radius);
       if (boxes && boxes->ballClear(center, radius, slack)) {
         ctx.counters.environment.box_clears += body.count;
         return true;
