@@ -180,8 +180,10 @@ struct Builder {
     // witness is kept for the lookups.
     if (witness && meshesIntersectExactly(up, Pose::identity(), down, t, tol, padding, witness))
       return PairTable::Verdict::Unsure;
-    q.mode = mode;
-    return pair.lowerBound(Pose::identity(), t, tol, q) >= need ? PairTable::Verdict::Free : PairTable::Verdict::Unsure;
+    // Then the triangles within the cell's margin (the parts, whose needs were at most this one, already
+    // failed: climbing the ladder again would only repeat them).
+    return meshesIntersectExactly(up, Pose::identity(), down, t, tol, need) ? PairTable::Verdict::Unsure
+                                                                            : PairTable::Verdict::Free;
   }
 };
 
