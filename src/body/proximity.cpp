@@ -103,13 +103,14 @@ bool exactIntersect(const LinkGeometry& a, const LinkGeometry& b, const Pose& b_
   const std::vector<Triangle>& ta = a.triangles();
   const std::vector<Triangle>& tb = b.triangles();
   if (!ta.empty() && !tb.empty() &&
-      forEachOverlap(a.tree(), b.tree(), b_in_a,
-                     [&](std::int32_t i, std::int32_t j) {
-                       if (!trianglePairIntersects(ta[i], tb[j], b_in_a, tol, padding, slack)) return false;
-                       if (witness) *witness = {i, j};
-                       return true;
-                     },
-                     slack))
+      forEachOverlapDeeperFirst(
+          a.tree(), b.tree(), b_in_a,
+          [&](std::int32_t i, std::int32_t j) {
+            if (!trianglePairIntersects(ta[i], tb[j], b_in_a, tol, padding, slack)) return false;
+            if (witness) *witness = {i, j};
+            return true;
+          },
+          slack))
     return true;
   if (!a.primitives().empty() || !b.primitives().empty()) {
     const Pose a_in_b = b_in_a.inverse();

@@ -421,6 +421,54 @@ TEST(AabbTree, TreeVsTreeTouchingCountsAndEarlyExit) {
   EXPECT_EQ(calls, 1);
 }
 
+// forEachOverlapDeeperFirst: forEachOverlap's pairs, each once, in another order (small trees, and large
+// ones whose descent goes past the ordered unfoldings into the plain depth-first rest); a search that
+// stops does so at a pair it wants, and only where there is one.
+template <bool kFull>
+void checkDeeperFirst(TreeSplit split, int leaf, int boxes, double margin, std::uint64_t seed, int cases) {
+  std::mt19937_64 rng(seed);
+  for (int c = 0; c < cases; ++c) {
+    const std::vector<Aabb> ba = randomBoxes(rng, boxes), bb = randomBoxes(rng, boxes, 0.6);
+    const AabbTree ta(ba, {split, leaf}), tb(bb, {split, leaf});
+    Pose b_in_a;
+    b_in_a.R = randomRotation(rng);
+    b_in_a.t = tree_ref::randomInBall(rng, 1.0);
+    const std::size_t nb = bb.size();
+    std::vector<char> plain(ba.size() * nb, 0), deeper(ba.size() * nb, 0);
+    forEachOverlap<kFull>(
+        ta, tb, b_in_a, [&](int i, int j) { ++plain[i * nb + j]; }, margin);
+    forEachOverlapDeeperFirst<kFull>(
+        ta, tb, b_in_a, [&](int i, int j) { ++deeper[i * nb + j]; }, margin);
+    ASSERT_EQ(plain, deeper) << "case " << c << ": another set of pairs, or one twice";
+    // Stopping at the first pair of a wanted subset: found exactly when the subset meets the pairs.
+    const auto wanted = [&](int i, int j) { return (i * 7 + j * 13 + c) % 29 == 0; };
+    bool any = false;
+    for (std::size_t k = 0; k < plain.size(); ++k) any = any || (plain[k] && wanted(k / nb, k % nb));
+    int stopped_at = -1;
+    const bool stopped = forEachOverlapDeeperFirst<kFull>(
+        ta, tb, b_in_a,
+        [&](int i, int j) {
+          if (!wanted(i, j)) return false;
+          stopped_at = i * static_cast<int>(nb) + j;
+          return true;
+        },
+        margin);
+    ASSERT_EQ(stopped, any) << "case " << c;
+    if (stopped) ASSERT_TRUE(plain[stopped_at] && wanted(stopped_at / nb, stopped_at % nb));
+  }
+}
+
+TEST(AabbTree, DeeperFirstVisitsTheSamePairsAndStopsOnlyAtAWantedOne) {
+  std::uint64_t seed = 700;
+  for (const TreeSplit split : kSplits)
+    for (int leaf = 1; leaf <= AabbTree::kMaxLeafSize; leaf += 2) {
+      SCOPED_TRACE(testing::Message() << "split " << static_cast<int>(split) << " leaf " << leaf);
+      checkDeeperFirst<false>(split, leaf, 50, 0.0, ++seed, 20);
+      checkDeeperFirst<true>(split, leaf, 50, 0.05, ++seed, 10);
+      checkDeeperFirst<true>(split, leaf, 400, 0.0, ++seed, 4);
+    }
+}
+
 TEST(AabbTree, PairsWithinACutoffAndTheNearestPair) {
   // Point items: the box distance is the point distance, known exactly.
   std::mt19937_64 rng(6);

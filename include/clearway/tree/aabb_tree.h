@@ -204,6 +204,132 @@ bool AabbTree::forEachWithinBy(D&& dist, double& cutoff, F&& on_item) const {
   return false;
 }
 
+namespace detail {
+
+// The descent of two trees at once behind forEachOverlap and forEachOverlapDeeperFirst: a pair of nodes
+// whose boxes overlap is unfolded on its larger box, into the child pairs that still overlap.
+template <bool kFullSat, class F>
+struct OverlapDescent {
+  using Node = AabbTree::Node;
+  const OrientedBoxTest test;
+  const Node* na;
+  const Node* nb;
+  const std::int32_t* items_a;
+  const std::int32_t* items_b;
+  const Aabb* boxes_a;
+  const Aabb* boxes_b;
+  F& on_pair;
+
+  OverlapDescent(const AabbTree& a, const AabbTree& b, const Pose& b_in_a, double margin, F& f)
+      : test(b_in_a, margin, treePairScale(a.bounds(), b.bounds(), b_in_a)),
+        na(a.nodes().data()),
+        nb(b.nodes().data()),
+        items_a(a.items().data()),
+        items_b(b.items().data()),
+        boxes_a(a.slotBoxes().data()),
+        boxes_b(b.slotBoxes().data()),
+        on_pair(f) {}
+
+  // Two leaves: their item pairs whose boxes overlap, to on_pair; true when it stops.
+  bool leaves(const Node& x, const Node& y) const {
+    if (x.count == 1 && y.count == 1) return callbackStops(on_pair, items_a[x.first], items_b[y.first]);  // (tested)
+    for (std::int32_t sa = x.first; sa < x.first + x.count; ++sa)
+      for (std::int32_t sb = y.first; sb < y.first + y.count; ++sb)
+        if (!test.template separated<kFullSat>(boxes_a[sa], boxes_b[sb]) &&
+            callbackStops(on_pair, items_a[sa], items_b[sb]))
+          return true;
+    return false;
+  }
+
+  // How much A's box (centre, half widths) and B's placed box overlap, as a share of the larger one's
+  // volume (both as A's axes see them; 0 for flat boxes, which only changes an order).
+  static double overlapShare(const double ca[3], const double ha[3], const OrientedBoxTest::PlacedB& b) noexcept {
+    double common = 1.0, va = 1.0, vb = 1.0;
+    for (int i = 0; i < 3; ++i) {
+      const double lo = std::max(ca[i] - ha[i], b.center[i] - b.reach[i]);
+      const double hi = std::min(ca[i] + ha[i], b.center[i] + b.reach[i]);
+      common *= std::max(hi - lo, 0.0);
+      va *= 2.0 * ha[i];
+      vb *= 2.0 * b.reach[i];
+    }
+    const double larger = std::max(va, vb);
+    return larger > 0.0 ? common / larger : 0.0;
+  }
+
+  // The pair (ia, ib), not two leaves, unfolded: the child pairs whose boxes overlap, in `kids`, in the
+  // order to visit them (the left child's first; kDeeper: of two, the one overlapping by the larger share
+  // first). Returns how many.
+  template <bool kDeeper>
+  int unfold(std::int32_t ia, std::int32_t ib, std::int32_t kids[2][2]) const {
+    const Node& x = na[ia];
+    const Node& y = nb[ib];
+    int n = 0;
+    double share[2];
+    if (!x.isLeaf() && (y.isLeaf() || boxSize(x.box) >= boxSize(y.box))) {
+      const OrientedBoxTest::PlacedB placed = test.place(y.box);  // (placed once for both children)
+      double cc[2][3], ch[2][3];
+      for (std::int32_t c = x.first; c <= x.first + 1; ++c) {
+        OrientedBoxTest::centerHalf(na[c].box, cc[n], ch[n]);
+        if (test.template separated<kFullSat>(cc[n], ch[n], placed)) continue;
+        kids[n][0] = c;
+        kids[n][1] = ib;
+        ++n;
+      }
+      if (kDeeper && n == 2)
+        share[0] = overlapShare(cc[0], ch[0], placed), share[1] = overlapShare(cc[1], ch[1], placed);
+    } else {
+      double ca[3], ha[3];
+      OrientedBoxTest::centerHalf(x.box, ca, ha);
+      OrientedBoxTest::PlacedB placed[2];
+      for (std::int32_t c = y.first; c <= y.first + 1; ++c) {
+        placed[n] = test.place(nb[c].box);
+        if (test.template separated<kFullSat>(ca, ha, placed[n])) continue;
+        kids[n][0] = ia;
+        kids[n][1] = c;
+        ++n;
+      }
+      if (kDeeper && n == 2) share[0] = overlapShare(ca, ha, placed[0]), share[1] = overlapShare(ca, ha, placed[1]);
+    }
+    if (kDeeper && n == 2 && share[1] > share[0]) {
+      std::swap(kids[0][0], kids[1][0]);
+      std::swap(kids[0][1], kids[1][1]);
+    }
+    return n;
+  }
+
+  // Every pair below the roots, depth first in unfold's order (kDeeper for the first kOrdered unfoldings
+  // that find two child pairs: past them, a search that has not stopped is probably one that visits
+  // every pair, which the ordering only slows); true when on_pair stops.
+  template <bool kDeeper>
+  bool descend() const {
+    if (test.template separated<kFullSat>(na[0].box, nb[0].box)) return false;
+    std::int32_t stack[2 * AabbTree::kMaxDepth + 1][2];  // (pairs whose boxes overlap)
+    stack[0][0] = 0;
+    stack[0][1] = 0;
+    int top = 1, ordered = 0;
+    while (top > 0) {
+      --top;
+      const std::int32_t ia = stack[top][0], ib = stack[top][1];
+      if (na[ia].isLeaf() && nb[ib].isLeaf()) {
+        if (leaves(na[ia], nb[ib])) return true;
+        continue;
+      }
+      std::int32_t kids[2][2];
+      const int n = kDeeper && ordered < kOrdered ? unfold<true>(ia, ib, kids) : unfold<false>(ia, ib, kids);
+      ordered += n == 2;
+      for (int k = n - 1; k >= 0; --k) {  // (the first is pushed last: visited first)
+        stack[top][0] = kids[k][0];
+        stack[top][1] = kids[k][1];
+        ++top;
+      }
+    }
+    return false;
+  }
+  static constexpr int kOrdered = 64;
+};
+
+}  // namespace detail
+
 /// Calls on_pair(item_a, item_b) for every item of tree a and item of tree b whose boxes overlap as
 /// oriented boxes (b's frame placed in a's by b_in_a), within `margin` metres and rounding; a pair may
 /// also be reported when its boxes are apart only along an axis the test does not try (the 9 edge axes
@@ -211,64 +337,19 @@ bool AabbTree::forEachWithinBy(D&& dist, double& cutoff, F&& on_item) const {
 /// true stops the descent; the function then returns true.
 template <bool kFullSat = false, class F>
 bool forEachOverlap(const AabbTree& a, const AabbTree& b, const Pose& b_in_a, F&& on_pair, double margin = 0.0) {
-  using Node = AabbTree::Node;
   if (a.empty() || b.empty()) return false;
-  const detail::OrientedBoxTest test(b_in_a, margin, detail::treePairScale(a.bounds(), b.bounds(), b_in_a));
-  const std::vector<Node>& na = a.nodes();
-  const std::vector<Node>& nb = b.nodes();
-  const std::int32_t* items_a = a.items().data();
-  const std::int32_t* items_b = b.items().data();
-  const Aabb* boxes_a = a.slotBoxes().data();
-  const Aabb* boxes_b = b.slotBoxes().data();
-  // The stack holds pairs whose boxes overlap: children are tested before they are pushed, so that the
-  // box kept whole is placed (or, for A, measured) once for both children.
-  std::int32_t stack[2 * AabbTree::kMaxDepth + 1][2];
-  if (test.template separated<kFullSat>(na[0].box, nb[0].box)) return false;
-  stack[0][0] = 0;
-  stack[0][1] = 0;
-  int top = 1;
-  while (top > 0) {
-    --top;
-    const std::int32_t ia = stack[top][0], ib = stack[top][1];
-    const Node& x = na[ia];
-    const Node& y = nb[ib];
-    if (x.isLeaf() && y.isLeaf()) {
-      if (x.count == 1 && y.count == 1) {  // the leaf boxes are the item boxes: already tested
-        if (detail::callbackStops(on_pair, items_a[x.first], items_b[y.first])) return true;
-        continue;
-      }
-      for (std::int32_t sa = x.first; sa < x.first + x.count; ++sa)
-        for (std::int32_t sb = y.first; sb < y.first + y.count; ++sb)
-          if (!test.template separated<kFullSat>(boxes_a[sa], boxes_b[sb]) &&
-              detail::callbackStops(on_pair, items_a[sa], items_b[sb]))
-            return true;
-      continue;
-    }
-    const bool unfold_a = !x.isLeaf() && (y.isLeaf() || detail::boxSize(x.box) >= detail::boxSize(y.box));
-    if (unfold_a) {
-      const detail::OrientedBoxTest::PlacedB placed = test.place(y.box);
-      for (std::int32_t c = x.first + 1; c >= x.first; --c) {  // right pushed first: left is visited first
-        double cc[3], ch[3];
-        detail::OrientedBoxTest::centerHalf(na[c].box, cc, ch);
-        if (!test.template separated<kFullSat>(cc, ch, placed)) {
-          stack[top][0] = c;
-          stack[top][1] = ib;
-          ++top;
-        }
-      }
-    } else {
-      double ca[3], ha[3];
-      detail::OrientedBoxTest::centerHalf(x.box, ca, ha);
-      for (std::int32_t c = y.first + 1; c >= y.first; --c) {
-        if (!test.template separated<kFullSat>(ca, ha, test.place(nb[c].box))) {
-          stack[top][0] = ia;
-          stack[top][1] = c;
-          ++top;
-        }
-      }
-    }
-  }
-  return false;
+  return detail::OverlapDescent<kFullSat, F>(a, b, b_in_a, margin, on_pair).template descend<false>();
+}
+
+/// forEachOverlap's pairs, each once, in another order: where both child pairs of an unfolded pair overlap
+/// (in its first 64 such unfoldings), the one that overlaps by the larger share of its larger box goes
+/// first. A search that stops at the first pair it wants (two meshes that touch) meets it sooner: on random
+/// touching poses of Panda links, after half as many triangle pairs.
+template <bool kFullSat = false, class F>
+bool forEachOverlapDeeperFirst(const AabbTree& a, const AabbTree& b, const Pose& b_in_a, F&& on_pair,
+                               double margin = 0.0) {
+  if (a.empty() || b.empty()) return false;
+  return detail::OverlapDescent<kFullSat, F>(a, b, b_in_a, margin, on_pair).template descend<true>();
 }
 
 /// Calls on_pair(item_a, item_b) for pairs of items whose oriented boxes may be within `cutoff` metres
