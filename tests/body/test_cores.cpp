@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "body/panda_meshes.h"
 #include "shared_data.h"
 #include "tree/mesh_reference.h"
 
@@ -100,11 +101,7 @@ TEST(Cores, LieInsideTheLinksOfRealRobots) {
 TEST(Cores, OverlapOnlyWhereTheReferenceCollides) {
   std::vector<TriangleMesh> meshes{tree_ref::uvSphere(0.1, 10, 16), tree_ref::torus(0.12, 0.03, 20, 10),
                                    tree_ref::gridBox(Vec3(0.05, 0.08, 0.1), 2)};
-  const std::string dir = test::sharedDir() + "/robots/panda/meshes/collision";
-  if (!test::sharedPath("robots/panda/meshes/collision").empty())
-    for (const char* name : {"link5", "link7", "hand"}) meshes.push_back(loadMesh(dir + "/" + name + ".stl", Vec3::Ones()));
-  else if (test::sharedDataRequired())
-    FAIL() << test::sharedMissing("robots/panda/meshes/collision");
+  if (const std::string missing = test::addSharedPandaMeshes(meshes); !missing.empty()) FAIL() << missing;
   std::vector<LinkGeometry> geoms;
   for (const TriangleMesh& m : meshes) geoms.emplace_back(m);
   std::mt19937_64 rng(41);

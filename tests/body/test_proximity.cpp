@@ -5,7 +5,6 @@
 // first contact, and bad input is never "far"; partsApart holds each part to its own need.
 #include <clearway/body/proximity.h>
 #include <clearway/tree/aabb_tree.h>
-#include <clearway/load/mesh_loader.h>
 
 #include <gtest/gtest.h>
 
@@ -17,7 +16,7 @@
 #include <utility>
 #include <vector>
 
-#include "shared_data.h"
+#include "body/panda_meshes.h"
 #include "tree/mesh_reference.h"
 
 namespace clearway {
@@ -425,20 +424,12 @@ TEST(BodyPair, NeverFarByAccident) {
   EXPECT_TRUE(pair.distance(Pose(), Pose::translation(Vec3(5, 0, 0)), tol, cut).mayCollide());
 }
 
-// partsApart: each of b's parts is held to its own need (a far part may move farther than a near one), a
-// true answer never claims more than the brute-force distance, a link inside a closed mesh is never apart,
-// and bad input is never apart.
 // Two meshes that touch: the triangle search (forEachOverlapDeeperFirst, the node pairs that overlap most
 // first) meets a pair of triangles that touch after fewer pairs than plain depth first, summed over random
 // colliding poses of Panda links and generated meshes (the order changes no answer: the tests above).
 TEST(BodyPair, TheTriangleSearchMeetsATouchingPairSooner) {
   std::vector<TriangleMesh> meshes{tree_ref::uvSphere(0.1, 10, 16), tree_ref::torus(0.12, 0.03, 20, 10)};
-  const std::string dir = test::sharedDir() + "/robots/panda/meshes/collision";
-  if (!test::sharedPath("robots/panda/meshes/collision").empty())
-    for (const char* name : {"link5", "link7", "hand"})
-      meshes.push_back(loadMesh(dir + "/" + name + ".stl", Vec3::Ones()));
-  else if (test::sharedDataRequired())
-    FAIL() << test::sharedMissing("robots/panda/meshes/collision");
+  if (const std::string missing = test::addSharedPandaMeshes(meshes); !missing.empty()) FAIL() << missing;
   std::vector<LinkGeometry> geoms;
   for (const TriangleMesh& m : meshes) geoms.emplace_back(m);
   std::mt19937_64 rng(43);
@@ -474,6 +465,9 @@ TEST(BodyPair, TheTriangleSearchMeetsATouchingPairSooner) {
   EXPECT_LT(deeper_visits, plain_visits);
 }
 
+// partsApart: each of b's parts is held to its own need (a far part may move farther than a near one), a
+// true answer never claims more than the brute-force distance, a link inside a closed mesh is never apart,
+// and bad input is never apart.
 TEST(PartsApart, EachPartAgainstItsOwnNeed) {
   const Tolerances tol;
   // A dumbbell: a ball at the origin and a cube 0.2 along x. A plate 0.05 beyond the cube's far face (and
