@@ -252,9 +252,6 @@ bool coreInPrimitive(const LinkGeometry& a, const LinkGeometry& b, const Pose& b
   return false;
 }
 
-}  // namespace
-
-namespace {
 // Past this many triangles in either link, a pair the hulls and cores leave is screened by its convex parts
 // before the triangle search, which near a fine mesh visits a great many triangles. Below it the search is
 // cheap, and a pair that touches would pay the parts for nothing (on the shared Panda's self-colliding
