@@ -4,6 +4,7 @@
 #include <limits>
 #include <sstream>
 
+#include "kinematics/pose_lanes.h"
 #include "kinematics/sincos.h"
 
 namespace clearway {
@@ -125,7 +126,12 @@ void computeLinkPose(const RobotModel& model, const double* q, Pose* link_poses,
 
 void computeLinkPoses(const RobotModel& model, const double* q, Pose* link_poses) noexcept {
   link_poses[0] = Pose::identity();
-  for (int i = 1; i < model.linkCount(); ++i) computeLinkPose(model, q, link_poses, i);
+  detail::computeLinksInLanes(model, q, link_poses, nullptr, 1, model.linkCount() - 1);
+}
+
+void computeLinkPoses(const RobotModel& model, const double* q, Pose* link_poses, const int* links,
+                      int count) noexcept {
+  detail::computeLinksInLanes(model, q, link_poses, links, 0, count);
 }
 
 bool validateJointVector(const RobotModel& model, const double* q, std::string* why) {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstddef>
 
+#include "kinematics/pose_lanes.h"
 #include "kinematics/sincos.h"
 
 #include "detail/simd_targets.h"
@@ -158,6 +159,106 @@ void ComputePass(const RobotModel& model, const double* const* q, int n, Pose* c
   }
 }
 
+// One state's links (links[k] for k < count, or first + k when links is null), each after its parent: a
+// column of a pose's R, or its t, is one vector of four lanes (rows 0..2 and a spare), the sines and
+// cosines four joints at a time, every operation computeLinkPose's in its order, so the poses are its own
+// bit for bit. Targets with fewer than four lanes of doubles (SSE4, the portable ones) gain nothing by it
+// and take computeLinkPose itself.
+template <class D>
+void ComputeLinks(D d, const RobotModel& model, const double* q, Pose* poses, const int* links, int first, int count) {
+  using Kind = detail::KinematicStep::Kind;
+  using V = hn::Vec<D>;
+  constexpr int kBlock = 32;            // links per pass: their columns stay in `cols` for their children
+  alignas(32) double cols[kBlock][16];  // per link of the pass: R's three columns, then t, four doubles each
+  alignas(32) double value[kBlock + 4], sine[kBlock + 4], cosine[kBlock + 4];
+  const auto link = [&](int k) { return links ? links[k] : first + k; };
+  for (int begin = 0; begin < count; begin += kBlock) {
+    const int end = count - begin < kBlock ? count : begin + kBlock;
+    int turns = 0;
+    for (int k = begin; k < end; ++k) {
+      const detail::KinematicStep& st = model.kinematicStep(link(k));
+      if (st.kind == Kind::TurnZ || st.kind == Kind::Turn) value[turns++] = st.value(q);
+    }
+    for (int j = turns; j < turns + 4; ++j) value[j] = 0.0;  // (the last vector's spare lanes)
+    for (int j = 0; j < turns; j += 4) SinCosLanes(d, value + j, sine + j, cosine + j);
+    int turn = 0;
+    for (int k = begin; k < end; ++k) {
+      const int i = link(k);
+      const detail::KinematicStep& st = model.kinematicStep(i);
+      double* out = cols[k - begin];
+      Pose& pose = poses[i];
+      if (st.kind == Kind::Other) {  // planar and floating joints: the scalar step
+        computeLinkPose(model, q, poses, i);
+        for (int c = 0; c < 3; ++c)
+          for (int r = 0; r < 3; ++r) out[4 * c + r] = pose.R.data()[3 * c + r];
+        for (int r = 0; r < 3; ++r) out[12 + r] = pose.t[r];
+        continue;
+      }
+      // The parent's columns: where this pass computed it, from `cols`; else from its pose (the load of t
+      // reads the next pose's first double into the spare lane: parent < i, so that pose exists).
+      const double* from = nullptr;
+      for (int j = k - 1; j >= begin && !from; --j)
+        if (link(j) == st.parent) from = cols[j - begin];
+      V P0, P1, P2, Pt;
+      if (from) {
+        P0 = hn::Load(d, from), P1 = hn::Load(d, from + 4), P2 = hn::Load(d, from + 8), Pt = hn::Load(d, from + 12);
+      } else {
+        const Pose& p = poses[st.parent];
+        P0 = hn::LoadU(d, p.R.data()), P1 = hn::LoadU(d, p.R.data() + 3), P2 = hn::LoadU(d, p.R.data() + 6);
+        Pt = hn::LoadU(d, p.t.data());
+      }
+      // parent · origin, as computeLinkPose's place(): M = P·O; t = P·(origin.t + shift) + parent.t.
+      const double* O = st.origin.R.data();
+      const auto column = [&](int c) HWY_ATTR {
+        return hn::Add(hn::Add(hn::Mul(P0, hn::Set(d, O[3 * c])), hn::Mul(P1, hn::Set(d, O[3 * c + 1]))),
+                       hn::Mul(P2, hn::Set(d, O[3 * c + 2])));
+      };
+      const V M0 = column(0), M1 = column(1), M2 = column(2);
+      double o[3];
+      if (st.kind == Kind::Slide) {
+        const double v = st.value(q);
+        for (int r = 0; r < 3; ++r) o[r] = st.origin.t[r] + v * st.axis[r];
+      } else {
+        for (int r = 0; r < 3; ++r) o[r] = st.origin.t[r] + 0.0;  // (the scalar adds a zero shift)
+      }
+      const V T = hn::Add(
+          hn::Add(hn::Add(hn::Mul(P0, hn::Set(d, o[0])), hn::Mul(P1, hn::Set(d, o[1]))), hn::Mul(P2, hn::Set(d, o[2]))),
+          Pt);
+      V R0 = M0, R1 = M1, R2 = M2;
+      if (st.kind == Kind::TurnZ) {  // only M's first two columns turn
+        const V c = hn::Set(d, cosine[turn]), s = hn::Set(d, sine[turn] * st.axis_sign);
+        ++turn;
+        R0 = hn::Add(hn::Mul(c, M0), hn::Mul(s, M1));
+        R1 = hn::Sub(hn::Mul(c, M1), hn::Mul(s, M0));
+      } else if (st.kind == Kind::Turn) {  // M·Rot(u) = c·M + s·M[u]× + (1 − c)·(M u) uᵀ
+        const double cv = cosine[turn];
+        const V c = hn::Set(d, cv), s = hn::Set(d, sine[turn]);
+        ++turn;
+        const V ux = hn::Set(d, st.axis[0]), uy = hn::Set(d, st.axis[1]), uz = hn::Set(d, st.axis[2]);
+        const V w = hn::Mul(hn::Set(d, 1.0 - cv), hn::Add(hn::Add(hn::Mul(M0, ux), hn::Mul(M1, uy)), hn::Mul(M2, uz)));
+        R0 = hn::Add(hn::Add(hn::Mul(c, M0), hn::Mul(s, hn::Sub(hn::Mul(uz, M1), hn::Mul(uy, M2)))), hn::Mul(ux, w));
+        R1 = hn::Add(hn::Add(hn::Mul(c, M1), hn::Mul(s, hn::Sub(hn::Mul(ux, M2), hn::Mul(uz, M0)))), hn::Mul(uy, w));
+        R2 = hn::Add(hn::Add(hn::Mul(c, M2), hn::Mul(s, hn::Sub(hn::Mul(uy, M0), hn::Mul(ux, M1)))), hn::Mul(uz, w));
+      }
+      hn::Store(R0, d, out), hn::Store(R1, d, out + 4), hn::Store(R2, d, out + 8), hn::Store(T, d, out + 12);
+      // Into the pose: each column's spare lane lands on the next column's first double, overwritten by the
+      // next store; t's three by hand (a fourth would write past the pose).
+      double* R = pose.R.data();
+      hn::StoreU(R0, d, R), hn::StoreU(R1, d, R + 3), hn::StoreU(R2, d, R + 6);
+      pose.t[0] = out[12], pose.t[1] = out[13], pose.t[2] = out[14];
+    }
+  }
+}
+
+void ComputeOne(const RobotModel& model, const double* q, Pose* poses, const int* links, int first, int count) {
+  const hn::CappedTag<double, 4> d;
+  if (hn::MaxLanes(d) < 4) {
+    for (int k = 0; k < count; ++k) computeLinkPose(model, q, poses, links ? links[k] : first + k);
+    return;
+  }
+  ComputeLinks(d, model, q, poses, links, first, count);
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace clearway
 HWY_AFTER_NAMESPACE();
@@ -168,6 +269,16 @@ namespace clearway {
 HWY_EXPORT(LaneCount);
 HWY_EXPORT(TargetName);
 HWY_EXPORT(ComputePass);
+HWY_EXPORT(ComputeOne);
+
+namespace detail {
+
+void computeLinksInLanes(const RobotModel& model, const double* q, Pose* poses, const int* links, int first,
+                         int count) noexcept {
+  HWY_DYNAMIC_DISPATCH(ComputeOne)(model, q, poses, links, first, count);
+}
+
+}  // namespace detail
 
 KinematicLanes::KinematicLanes(const RobotModel& model)
     : model_(&model), lanes_(static_cast<std::size_t>(12 * model.linkCount() * kMaxLanes), 0.0) {

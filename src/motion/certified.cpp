@@ -120,10 +120,14 @@ struct MotionChecker::Sweep {
     }
     const RobotModel& model = mc.scene_->robot();
     Pose* poses = ctx.poses.data();
-    for (int l = link; l > 0 && ctx.pose_stamp[l] != ctx.step_stamp; l = model.parentLink(l)) ctx.pose_path.push_back(l);
-    for (; !ctx.pose_path.empty(); ctx.pose_path.pop_back()) {
-      computeLinkPose(model, ctx.full_q.data(), poses, ctx.pose_path.back());
-      ctx.pose_stamp[ctx.pose_path.back()] = ctx.step_stamp;
+    for (int l = link; l > 0 && ctx.pose_stamp[l] != ctx.step_stamp; l = model.parentLink(l)) {
+      ctx.pose_path.push_back(l);
+      ctx.pose_stamp[l] = ctx.step_stamp;
+    }
+    if (!ctx.pose_path.empty()) {  // (root first)
+      std::reverse(ctx.pose_path.begin(), ctx.pose_path.end());
+      computeLinkPoses(model, ctx.full_q.data(), poses, ctx.pose_path.data(), static_cast<int>(ctx.pose_path.size()));
+      ctx.pose_path.clear();
     }
     return poses[link];
   }

@@ -13,6 +13,7 @@
 
 #include "forced_target.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -29,11 +30,23 @@ bool sameBits(double a, double b) {
   return std::isnan(a) ? std::isnan(b) : std::memcmp(&a, &b, sizeof a) == 0;
 }
 
-// Every pose of every state of `states` from the lanes equals the scalar one, on every target.
+// Every pose of every state of `states` from the lanes, across states (KinematicLanes) and across a pose's
+// rows (computeLinkPoses), equals the scalar step's (computeLinkPose, link by link), on every target.
 void expectLanesEqualScalar(const RobotModel& m, const std::vector<std::vector<double>>& states, const std::string& what) {
   const int n = static_cast<int>(states.size());
   std::vector<std::vector<Pose>> scalar(n, std::vector<Pose>(m.linkCount()));
-  for (int s = 0; s < n; ++s) computeLinkPoses(m, states[s].data(), scalar[s].data());
+  for (int s = 0; s < n; ++s)
+    for (int i = 1; i < m.linkCount(); ++i) computeLinkPose(m, states[s].data(), scalar[s].data(), i);
+  const auto same = [&](const Pose& a, const Pose& b, const std::string& where) -> ::testing::AssertionResult {
+    for (int k = 0; k < 9; ++k)
+      if (!sameBits(a.R.data()[k], b.R.data()[k]))
+        return ::testing::AssertionFailure()
+               << where << ", R[" << k << "] = " << a.R.data()[k] << " vs " << b.R.data()[k];
+    for (int k = 0; k < 3; ++k)
+      if (!sameBits(a.t[k], b.t[k]))
+        return ::testing::AssertionFailure() << where << ", t[" << k << "] = " << a.t[k] << " vs " << b.t[k];
+    return ::testing::AssertionSuccess();
+  };
   std::vector<const double*> q(n);
   for (int s = 0; s < n; ++s) q[s] = states[s].data();
   const std::vector<std::int64_t> targets = KinematicLanes::targets();
@@ -43,6 +56,31 @@ void expectLanesEqualScalar(const RobotModel& m, const std::vector<std::vector<d
     ASSERT_STREQ(KinematicLanes::targetName(), hwy::TargetName(target));
     const int w = KinematicLanes::width();
     ASSERT_TRUE(w >= 1 && w <= KinematicLanes::kMaxLanes) << w;
+    // One state at a time: every link, and the chain down to each link (from the root, and from its
+    // grandparent with the links above it already placed).
+    for (int s = 0; s < n; ++s) {
+      const std::string at = what + ", target " + hwy::TargetName(target) + ", state " + std::to_string(s);
+      std::vector<Pose> all(m.linkCount());
+      computeLinkPoses(m, states[s].data(), all.data());
+      for (int i = 0; i < m.linkCount(); ++i) ASSERT_TRUE(same(all[i], scalar[s][i], at + ", link " + m.link(i).name));
+      for (int i = 1; i < m.linkCount(); ++i) {
+        std::vector<int> chain;
+        for (int l = i; l > 0; l = m.kinematicStep(l).parent) chain.insert(chain.begin(), l);
+        for (const std::size_t from : {std::size_t{0}, chain.size() > 2 ? chain.size() - 2 : std::size_t{0}}) {
+          std::vector<Pose> some(m.linkCount(), Pose{Mat3::Constant(-7.0), Vec3::Constant(-7.0)});
+          for (std::size_t k = 0; k < from; ++k) some[chain[k]] = scalar[s][chain[k]];
+          some[0] = Pose::identity();
+          computeLinkPoses(m, states[s].data(), some.data(), chain.data() + from,
+                           static_cast<int>(chain.size() - from));
+          for (int l = 0; l < m.linkCount(); ++l) {
+            const bool placed = l == 0 || std::find(chain.begin(), chain.end(), l) != chain.end();
+            const Pose& want =
+                placed ? scalar[s][l] : Pose{Mat3::Constant(-7.0), Vec3::Constant(-7.0)};  // (or untouched)
+            ASSERT_TRUE(same(some[l], want, at + ", chain to " + m.link(i).name + ", link " + m.link(l).name));
+          }
+        }
+      }
+    }
     KinematicLanes lanes(m);
     // Batches of every length up to two passes and one: full passes and a partial last one.
     for (int count = 1; count <= std::min(n, 2 * w + 1); ++count) {

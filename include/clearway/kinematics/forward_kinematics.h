@@ -28,6 +28,11 @@ void computeLinkPoses(const RobotModel& model, const double* q, Pose* link_poses
 /// step of computeLinkPoses, for callers that need a few links only.
 void computeLinkPose(const RobotModel& model, const double* q, Pose* link_poses, int i) noexcept;
 
+/// Writes the poses of links[0 .. count), in that order, each from its parent's (earlier in the list or
+/// already in link_poses, which holds every link's): the bits computeLinkPose gives, in SIMD lanes where
+/// the CPU has four of doubles (a pose's rows side by side, four joints' sines at once).
+void computeLinkPoses(const RobotModel& model, const double* q, Pose* link_poses, const int* links, int count) noexcept;
+
 /// The frames u, v of a planar joint's plane: with the unit axis n, (u, v, n) is right-handed.
 void planarBasis(const Vec3& axis, Vec3* u, Vec3* v) noexcept;
 
