@@ -484,33 +484,16 @@ PairTable::Verdict PairTable::lookup(const double* q, TrianglePair* witness) con
   return fine_cells_[e + at];
 }
 
-}  // namespace clearway
-
-namespace clearway {
-
-PairTable::Verdict PairTable::fineCell(const int* c) const noexcept {
-  const int dims = static_cast<int>(var_.size());
-  int cell = 0, at = 0, stride = 1, fine_stride = 1;
-  for (int k = 0; k < dims; ++k) {
-    cell += c[k] / fine_ * stride;
-    at += c[k] % fine_ * fine_stride;
-    stride *= n_[k];
-    fine_stride *= fine_;
-  }
-  const std::int32_t e = coarse_[cell];
-  return e < 0 ? static_cast<Verdict>(-1 - e) : fine_cells_[e + at];
-}
-
 bool PairTable::freeAlong(const double* q0, const double* q1) const noexcept {
-  // A walk through the fine cells the segment crosses (Amanatides–Woo), in fine-cell units; a turn is
-  // walked unrolled, its cells taken modulo the turn. A crossing misordered by rounding near a corner
-  // visits a neighbour of the cell it skips, within far less than the slack every cell's check added.
+  // A walk through the coarse cells the segment crosses (Amanatides–Woo), in coarse-cell units, and through
+  // the fine cells it crosses within each refined one; a turn is walked unrolled, its cells taken modulo the
+  // turn. A crossing misordered by rounding near a corner visits a neighbour of the cell it skips, within
+  // far less than the slack every cell's check added.
   const int dims = static_cast<int>(var_.size());
   double u[2] = {0.0, 0.0}, d[2] = {0.0, 0.0}, next[2], delta[2];
-  int c[2] = {0, 0}, step[2] = {0, 0}, cells[2] = {1, 1};
-  long budget = 2;  // cells the walk may visit: those between its ends, plus its first
+  int c[2] = {0, 0}, step[2] = {0, 0};
+  long budget = 2;  // coarse cells the walk may visit: those between its ends, plus its first
   for (int k = 0; k < dims; ++k) {
-    cells[k] = n_[k] * fine_;
     double a = q0[var_[k]], b = q1[var_[k]];
     if (periodic_[k]) {
       if (!(std::abs(a) <= kMaxTurn && std::abs(b) <= kMaxTurn)) return false;
@@ -520,9 +503,8 @@ bool PairTable::freeAlong(const double* q0, const double* q1) const noexcept {
     } else if (!(a >= lo_[k] && a <= lo_[k] + n_[k] / inv_[k] && b >= lo_[k] && b <= lo_[k] + n_[k] / inv_[k])) {
       return false;  // (the segment lies within the range when its ends do)
     }
-    const double scale = inv_[k] * fine_;
-    u[k] = (a - lo_[k]) * scale;
-    d[k] = (b - a) * scale;
+    u[k] = (a - lo_[k]) * inv_[k];
+    d[k] = (b - a) * inv_[k];
     if (!std::isfinite(u[k]) || !std::isfinite(d[k])) return false;
     const double start = std::floor(u[k]);
     c[k] = static_cast<int>(start);
@@ -539,21 +521,68 @@ bool PairTable::freeAlong(const double* q0, const double* q1) const noexcept {
     }
     budget += static_cast<long>(std::abs(std::floor(u[k] + d[k]) - start)) + 1;
   }
-  if (budget > 64L * (cells[0] + cells[1])) return false;  // many turns: not worth the walk
+  if (budget > 64L * (n_[0] + (dims == 2 ? n_[1] : 0))) return false;  // many turns: not worth the walk
+  double t_in = 0.0;                                                   // where the segment enters the coarse cell c
   for (; budget > 0; --budget) {
-    int at[2];
-    for (int k = 0; k < 2; ++k) {
-      at[k] = k < dims ? c[k] % cells[k] : 0;
-      if (at[k] < 0) at[k] += cells[k];
-      if (k < dims && !periodic_[k]) at[k] = std::clamp(c[k], 0, cells[k] - 1);  // an end on the far border
+    int cell = 0, stride = 1;
+    int walked[2] = {0, 0};  // c, but a range's end on its far border in the last cell
+    for (int k = 0; k < dims; ++k) {
+      int at = c[k] % n_[k];
+      if (at < 0) at += n_[k];
+      walked[k] = c[k];
+      if (!periodic_[k]) at = walked[k] = std::clamp(c[k], 0, n_[k] - 1);
+      cell += at * stride;
+      stride *= n_[k];
     }
-    if (fineCell(at) != Verdict::Free) return false;
     const int k = dims == 2 && next[1] < next[0] ? 1 : 0;
+    const double t_out = std::min(next[k], 1.0);
+    const std::int32_t e = coarse_[cell];
+    if (e < 0 ? static_cast<Verdict>(-1 - e) != Verdict::Free : !fineFreeAlong(e, walked, u, d, t_in, t_out))
+      return false;
     if (!(next[k] <= 1.0)) return true;  // the walk reached q1's cell
     c[k] += step[k];
+    t_in = next[k];
     next[k] += delta[k];
   }
   return false;  // (rounding took more steps than the cells between the ends: not proved)
+}
+
+bool PairTable::fineFreeAlong(std::int32_t e, const int* c, const double* u, const double* d, double t_in,
+                              double t_out) const noexcept {
+  // The same walk in fine-cell units, from where the segment enters coarse cell c (unrolled) until it leaves
+  // it, its fine cells clamped into c's.
+  const int dims = static_cast<int>(var_.size());
+  double uf[2], next[2] = {INFINITY, INFINITY}, delta[2] = {INFINITY, INFINITY};
+  int f[2] = {0, 0}, step[2] = {0, 0}, first[2] = {0, 0};
+  for (int k = 0; k < dims; ++k) {
+    uf[k] = u[k] * fine_;
+    const double df = d[k] * fine_;
+    first[k] = c[k] * fine_;
+    f[k] = std::clamp(static_cast<int>(std::floor(uf[k] + df * t_in)), first[k], first[k] + fine_ - 1);
+    if (df > 0.0) {
+      step[k] = 1;
+      next[k] = (f[k] + 1.0 - uf[k]) / df;
+      delta[k] = 1.0 / df;
+    } else if (df < 0.0) {
+      step[k] = -1;
+      next[k] = (uf[k] - f[k]) / -df;
+      delta[k] = -1.0 / df;
+    }
+  }
+  for (int left = 2 * fine_ + 2; left > 0; --left) {  // (a walk within one coarse cell crosses 2·fine_ at most)
+    int at = 0, stride = 1;
+    for (int k = 0; k < dims; ++k) {
+      at += (f[k] - first[k]) * stride;
+      stride *= fine_;
+    }
+    if (fine_cells_[e + at] != Verdict::Free) return false;
+    const int k = dims == 2 && next[1] < next[0] ? 1 : 0;
+    if (!(next[k] < t_out)) return true;  // it leaves the coarse cell first
+    f[k] += step[k];
+    if (f[k] < first[k] || f[k] >= first[k] + fine_) return true;
+    next[k] += delta[k];
+  }
+  return false;
 }
 
 }  // namespace clearway

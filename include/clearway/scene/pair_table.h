@@ -112,8 +112,10 @@ class PairTable {
   PairTable() = default;
   // Cell coordinates of variable k's value x (in coarse cells), or −1 when outside the table.
   double coordinate(int k, double x) const noexcept;
-  // The verdict of fine cell (c[0], c[1]) (fine cells per dimension: n_[k]·fine_, each index in range).
-  Verdict fineCell(const int* c) const noexcept;
+  // freeAlong's walk through the fine cells of refined coarse cell c (unrolled coordinates; its fine cells
+  // from fine_cells_[e]) that the segment u + s·d (coarse units) crosses for s in [t_in, t_out].
+  bool fineFreeAlong(std::int32_t e, const int* c, const double* u, const double* d, double t_in,
+                     double t_out) const noexcept;
 
   std::vector<int> var_;          // per dimension: the variable
   std::vector<char> periodic_;    // per dimension: a full turn (values reduced to [−π, π])
