@@ -94,7 +94,11 @@ struct MotionChecker::Sweep {
       return true;
     }
   }
-  double at_s = -1.0;  // the parameter ctx.full_q holds
+  // The parameter each pose slot holds (−1: none), the steps they were placed at, the slot last placed or
+  // looked up, and the slot the next new parameter takes (the one placed longest ago).
+  double slot_s[motion_detail::Scratch::kPoseSlots] = {-1.0, -1.0, -1.0, -1.0};
+  std::uint64_t slot_step[motion_detail::Scratch::kPoseSlots] = {};
+  int slot = 0, next_slot = 0;
   // The last measurement's self item whose hulls' GJK axis separates them (splitClearances), −1: none.
   static constexpr std::size_t kSplit = 8;
   int split_item = -1;
@@ -102,34 +106,66 @@ struct MotionChecker::Sweep {
 
   Sweep(const MotionChecker& checker, motion_detail::Scratch& c, MotionResult& result, const double* from, const double* to)
       : mc(checker), ctx(c), r(result), q0(from), q1(to) {
-    ctx.poses[0] = Pose::identity();
+    for (std::vector<Pose>& p : ctx.poses) p[0] = Pose::identity();
   }
 
   // The time at parameter s.
   double time(double s) const noexcept { return t0 + s * (t1 - t0); }
 
-  // The link's pose (and its ancestors') at parameter s.
+  // The link's pose (and its ancestors') at parameter s, in the slot that holds s (placed there if none
+  // does), which becomes `slot`.
   const Pose& pose(double s, int link) {
-    if (s != at_s) {
-      mc.interpolate(q0, q1, s, ctx.q.data());
-      const std::vector<int>& group = mc.scene_->groupVariables();
-      for (std::size_t i = 0; i < group.size(); ++i) ctx.full_q[group[i]] = ctx.q[i];
-      ++ctx.step_stamp;
-      ++r.steps;
-      at_s = s;
+    if (s != slot_s[slot]) {
+      int k = 0;
+      while (k < motion_detail::Scratch::kPoseSlots && slot_s[k] != s) ++k;
+      if (k == motion_detail::Scratch::kPoseSlots) {
+        k = next_slot;
+        next_slot = (next_slot + 1) % motion_detail::Scratch::kPoseSlots;
+        mc.interpolate(q0, q1, s, ctx.q.data());
+        const std::vector<int>& group = mc.scene_->groupVariables();
+        for (std::size_t i = 0; i < group.size(); ++i) ctx.full_q[k][group[i]] = ctx.q[i];
+        slot_step[k] = ++ctx.step_stamp;
+        slot_s[k] = s;
+        ++r.steps;
+      }
+      slot = k;
     }
     const RobotModel& model = mc.scene_->robot();
-    Pose* poses = ctx.poses.data();
-    for (int l = link; l > 0 && ctx.pose_stamp[l] != ctx.step_stamp; l = model.parentLink(l)) {
+    Pose* poses = ctx.poses[slot].data();
+    std::uint64_t* stamp = ctx.pose_stamp[slot].data();
+    for (int l = link; l > 0 && stamp[l] != slot_step[slot]; l = model.parentLink(l)) {
       ctx.pose_path.push_back(l);
-      ctx.pose_stamp[l] = ctx.step_stamp;
+      stamp[l] = slot_step[slot];
     }
     if (!ctx.pose_path.empty()) {  // (root first)
       std::reverse(ctx.pose_path.begin(), ctx.pose_path.end());
-      computeLinkPoses(model, ctx.full_q.data(), poses, ctx.pose_path.data(), static_cast<int>(ctx.pose_path.size()));
+      computeLinkPoses(model, ctx.full_q[slot].data(), poses, ctx.pose_path.data(),
+                       static_cast<int>(ctx.pose_path.size()));
       ctx.pose_path.clear();
     }
     return poses[link];
+  }
+
+  // The poses of the parameter last measured at (its item's links and their ancestors placed).
+  const Pose* measuredPoses() const noexcept { return ctx.poses[slot].data(); }
+
+  // Where to measure [a, b]: its midpoint; but for a checker of many items, the coarsest dyadic fraction
+  // in its middle half (the nearest such to the midpoint), so that items whose intervals differ share
+  // parameters and so poses (the dual arm's 562 items: 16% fewer instructions per free segment, 10% per
+  // colliding one). Not for a few items, which share little: there it moved the Panda's colliding segments
+  // onto the quarters the probe had checked already, 6-10% dearer. The midpoint when the interval is too
+  // narrow for a fraction of 2^-40.
+  static constexpr std::size_t kAlignedItems = 64;
+  double measuringPoint(double a, double b) const noexcept {
+    const double w = b - a, lo = a + 0.25 * w, hi = b - 0.25 * w, mid = 0.5 * (a + b);
+    if (mc.items_.size() <= kAlignedItems) return mid;
+    for (double step = 0.5; step >= 0x1p-40 && w > 0.0; step *= 0.5) {  // (≤ 40 halvings: the loop ends)
+      const double first = std::ceil(lo / step) * step;                 // (exact: step is a power of two)
+      if (!(first <= hi)) continue;
+      const double last = std::floor(hi / step) * step;
+      return std::clamp(std::round(mid / step) * step, first, last);
+    }
+    return mid;
   }
 
   // One item's warm starts, the block of n at `slot` in `all` (none for −1), emptied when this segment
@@ -186,7 +222,7 @@ struct MotionChecker::Sweep {
 
   // True when the state at s collides as the validity checker sees it (then `report` says what).
   bool stateCollides(double s, CollisionReport& report) {
-    at_s = -1.0;  // (the check overwrites the poses the sweep keeps)
+    for (double& at : slot_s) at = -1.0;  // (the check overwrites ctx.q: each slot is placed again)
     ++r.steps;
     return motion_detail::stateCollides(mc, q0, q1, s, time(s), ctx, report);
   }
@@ -286,8 +322,8 @@ struct MotionChecker::Sweep {
     const std::vector<LinkGeometry::Part>& parts_a = it.ga->parts();
     const std::vector<LinkGeometry::Part>& parts_b = it.gb->parts();
     if (!cache.valid || parts_a.size() > kSplit || parts_b.size() > kSplit) return false;
-    const Pose& pa = ctx.poses[it.frame_a];  // (as measured)
-    const Pose& pb = ctx.poses[it.frame_b];
+    const Pose& pa = measuredPoses()[it.frame_a];
+    const Pose& pb = measuredPoses()[it.frame_b];
     const Vec3 u_a = -cache.axis.normalized();  // A towards B, in A's frame
     const Vec3 u = pa.R * u_a, u_b = pb.R.transpose() * u;
     if (!u.allFinite()) return false;
@@ -320,7 +356,7 @@ struct MotionChecker::Sweep {
   double reach(int k, double d, double want) {
     const Item& it = mc.items_[k];
     const double* dq = ctx.dq.data();
-    const Pose* poses = ctx.poses.data();  // (at the parameter d was measured at)
+    const Pose* poses = measuredPoses();  // (at the parameter d was measured at)
     // The static bound first: where it reaches as far as asked, the reaches from the axes now are not needed.
     double h = d / ctx.bound[k];  // (∞ when the item does not move)
     if (std::isnan(h)) h = d == INFINITY ? INFINITY : 0.0;  // (∞ / ∞: nothing near, and an unbounded motion)
@@ -368,8 +404,8 @@ struct MotionChecker::Sweep {
       ctx.intervals.pop_back();
       const double hi = std::min(iv.b, limit);
       if (iv.a > hi || (hit && iv.a >= hi)) continue;
-      const double m = 0.5 * (iv.a + hi);
-      const double d = measureItem(k, m, ctx.bound[k] * 0.5 * (hi - iv.a), report);
+      const double m = measuringPoint(iv.a, hi);
+      const double d = measureItem(k, m, ctx.bound[k] * std::max(m - iv.a, hi - m), report);
       if (d <= contactOf(k, m)) {
         if (it.last > it.first) {  // a group within contact: its members take over here, exactly
           for (int member = it.first; member < it.last && !stop(); ++member) {

@@ -274,8 +274,11 @@ MotionContext MotionChecker::makeContext() const {
   motion_detail::Scratch& c = *scratch;
   c.owner = serial_;
   c.scene = scene_->makeContext();
-  c.full_q = c.scene.jointValues();
-  c.poses.resize(scene_->robot().linkCount());
+  for (int k = 0; k < motion_detail::Scratch::kPoseSlots; ++k) {
+    c.full_q[k] = c.scene.jointValues();
+    c.poses[k].resize(scene_->robot().linkCount());
+    c.pose_stamp[k].assign(scene_->robot().linkCount(), 0);
+  }
   c.q.resize(scene_->dimension());
   c.dq.resize(scene_->dimension());
   c.safe_until.resize(items_.size());
@@ -302,7 +305,6 @@ MotionContext MotionChecker::makeContext() const {
     c.env_cache.resize(env_items * obstacles);
   }
   c.probe_states.resize(static_cast<std::size_t>(motion_detail::kProbes) * scene_->dimension());
-  c.pose_stamp.assign(scene_->robot().linkCount(), 0);
   c.pose_path.reserve(scene_->robot().linkCount());
   c.intervals.reserve(256);
   if (options_.mode == MotionMode::Cast) c.end_poses.resize(scene_->robot().linkCount());
@@ -348,7 +350,7 @@ MotionResult MotionChecker::check(const double* q0, double t0, const double* q1,
   // that checker's items', perhaps freed with it) does not fit: refused.
   const std::size_t dim = static_cast<std::size_t>(scene_->dimension());
   if (ctx.owner != serial_ || ctx.safe_until.size() != items_.size() ||
-      ctx.poses.size() != static_cast<std::size_t>(scene_->robot().linkCount()) || ctx.q.size() != dim ||
+      ctx.poses[0].size() != static_cast<std::size_t>(scene_->robot().linkCount()) || ctx.q.size() != dim ||
       ctx.dq.size() != dim || ctx.probe_states.size() != motion_detail::kProbes * dim) {
     MotionResult r;
     r.report.kind = CollisionReport::Kind::Invalid;

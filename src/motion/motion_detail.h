@@ -20,10 +20,13 @@ struct Scratch {
   std::uint64_t owner = 0;
   SceneContext scene;
   std::vector<double> q, dq;
-  // The robot's full joint vector and every link's pose at the parameter the sweep last placed (the
-  // sweep's own: a state check in between places the scene context's).
-  std::vector<double> full_q;
-  std::vector<Pose> poses;
+  // The sweep's poses at the last few parameters it placed (items measured at one parameter share them):
+  // per slot, the robot's full joint vector, every link's pose, and per link the step its pose was computed
+  // for (the sweep's own: a state check in between places the scene context's).
+  static constexpr int kPoseSlots = 4;
+  std::array<std::vector<double>, kPoseSlots> full_q;
+  std::array<std::vector<Pose>, kPoseSlots> poses;
+  std::array<std::vector<std::uint64_t>, kPoseSlots> pose_stamp;
   std::vector<double> ends[2];  // the segment's ends as full variable vectors (for the pair tables)
   std::vector<double> safe_until;  // per item: where its coverage starts (Cast: where its shape cast reached)
   std::vector<double> bound;       // per item: its motion bound for this segment
@@ -46,8 +49,7 @@ struct Scratch {
   std::vector<int> split_slot;
   std::vector<std::uint64_t> split_stamp;
   double obstacle_motion = 0.0;  // how far moving obstacles travel over the segment (per unit of s)
-  std::uint64_t segment = 0;  // segments checked with this context (the stamps above refer to it)
-  std::vector<std::uint64_t> pose_stamp;  // per link: the step its pose in `poses` was computed for
+  std::uint64_t segment = 0;     // segments checked with this context (the stamps above refer to it)
   std::vector<int> pose_path;             // scratch: links whose poses are due, deepest first
   std::vector<Pose> end_poses;            // Cast: the link poses at the segment's end
   std::uint64_t step_stamp = 0;

@@ -52,14 +52,16 @@ TEST(MotionCertified, ThinWallIsNeverTunnelled) {
   // Few steps: the block is far from the wall most of the way.
   EXPECT_LT(r.steps, 200);
   // The verdict only: the same verdict and what collides, found at a parameter where the block is within
-  // contact_distance of the wall or through it (the segment's middle, here), with fewer steps.
+  // contact_distance of the wall or through it (the segment's middle, here), with less work: its probe's
+  // states and no distance query, where locating the contact measures and advances.
   const MotionResult loose = certified.check(q0, q1, ctx, /*locate_contact=*/false);
   ASSERT_FALSE(loose.free);
   EXPECT_EQ(loose.report.kind, r.report.kind);
   EXPECT_GE(loose.first_contact, near - 1e-9);
   EXPECT_LE(loose.first_contact, (1.0 + 0.0505 + certified.options().contact_distance) / 2.0 + 1e-9);
   EXPECT_EQ(loose.last_valid, 0.0);
-  EXPECT_LT(loose.steps, r.steps);
+  EXPECT_LT(loose.distance_queries, r.distance_queries);
+  EXPECT_LE(loose.steps, r.steps);
 
   // Turning while sliding (the block's corners sweep wider) is caught as well, and sooner.
   const double t1[2] = {1, 3.0};
@@ -388,6 +390,44 @@ TEST(MotionCertified, ManyPairRobotNeverMissesWhatDenseSamplingFinds) {
   EXPECT_EQ(d.report.kind, CollisionReport::Kind::Self) << scene->describe(d.report);
   EXPECT_FALSE(c.free);
   EXPECT_LE(c.first_contact, d.first_contact + 1e-9);
+}
+
+// With hundreds of items, each item's intervals are measured at dyadic parameters, which items share, and
+// the sweep keeps the poses of its last few parameters: a free segment of RRTConnect's range places far
+// fewer parameters than it measures (at the intervals' own midpoints, about one in two).
+TEST(MotionCertified, ManyItemsShareTheParametersTheyAreMeasuredAt) {
+  const auto scene = Scene::load(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/dual_arm_shelf.yaml");
+  const MotionChecker certified(scene);
+  MotionContext ctx = certified.makeContext();
+  std::mt19937_64 rng(7);
+  const int dim = scene->dimension();
+  double extent = 0.0;
+  for (int i = 0; i < dim; ++i) extent += (scene->upper(i) - scene->lower(i)) * (scene->upper(i) - scene->lower(i));
+  const double range = 0.2 * std::sqrt(extent);  // (OMPL's default for RRTConnect)
+  std::vector<double> q0(dim), q1(dim);
+  long steps = 0, queries = 0;
+  int free = 0;
+  for (int tries = 0; tries < 20000 && free < 20; ++tries) {
+    for (int i = 0; i < dim; ++i) q0[i] = std::uniform_real_distribution<double>(scene->lower(i), scene->upper(i))(rng);
+    if (!scene->isFree(q0)) continue;
+    double length = 0.0;
+    for (int i = 0; i < dim; ++i) {
+      q1[i] = std::uniform_real_distribution<double>(scene->lower(i), scene->upper(i))(rng);
+      length += (q1[i] - q0[i]) * (q1[i] - q0[i]);
+    }
+    length = std::sqrt(length);
+    for (int i = 0; i < dim; ++i) q1[i] = q0[i] + (q1[i] - q0[i]) * std::min(1.0, range / length);
+    const MotionResult r = certified.check(q0.data(), q1.data(), ctx, /*locate_contact=*/false);
+    if (!r.free) continue;
+    ++free;
+    steps += r.steps;
+    queries += r.distance_queries;
+  }
+  ASSERT_EQ(free, 20);
+  std::printf("dual_arm: 20 free segments, %.1f parameters placed and %.1f distances measured per segment\n",
+              steps / 20.0, queries / 20.0);
+  EXPECT_GT(queries, 20 * 300);  // (hundreds of items, each measured)
+  EXPECT_LT(steps, queries / 3);
 }
 
 TEST(MotionCertified, MovingWallIsNeverTunnelled) {
