@@ -362,7 +362,10 @@ struct MotionChecker::Sweep {
     if (std::isnan(h)) h = d == INFINITY ? INFINITY : 0.0;  // (∞ / ∞: nothing near, and an unbounded motion)
     if (!(h < want)) return h;
     if (it.b < 0) return std::max(h, mc.bound_.linkStep(it.a, dq, poses, d, ctx.obstacle_motion));
-    h = std::max(h, mc.bound_.pairStep(it.a, it.b, dq, poses, d));
+    // (With many items, pairs share links and parameters, and so the walks of their links' chains.)
+    h = std::max(h, mc.items_.size() > kAlignedItems
+                        ? mc.bound_.pairStep(it.a, it.b, dq, poses, d, ctx.step_cache, slot_step[slot])
+                        : mc.bound_.pairStep(it.a, it.b, dq, poses, d));
     if (h < want && split_item == k && splitClearances(k, d)) {
       const double* bound = splitBounds(k);
       const std::size_t na = it.ga->parts().size(), nb = it.gb->parts().size();

@@ -43,9 +43,18 @@ struct MotionBound::Tables {
   using Body = MotionBound::Body;
 
   struct DynamicBound;
+  using LinkTerms = MotionBound::LinkTerms;
   // Adds to f and t the joints of link's chain from index `from` on, in one walk of the chain.
   void addBounds(int link, std::size_t from, const double* dq, const Pose* poses, DynamicBound& f,
                  TwistBound& t) const noexcept;
+  // The same walk's sums for the link alone, with room for at most `room` pieces (f's left).
+  void linkTerms(int link, std::size_t from, const double* dq, const Pose* poses, int room,
+                 LinkTerms& out) const noexcept;
+  // A link's sums, from the cache where it holds them for these poses (id), else walked (and kept there).
+  const LinkTerms& cachedTerms(int link, std::size_t from, const double* dq, const Pose* poses, int room,
+                               MotionBound::StepCache& cache, std::uint64_t id) const noexcept;
+  double pairStep(int a, int b, const double* dq, const Pose* poses, double d, MotionBound::StepCache& cache,
+                  std::uint64_t id) const noexcept;
 
   int dim_ = 0, links_ = 0;
   std::vector<int> frame_;                        // per link: the link whose pose places it (a body's anchor)
@@ -303,15 +312,43 @@ struct MotionBound::Tables::DynamicBound {
 };
 
 // The twist bound (TwistBound): the motion from the link's velocity field now, where the joints' speeds add
-// as vectors, not as lengths. A revolute chain turns the link's points at w_k (the signed Δq_k) about axis k (unit u_k through
-// o_k): dx/ds = Σ_k w_k·t_k with t_k = u_k × (x − o_k), a twist Ω × x + V, so on the link's ball (centre c,
+// as vectors, not as lengths. A revolute chain turns the link's points at w_k (the signed Δq_k) about axis k (unit u_k
+// through o_k): dx/ds = Σ_k w_k·t_k with t_k = u_k × (x − o_k), a twist Ω × x + V, so on the link's ball (centre c,
 // radius ρ) the speed now is at most v0 = |Ω × c + V| + |Ω|·ρ. Along the segment t_k turns with the frame
 // of joint k (at most Σ_{j≤k} |w_j| radians per unit s) and changes inside it only as the joints below k
 // move x, by at most Σ_{j>k} |w_j|·R_j; with |t_k| ≤ R_k (the static reach of the link from axis k),
 // |d²x/ds²| ≤ A = Σ_k |w_k|·((Σ_{j≤k} |w_j|)·R_k + Σ_{j>k} |w_j|·R_j) anywhere. So no point moves farther than
 // h·v0 + h²·A/2 for a step of h either way. Only for chains whose moving joints all turn (else not valid).
+// One link's terms of f and t: each sum its own, added to the pair's as a whole (so that a pair's bound is
+// the same number whether its links' terms were walked now or kept from another pair at the same poses).
+struct MotionBound::LinkTerms {
+  double a = 0.0, c = 0.0, fixed = 0.0;  // DynamicBound's sums
+  double cap[Tables::DynamicBound::kMax], gain[Tables::DynamicBound::kMax], excess[Tables::DynamicBound::kMax];
+  int n = 0;
+  double accel = 0.0, speed = 0.0;  // TwistBound's
+  bool valid = true;
+  // Empty again (the pieces' arrays need no clearing: only the first n count).
+  void clear() noexcept { a = c = fixed = accel = speed = 0.0, n = 0, valid = true; }
+  // Adds the terms to a pair's (or a link's) bounds.
+  void addTo(Tables::DynamicBound& f, Tables::TwistBound& t) const noexcept {
+    f.a += a, f.c += c, f.fixed += fixed;
+    for (int i = 0; i < n; ++i) f.cap[f.n + i] = cap[i], f.gain[f.n + i] = gain[i], f.excess[f.n + i] = excess[i];
+    f.n += n;
+    t.valid = t.valid && valid;
+    t.accel += accel;
+    t.speed += speed;
+  }
+};
+
 void MotionBound::Tables::addBounds(int link, std::size_t from, const double* dq, const Pose* poses, DynamicBound& f,
                                     TwistBound& t) const noexcept {
+  LinkTerms terms;
+  linkTerms(link, from, dq, poses, DynamicBound::kMax - f.n, terms);
+  terms.addTo(f, t);
+}
+
+void MotionBound::Tables::linkTerms(int link, std::size_t from, const double* dq, const Pose* poses, int room,
+                                    LinkTerms& f) const noexcept {
   const std::vector<int>& chain = chain_[link];
   const Vec3 center = poses[frame_[link]] * sphere_center_[link];
   const double rho = sphere_radius_[link];
@@ -327,13 +364,13 @@ void MotionBound::Tables::addBounds(int link, std::size_t from, const double* dq
     const double reach = isSlide(j) ? 1.0 : joint_reach_[link][k];
     if (kind_[j] != static_cast<char>(Kind::Revolute)) {  // slides, spins: static, and no twist
       f.a += w * reach;
-      t.valid = false;
+      f.valid = false;
     } else {
       const Pose& frame = poses[child_[j]];
       const Vec3 u = frame.R * axis_[j], r = center - frame.t;
       const double now = std::min(reach, (r - r.dot(u) * u).norm() + rho);
-      f.a += w * (f.n == DynamicBound::kMax ? reach : now);
-      if (f.n < DynamicBound::kMax && now < reach && after > 0.0) {
+      f.a += w * (f.n == room ? reach : now);
+      if (f.n < room && now < reach && after > 0.0) {
         f.c += w * after;
         f.cap[f.n] = (reach - now) / after, f.gain[f.n] = w * after, f.excess[f.n] = w * (reach - now);
         ++f.n;
@@ -346,11 +383,25 @@ void MotionBound::Tables::addBounds(int link, std::size_t from, const double* dq
     }
     after += w * reach;
   }
-  f.fixed += after;
-  t.accel += accel;
+  f.fixed = after;
+  f.accel = accel;
   // Rounding: the field's terms can cancel, so their sum's error is absolute, a few ulps of Σ |w_k|·(R_k + ρ)
   // at most; 1e-12 of it is far above.
-  t.speed += velocity.norm() + omega.norm() * rho + margins::kRounding * size;
+  f.speed = velocity.norm() + omega.norm() * rho + margins::kRounding * size;
+}
+
+// A walk with room for `room` pieces that kept fewer than it allowed would be the same with any room above
+// what it kept: the cap never bound. So an entry serves such rooms, or its own.
+const MotionBound::LinkTerms& MotionBound::Tables::cachedTerms(int link, std::size_t from, const double* dq,
+                                                               const Pose* poses, int room,
+                                                               MotionBound::StepCache& cache,
+                                                               std::uint64_t id) const noexcept {
+  MotionBound::StepCache::Entry& e = cache.entries_[link];
+  if (e.id == id && e.from == from && (e.room == room || (e.terms->n < e.room && e.terms->n < room))) return *e.terms;
+  e.id = id, e.from = from, e.room = room;
+  e.terms->clear();
+  linkTerms(link, from, dq, poses, room, *e.terms);
+  return *e.terms;
 }
 
 double MotionBound::Tables::linkStep(int link, const double* dq, const Pose* poses, double d, double extra) const noexcept {
@@ -379,6 +430,17 @@ double MotionBound::Tables::pairStep(int a, int b, const double* dq, const Pose*
   TwistBound t;
   addBounds(a, fork, dq, poses, f, t);
   addBounds(b, fork, dq, poses, f, t);
+  return t.valid ? std::max(f.solve(d), t.solve(d)) : f.solve(d);
+}
+
+double MotionBound::Tables::pairStep(int a, int b, const double* dq, const Pose* poses, double d,
+                                     MotionBound::StepCache& cache, std::uint64_t id) const noexcept {
+  std::size_t fork = 0;
+  while (fork < chain_[a].size() && fork < chain_[b].size() && chain_[a][fork] == chain_[b][fork]) ++fork;
+  DynamicBound f;
+  TwistBound t;
+  cachedTerms(a, fork, dq, poses, DynamicBound::kMax, cache, id).addTo(f, t);
+  cachedTerms(b, fork, dq, poses, DynamicBound::kMax - f.n, cache, id).addTo(f, t);
   return t.valid ? std::max(f.solve(d), t.solve(d)) : f.solve(d);
 }
 
@@ -486,6 +548,18 @@ double MotionBound::linkStep(int link, const double* dq, const Pose* poses, doub
 }
 double MotionBound::pairStep(int a, int b, const double* dq, const Pose* poses, double d) const noexcept {
   return t_->pairStep(a, b, dq, poses, d);
+}
+double MotionBound::pairStep(int a, int b, const double* dq, const Pose* poses, double d, StepCache& cache,
+                             std::uint64_t poses_id) const noexcept {
+  if (cache.entries_.size() != static_cast<std::size_t>(t_->links_)) return t_->pairStep(a, b, dq, poses, d);
+  return t_->pairStep(a, b, dq, poses, d, cache, poses_id);
+}
+
+MotionBound::StepCache MotionBound::makeStepCache() const {
+  StepCache cache;
+  cache.entries_.resize(t_->links_);
+  for (StepCache::Entry& e : cache.entries_) e.terms = std::make_shared<LinkTerms>();
+  return cache;
 }
 bool MotionBound::linkTwist(int link, const double* dq, const Pose* poses, double& speed, double& accel) const noexcept {
   Tables::DynamicBound f;

@@ -306,6 +306,7 @@ MotionContext MotionChecker::makeContext() const {
   }
   c.probe_states.resize(static_cast<std::size_t>(motion_detail::kProbes) * scene_->dimension());
   c.pose_path.reserve(scene_->robot().linkCount());
+  c.step_cache = bound_.makeStepCache();
   c.intervals.reserve(256);
   if (options_.mode == MotionMode::Cast) c.end_poses.resize(scene_->robot().linkCount());
   return MotionContext(std::move(scratch));

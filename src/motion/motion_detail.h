@@ -51,6 +51,7 @@ struct Scratch {
   double obstacle_motion = 0.0;  // how far moving obstacles travel over the segment (per unit of s)
   std::uint64_t segment = 0;     // segments checked with this context (the stamps above refer to it)
   std::vector<int> pose_path;             // scratch: links whose poses are due, deepest first
+  MotionBound::StepCache step_cache;      // pairStep's walks per link at the poses of a slot's step
   std::vector<Pose> end_poses;            // Cast: the link poses at the segment's end
   std::uint64_t step_stamp = 0;
   struct Interval {

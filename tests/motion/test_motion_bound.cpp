@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -231,6 +232,43 @@ TEST(MotionBound, PathsGiveThePairBoundExactly) {
 // hulls are near): no distance between a part's hull vertices and the other link's changes by more than
 // pair(part, other) says; and a part next to the axes that turn it gets a bound well below its link's
 // (the UR5's upper arm turns about the shoulder, where its near end sits beside the base).
+// pairStep with a StepCache is the same number as without, bit for bit, for every checked pair either way
+// round in any order: the dual arm (its pairs share links and forks) and arm6, at several poses one after
+// another, each under its own id (terms kept for other poses never serve).
+TEST(MotionBound, CachedPairStepsAreThePairSteps) {
+  for (const char* rel : {"/robots/scenes/dual_arm_shelf.yaml", "/robots/scenes/arm6_wall.yaml"}) {
+    const auto scene = Scene::load(std::string(CLEARWAY_SOURCE_DIR) + rel);
+    const MotionBound bound(*scene);
+    MotionBound::StepCache cache = bound.makeStepCache();
+    const SelfCollision& self = scene->selfCollision();
+    std::vector<std::pair<int, int>> pairs;
+    for (const LinkPair& p : self.pairs()) pairs.push_back({p.a, p.b}), pairs.push_back({p.b, p.a});
+    ASSERT_FALSE(pairs.empty());
+    std::mt19937 rng(11);
+    SceneContext ctx = scene->makeContext();
+    std::uint64_t id = 0;
+    int compared = 0;
+    for (int round = 0; round < 6; ++round) {
+      const std::vector<double> q0 = randomState(*scene, rng), q1 = randomState(*scene, rng);
+      std::vector<double> dq(q0.size());
+      for (std::size_t i = 0; i < q0.size(); ++i) dq[i] = q1[i] - q0[i];
+      scene->computePoses(q0.data(), ctx);
+      ++id;
+      std::shuffle(pairs.begin(), pairs.end(), rng);
+      for (const auto& [a, b] : pairs)
+        for (const double d : {1e-3, 0.05, 0.4}) {
+          const double plain = bound.pairStep(a, b, dq.data(), ctx.poses().data(), d);
+          const double cached = bound.pairStep(a, b, dq.data(), ctx.poses().data(), d, cache, id);
+          ASSERT_EQ(std::memcmp(&plain, &cached, sizeof plain), 0)
+              << scene->robot().link(a).name << "/" << scene->robot().link(b).name << " at d = " << d << ": " << plain
+              << " vs " << cached;
+          ++compared;
+        }
+    }
+    std::printf("%s: %d pair steps compared\n", scene->robot().name().c_str(), compared);
+  }
+}
+
 TEST(MotionBound, HoldsForConvexParts) {
   CLEARWAY_REQUIRE_SHARED("robots/panda/panda.urdf");
   CLEARWAY_SHARED_OR_SKIP(root, "scenes");

@@ -83,6 +83,32 @@ class MotionBound {
   /// The same for the distance between links a and b (poses of both and their ancestors needed), watched
   /// from their common ancestor; where pair() watches from a better link, d / pair(a, b, dq) may be larger.
   double pairStep(int a, int b, const double* dq, const Pose* poses, double d) const noexcept;
+
+ private:
+  struct Tables;     // motion_bound.cpp: the chains, reaches and coefficients, shared by copies
+  struct LinkTerms;  // motion_bound.cpp: one link's share of pairStep's bound
+
+ public:
+  /// What pairStep walks per link, kept for the next pair that shares the link, its fork and its poses.
+  /// Made per thread (makeStepCache); a cache of another bound's robot is not used.
+  class StepCache {
+    friend class MotionBound;
+    friend struct MotionBound::Tables;
+    struct Entry {
+      std::uint64_t id = 0;  // the poses it was walked at (0: none)
+      std::size_t from = 0;
+      int room = 0;
+      std::shared_ptr<LinkTerms> terms;
+    };
+    std::vector<Entry> entries_;  // per link
+  };
+  /// An empty cache for this bound's robot.
+  StepCache makeStepCache() const;
+  /// pairStep(a, b, dq, poses, d), the same number, reusing each link's walk from `cache` where it was made
+  /// for the same poses, dq and fork. poses_id names the poses and dq: the caller promises that one id
+  /// (nonzero) is never given two different ones.
+  double pairStep(int a, int b, const double* dq, const Pose* poses, double d, StepCache& cache,
+                  std::uint64_t poses_id) const noexcept;
   /// The terms of the second bound linkStep() takes the larger of, from the link's velocity field now: for
   /// the step ±h·dq no point of the link moves h·speed + h²·accel/2 or farther, speed bounding its points'
   /// speed at `poses` and accel their acceleration anywhere (per unit step). False, with no terms, when a
@@ -100,7 +126,6 @@ class MotionBound {
   double linkCoefficient(int link, int v) const noexcept;
 
  private:
-  struct Tables;  // motion_bound.cpp: the chains, reaches and coefficients, shared by copies
   std::shared_ptr<const Tables> t_;
 };
 
