@@ -8,6 +8,7 @@
 #include <clearway/narrowphase/ray_cast.h>
 
 #include <algorithm>
+#include <iterator>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -96,7 +97,7 @@ struct MotionChecker::Sweep {
   }
   // The parameter each pose slot holds (−1: none), the steps they were placed at, the slot last placed or
   // looked up, and the slot the next new parameter takes (the one placed longest ago).
-  double slot_s[motion_detail::Scratch::kPoseSlots] = {-1.0, -1.0, -1.0, -1.0};
+  double slot_s[motion_detail::Scratch::kPoseSlots];
   std::uint64_t slot_step[motion_detail::Scratch::kPoseSlots] = {};
   int slot = 0, next_slot = 0;
   // The last measurement's self item whose hulls' GJK axis separates them (splitClearances), −1: none.
@@ -107,6 +108,7 @@ struct MotionChecker::Sweep {
   Sweep(const MotionChecker& checker, motion_detail::Scratch& c, MotionResult& result, const double* from, const double* to)
       : mc(checker), ctx(c), r(result), q0(from), q1(to) {
     for (std::vector<Pose>& p : ctx.poses) p[0] = Pose::identity();
+    std::fill(std::begin(slot_s), std::end(slot_s), -1.0);
   }
 
   // The time at parameter s.
@@ -222,8 +224,7 @@ struct MotionChecker::Sweep {
 
   // True when the state at s collides as the validity checker sees it (then `report` says what).
   bool stateCollides(double s, CollisionReport& report) {
-    for (double& at : slot_s) at = -1.0;  // (the check overwrites ctx.q: each slot is placed again)
-    ++r.steps;
+    ++r.steps;  // (the check places the scene context's poses, not the slots')
     return motion_detail::stateCollides(mc, q0, q1, s, time(s), ctx, report);
   }
 

@@ -2,6 +2,7 @@
 #include <clearway/motion/motion.h>
 
 #include <clearway/detail/margins.h>
+#include <clearway/serial.h>
 
 #include <algorithm>
 #include <cmath>
@@ -57,6 +58,9 @@ struct MotionBound::Tables {
                   std::uint64_t id) const noexcept;
 
   int dim_ = 0, links_ = 0;
+  // Names these tables for the caches made from them (by serial, not address: tables made after others
+  // were freed may take their address).
+  std::uint64_t serial_ = detail::nextSerial();
   std::vector<int> frame_;                        // per link: the link whose pose places it (a body's anchor)
   std::vector<double> link_coef_;                 // links × dim
   std::vector<std::vector<int>> chain_;           // per link: the joints from the root, in order
@@ -311,14 +315,6 @@ struct MotionBound::Tables::DynamicBound {
   }
 };
 
-// The twist bound (TwistBound): the motion from the link's velocity field now, where the joints' speeds add
-// as vectors, not as lengths. A revolute chain turns the link's points at w_k (the signed Δq_k) about axis k (unit u_k
-// through o_k): dx/ds = Σ_k w_k·t_k with t_k = u_k × (x − o_k), a twist Ω × x + V, so on the link's ball (centre c,
-// radius ρ) the speed now is at most v0 = |Ω × c + V| + |Ω|·ρ. Along the segment t_k turns with the frame
-// of joint k (at most Σ_{j≤k} |w_j| radians per unit s) and changes inside it only as the joints below k
-// move x, by at most Σ_{j>k} |w_j|·R_j; with |t_k| ≤ R_k (the static reach of the link from axis k),
-// |d²x/ds²| ≤ A = Σ_k |w_k|·((Σ_{j≤k} |w_j|)·R_k + Σ_{j>k} |w_j|·R_j) anywhere. So no point moves farther than
-// h·v0 + h²·A/2 for a step of h either way. Only for chains whose moving joints all turn (else not valid).
 // One link's terms of f and t: each sum its own, added to the pair's as a whole (so that a pair's bound is
 // the same number whether its links' terms were walked now or kept from another pair at the same poses).
 struct MotionBound::LinkTerms {
@@ -340,6 +336,14 @@ struct MotionBound::LinkTerms {
   }
 };
 
+// The twist bound (TwistBound): the motion from the link's velocity field now, where the joints' speeds add
+// as vectors, not as lengths. A revolute chain turns the link's points at w_k (the signed Δq_k) about axis k (unit u_k
+// through o_k): dx/ds = Σ_k w_k·t_k with t_k = u_k × (x − o_k), a twist Ω × x + V, so on the link's ball (centre c,
+// radius ρ) the speed now is at most v0 = |Ω × c + V| + |Ω|·ρ. Along the segment t_k turns with the frame
+// of joint k (at most Σ_{j≤k} |w_j| radians per unit s) and changes inside it only as the joints below k
+// move x, by at most Σ_{j>k} |w_j|·R_j; with |t_k| ≤ R_k (the static reach of the link from axis k),
+// |d²x/ds²| ≤ A = Σ_k |w_k|·((Σ_{j≤k} |w_j|)·R_k + Σ_{j>k} |w_j|·R_j) anywhere. So no point moves farther than
+// h·v0 + h²·A/2 for a step of h either way. Only for chains whose moving joints all turn (else not valid).
 void MotionBound::Tables::addBounds(int link, std::size_t from, const double* dq, const Pose* poses, DynamicBound& f,
                                     TwistBound& t) const noexcept {
   LinkTerms terms;
@@ -551,12 +555,13 @@ double MotionBound::pairStep(int a, int b, const double* dq, const Pose* poses, 
 }
 double MotionBound::pairStep(int a, int b, const double* dq, const Pose* poses, double d, StepCache& cache,
                              std::uint64_t poses_id) const noexcept {
-  if (cache.entries_.size() != static_cast<std::size_t>(t_->links_)) return t_->pairStep(a, b, dq, poses, d);
+  if (cache.owner_ != t_->serial_) return t_->pairStep(a, b, dq, poses, d);  // (another robot's, or none's)
   return t_->pairStep(a, b, dq, poses, d, cache, poses_id);
 }
 
 MotionBound::StepCache MotionBound::makeStepCache() const {
   StepCache cache;
+  cache.owner_ = t_->serial_;
   cache.entries_.resize(t_->links_);
   for (StepCache::Entry& e : cache.entries_) e.terms = std::make_shared<LinkTerms>();
   return cache;

@@ -233,12 +233,29 @@ TEST(MotionBound, PathsGiveThePairBoundExactly) {
 // pair(part, other) says; and a part next to the axes that turn it gets a bound well below its link's
 // (the UR5's upper arm turns about the shoulder, where its near end sits beside the base).
 // pairStep with a StepCache is the same number as without, bit for bit, for every checked pair either way
-// round in any order: the dual arm (its pairs share links and forks) and arm6, at several poses one after
-// another, each under its own id (terms kept for other poses never serve).
+// round in any order: the dual arm (its pairs share links and forks), the twin arm and arm6, at several
+// poses one after another, each under its own id (terms kept for other poses never serve). Nor does another
+// robot's cache: arm6 with two bodies has as many bound links as the twin arm, whose cache is offered to it
+// under the id its terms were kept under.
 TEST(MotionBound, CachedPairStepsAreThePairSteps) {
-  for (const char* rel : {"/robots/scenes/dual_arm_shelf.yaml", "/robots/scenes/arm6_wall.yaml"}) {
-    const auto scene = Scene::load(std::string(CLEARWAY_SOURCE_DIR) + rel);
-    const MotionBound bound(*scene);
+  struct Case {
+    const char* scene;
+    int bodies;
+  };
+  MotionBound::StepCache other;  // the previous robot's
+  int other_links = 0;
+  std::uint64_t other_id = 0;  // the id its last terms were kept under
+  for (const Case& c : {Case{"dual_arm_shelf.yaml", 0}, Case{"twin_arm_table.yaml", 0}, Case{"arm6_wall.yaml", 2}}) {
+    const auto scene = Scene::load(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/" + c.scene);
+    std::vector<MotionBound::Body> bodies;
+    const int l = scene->geometry().geometricLinks().back();
+    for (int k = 0; k < c.bodies; ++k) {
+      const LinkGeometry::Part& part = scene->geometry().link(l)->parts()[0];
+      bodies.push_back({l, &part.hull, part.center, part.radius});
+    }
+    if (c.bodies > 0)
+      ASSERT_EQ(scene->robot().linkCount() + c.bodies, other_links) << "the bodies make the counts equal";
+    const MotionBound bound(*scene, bodies);
     MotionBound::StepCache cache = bound.makeStepCache();
     const SelfCollision& self = scene->selfCollision();
     std::vector<std::pair<int, int>> pairs;
@@ -262,10 +279,15 @@ TEST(MotionBound, CachedPairStepsAreThePairSteps) {
           ASSERT_EQ(std::memcmp(&plain, &cached, sizeof plain), 0)
               << scene->robot().link(a).name << "/" << scene->robot().link(b).name << " at d = " << d << ": " << plain
               << " vs " << cached;
+          const double foreign = bound.pairStep(a, b, dq.data(), ctx.poses().data(), d, other, other_id);
+          ASSERT_EQ(std::memcmp(&plain, &foreign, sizeof plain), 0) << "another robot's cache served";
           ++compared;
         }
     }
     std::printf("%s: %d pair steps compared\n", scene->robot().name().c_str(), compared);
+    other = std::move(cache);
+    other_links = scene->robot().linkCount() + c.bodies;
+    other_id = id;
   }
 }
 

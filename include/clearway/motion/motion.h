@@ -101,6 +101,7 @@ class MotionBound {
       std::shared_ptr<LinkTerms> terms;
     };
     std::vector<Entry> entries_;  // per link
+    std::uint64_t owner_ = 0;     // the serial of the bound's tables (shared by its copies) that made it
   };
   /// An empty cache for this bound's robot.
   StepCache makeStepCache() const;
