@@ -43,6 +43,12 @@ struct MotionBound::Tables {
   static constexpr double kSpin = MotionBound::kSpin;
   using Body = MotionBound::Body;
 
+  // How many joints the chains of links a and b share (from the root): the index of the first that is not.
+  std::size_t forkOf(int a, int b) const noexcept {
+    std::size_t fork = 0;
+    while (fork < chain_[a].size() && fork < chain_[b].size() && chain_[a][fork] == chain_[b][fork]) ++fork;
+    return fork;
+  }
   struct DynamicBound;
   using LinkTerms = MotionBound::LinkTerms;
   // Adds to f and t the joints of link's chain from index `from` on, in one walk of the chain.
@@ -254,8 +260,7 @@ MotionBound::Tables::Tables(const Scene& scene, const std::vector<Body>& bodies)
 
 bool MotionBound::Tables::translates(int a, int b, const double* dq) const noexcept {
   // Joints above the fork move both links alike; only the path between them matters.
-  std::size_t fork = 0;
-  while (fork < chain_[a].size() && fork < chain_[b].size() && chain_[a][fork] == chain_[b][fork]) ++fork;
+  const std::size_t fork = forkOf(a, b);
   for (const int l : {a, b})
     for (std::size_t k = fork; k < chain_[l].size(); ++k) {
       const int j = chain_[l][k], v = joint_var_[j];
@@ -428,8 +433,7 @@ double MotionBound::Tables::TwistBound::solve(double d) const noexcept {
 
 double MotionBound::Tables::pairStep(int a, int b, const double* dq, const Pose* poses, double d) const noexcept {
   // Watched from the fork: each link moves by the joints below it, from where their axes are now.
-  std::size_t fork = 0;
-  while (fork < chain_[a].size() && fork < chain_[b].size() && chain_[a][fork] == chain_[b][fork]) ++fork;
+  const std::size_t fork = forkOf(a, b);
   DynamicBound f;
   TwistBound t;
   addBounds(a, fork, dq, poses, f, t);
@@ -439,8 +443,7 @@ double MotionBound::Tables::pairStep(int a, int b, const double* dq, const Pose*
 
 double MotionBound::Tables::pairStep(int a, int b, const double* dq, const Pose* poses, double d,
                                      MotionBound::StepCache& cache, std::uint64_t id) const noexcept {
-  std::size_t fork = 0;
-  while (fork < chain_[a].size() && fork < chain_[b].size() && chain_[a][fork] == chain_[b][fork]) ++fork;
+  const std::size_t fork = forkOf(a, b);
   DynamicBound f;
   TwistBound t;
   cachedTerms(a, fork, dq, poses, DynamicBound::kMax, cache, id).addTo(f, t);
@@ -457,8 +460,7 @@ bool MotionBound::Tables::forPath(int a, int b, F&& visit) const noexcept {
   const std::vector<int>& ca = chain_[a];
   const std::vector<int>& cb = chain_[b];
   const std::size_t na = ca.size(), nb = cb.size();
-  std::size_t fork = 0;
-  while (fork < na && fork < nb && ca[fork] == cb[fork]) ++fork;
+  const std::size_t fork = forkOf(a, b);
   if (na - fork + nb - fork > kMaxPath) return false;
   const std::ptrdiff_t shared = static_cast<std::ptrdiff_t>(fork) - 1;  // the last joint both chains share
   const double side_a = offsets(a, shared, static_cast<std::ptrdiff_t>(na) - 1);
@@ -505,8 +507,7 @@ double MotionBound::Tables::pair(int a, int b, const double* dq) const noexcept 
   });
   if (within) return cheapestSplit(cost_a, cost_b, n);
   // Beyond any real robot: watched from the fork.
-  std::size_t fork = 0;
-  while (fork < chain_[a].size() && fork < chain_[b].size() && chain_[a][fork] == chain_[b][fork]) ++fork;
+  const std::size_t fork = forkOf(a, b);
   double bound = 0.0;
   for (int side = 0; side < 2; ++side) {
     const int l = side ? b : a;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <tuple>
@@ -27,6 +28,25 @@ constexpr double kPi = 3.14159265358979323846;
 // kMaxTurn, beyond which a turn is not looked up).
 constexpr double kValueSlack = margins::kSlack;
 constexpr double kMaxTurn = 1e3;
+
+// One axis of a walk through unit cells (Amanatides–Woo) along u + s·d, s ∈ [0, 1], from the cell `start`
+// (the integer part of u, or a cell it was clamped into): the step to the next cell, the parameter s of the
+// first crossing and the parameter between crossings (∞ for an axis the segment does not move along).
+struct WalkAxis {
+  int step = 0;
+  double next = std::numeric_limits<double>::infinity(), delta = std::numeric_limits<double>::infinity();
+  WalkAxis(double u, double d, double start) noexcept {
+    if (d > 0.0) {
+      step = 1;
+      next = (start + 1.0 - u) / d;
+      delta = 1.0 / d;
+    } else if (d < 0.0) {
+      step = -1;
+      next = (u - start) / -d;
+      delta = -1.0 / d;
+    }
+  }
+};
 
 // A joint of the chain that the table's variables move.
 struct Moved {
@@ -508,17 +528,8 @@ bool PairTable::freeAlong(const double* q0, const double* q1) const noexcept {
     if (!std::isfinite(u[k]) || !std::isfinite(d[k])) return false;
     const double start = std::floor(u[k]);
     c[k] = static_cast<int>(start);
-    if (d[k] > 0.0) {
-      step[k] = 1;
-      next[k] = (start + 1.0 - u[k]) / d[k];
-      delta[k] = 1.0 / d[k];
-    } else if (d[k] < 0.0) {
-      step[k] = -1;
-      next[k] = (u[k] - start) / -d[k];
-      delta[k] = -1.0 / d[k];
-    } else {
-      next[k] = delta[k] = std::numeric_limits<double>::infinity();
-    }
+    const WalkAxis axis(u[k], d[k], start);
+    step[k] = axis.step, next[k] = axis.next, delta[k] = axis.delta;
     budget += static_cast<long>(std::abs(std::floor(u[k] + d[k]) - start)) + 1;
   }
   if (budget > 64L * (n_[0] + (dims == 2 ? n_[1] : 0))) return false;  // many turns: not worth the walk
@@ -559,15 +570,8 @@ bool PairTable::fineFreeAlong(std::int32_t e, const int* c, const double* u, con
     const double df = d[k] * fine_;
     first[k] = c[k] * fine_;
     f[k] = std::clamp(static_cast<int>(std::floor(uf[k] + df * t_in)), first[k], first[k] + fine_ - 1);
-    if (df > 0.0) {
-      step[k] = 1;
-      next[k] = (f[k] + 1.0 - uf[k]) / df;
-      delta[k] = 1.0 / df;
-    } else if (df < 0.0) {
-      step[k] = -1;
-      next[k] = (uf[k] - f[k]) / -df;
-      delta[k] = -1.0 / df;
-    }
+    const WalkAxis axis(uf[k], df, f[k]);
+    step[k] = axis.step, next[k] = axis.next, delta[k] = axis.delta;
   }
   for (int left = 2 * fine_ + 2; left > 0; --left) {  // (a walk within one coarse cell crosses 2·fine_ at most)
     int at = 0, stride = 1;
