@@ -3,13 +3,13 @@
 //     and centres are the surface; the cells no path of unmarked cells joins to the grid's rim are the
 //     inside (a closed mesh's solid);
 //  2. a distance transform gives each cell its depth (to the nearest unmarked cell);
-//  3. greedy set cover: a candidate ball at a cell reaches its depth plus half a step, and covers the
-//     cells whose contents (pieces, inside cubes, a surface cell's corners inside the solid) it holds;
-//     the candidate covering most new cells is taken until none is left;
+//  3. greedy set cover: a candidate ball at a cell reaches its depth plus half a step; the items it holds
+//     whole (a piece's three corners, an inside cube's eight, a surface cell's corner inside the solid)
+//     are its gain, and the candidate of most gain is taken until no item is left;
 //  4. each ball shrinks to the farthest point it was given, and grows by the rounding and the margin the
 //     proof of the inside needs; then LinkGeometry::ballsHoldSolids proves the inside.
-// Deep balls reach the surface from within, so a long round link takes a few balls a few millimetres
-// looser than its surface (the UR5's forearm: about 170 balls at 5 mm steps) where balls around
+// Deep balls reach the surface from within, so a long round link takes few balls a few millimetres
+// looser than its surface (the UR5's forearm: 118 balls at 4.7 mm steps), where balls around clusters of
 // triangles bulge by their own radius.
 #include <clearway/body/outer_balls.h>
 
@@ -30,7 +30,7 @@ namespace {
 // balls do (part_cover.cpp).
 constexpr double kMarginFraction = 1.0 / 1024.0;
 // More pieces than this (a few large triangles on a fine grid cost n² each) and the link is not served.
-constexpr long kMaxPieces = 1L << 20;
+constexpr long kMaxPieces = 1L << 19;  // (about 50 MB of points at most)
 
 // The squared distance transform of one row (Felzenszwalb and Huttenlocher's lower envelope of
 // parabolas): d[q] = min_p (q − p)² + f[p].
@@ -123,6 +123,7 @@ OuterBalls buildOuterBalls(const LinkGeometry& link, const OuterBallOptions& opt
   const Vec3 extent = (bounds.max - bounds.min).cwiseMax(Vec3::Zero());
   double step = std::max(options.step, std::cbrt(extent.prod() / static_cast<double>(options.max_cells)));
   if (!(step > 0.0) || !std::isfinite(step)) return out;
+  if (!(extent.maxCoeff() / step <= 1e6)) return out;  // (a flat link metres wide: too many cells, and ints)
   Grid grid;
   grid.step = step;
   grid.origin = bounds.min - Vec3::Constant(1.5 * step);
@@ -134,8 +135,8 @@ OuterBalls buildOuterBalls(const LinkGeometry& link, const OuterBallOptions& opt
   if (cells > 4 * options.max_cells) return out;  // (a flat link: its thin sides still get 3 cells)
   const int n = static_cast<int>(cells);
 
-  // 1. The contents of each cell: points, in cell order (pieces give 3, inside cubes 8, a surface cell up
-  //    to 8 corners inside the solid). `pieces` are the cut triangles, which the proof needs.
+  // 1. The contents of the cells: the pieces of the cut triangles (which the proof needs), and for the
+  //    solids the inside cells' cubes and the surface cells' corners inside.
   enum : std::uint8_t { kEmpty = 0, kSurface = 1, kInside = 2 };
   std::vector<std::uint8_t> mark(n, kEmpty);
   // (cell, first point of its item): an item is the points a ball must hold together (a piece's three

@@ -44,8 +44,9 @@ struct OuterBallOptions {
 /// every triangle is cut into pieces no longer than a grid step, each of which lies in one ball by
 /// its corners (a ball is convex), with room for the rounding of the cut; the inside of the closed meshes
 /// is proven held by LinkGeometry::ballsHoldSolids. Not proven (empty) for a link with primitives or
-/// without triangles, or when the proof gives up. Pure and deterministic; 5 to 900 ms a link on the
-/// shared UR5 (2.6 s for all its links), too slow yet to build at load.
+/// without triangles, one too large for the grid's bounds, or when the proof gives up. Pure and
+/// deterministic; 5 to 900 ms a link on the shared UR5 (2.8 s for all its links, 5.7 s for the Panda's
+/// large triangles), too slow yet to build at load.
 OuterBalls buildOuterBalls(const LinkGeometry& link, const OuterBallOptions& options = {});
 
 }  // namespace clearway
