@@ -329,24 +329,48 @@ OuterBalls buildOuterBalls(const LinkGeometry& link, const OuterBallOptions& opt
   };
   std::priority_queue<std::pair<int, int>> queue;  // (key, cell)
   for (int c : candidates) queue.push({bound(c), c});
+  // A candidate's items, kept from its first count: a recount drops those held since, without geometry
+  // (the items a ball holds never change; only which are held). Long lists, and lists past a total of
+  // 8 million items (32 MB), are counted again instead.
+  constexpr std::size_t kKeptItems = 4096;
+  constexpr std::size_t kKeptTotal = 8u << 20;
+  std::size_t kept_total = 0;
+  std::vector<std::vector<int>> kept(n);
+  std::vector<std::uint8_t> counted(n, 0);
   std::vector<int> take;
+  const auto count = [&](int c) -> std::vector<int>& {
+    std::vector<int>& list = kept[c];
+    if (counted[c] == 1) {  // (2: its list was too long to keep)
+      list.erase(std::remove_if(list.begin(), list.end(), [&](int i) { return held[i] != 0; }), list.end());
+      return list;
+    }
+    take.clear();
+    gain(c, &take);
+    counted[c] = take.size() > kKeptItems || kept_total + take.size() > kKeptTotal ? 2 : 1;
+    if (counted[c] == 2) return take;
+    kept_total += take.size();
+    list = take;
+    return list;
+  };
   std::vector<std::pair<Vec3, std::vector<int>>> chosen;  // centre, items
   while (!queue.empty()) {
     const auto [was, c] = queue.top();
     queue.pop();
     if (was == 0) break;
-    const int now = gain(c, nullptr);
-    if (!queue.empty() && now < queue.top().first) {  // gains only fall: recount, and take it when still best
-      queue.push({now, c});
+    const std::vector<int>& now = count(c);
+    const int gained = static_cast<int>(now.size());
+    if (!queue.empty() && gained < queue.top().first) {  // gains only fall: recount, take it when still best
+      queue.push({gained, c});
       continue;
     }
-    take.clear();
-    gain(c, &take);
-    for (int i : take) {
+    const std::vector<int> taken = now;
+    kept[c].clear();
+    kept[c].shrink_to_fit();
+    for (int i : taken) {
       held[i] = 1;
       --open[items[i].first];
     }
-    chosen.push_back({grid.center(c), take});
+    chosen.push_back({grid.center(c), taken});
   }
   for (int i = 0; i < item_count; ++i)  // items no candidate held: their own balls
     if (!held[i]) chosen.push_back({points[items[i].second].second, {i}});

@@ -45,7 +45,7 @@ struct OuterBallOptions {
 /// its corners (a ball is convex), with room for the rounding of the cut; the inside of the closed meshes
 /// is proven held by LinkGeometry::ballsHoldSolids. Not proven (empty) for a link with primitives or
 /// without triangles, one too large for the grid's bounds, or when the proof gives up. Pure and
-/// deterministic; 5 to 900 ms a link on the shared UR5 (2.8 s for all its links, 5.7 s for the Panda's
+/// deterministic; up to 700 ms a link on the shared UR5 (2.2 s for all its links, 4.1 s for the Panda's
 /// large triangles), too slow yet to build at load.
 OuterBalls buildOuterBalls(const LinkGeometry& link, const OuterBallOptions& options = {});
 
