@@ -73,9 +73,13 @@ struct Grid {
     const auto clamp = [](double v, int n) { return std::clamp(static_cast<int>(std::floor(v)), 0, n - 1); };
     return index(clamp(u.x(), nx), clamp(u.y(), ny), clamp(u.z(), nz));
   }
+  struct Cell {
+    int x, y, z;
+  };
+  Cell coordinates(int c) const noexcept { return {c % nx, (c / nx) % ny, c / (nx * ny)}; }
   Vec3 corner(int x, int y, int z) const noexcept { return origin + Vec3(x, y, z) * step; }
   Vec3 center(int c) const noexcept {
-    const int x = c % nx, y = (c / nx) % ny, z = c / (nx * ny);
+    const auto [x, y, z] = coordinates(c);
     return origin + (Vec3(x, y, z) + Vec3::Constant(0.5)) * step;
   }
 };
@@ -186,7 +190,7 @@ OuterBalls buildOuterBalls(const LinkGeometry& link, const OuterBallOptions& opt
     while (!stack.empty()) {
       const int c = stack.back();
       stack.pop_back();
-      const int x = c % grid.nx, y = (c / grid.nx) % grid.ny, z = c / (grid.nx * grid.ny);
+      const auto [x, y, z] = grid.coordinates(c);
       if (x > 0) visit(x - 1, y, z);
       if (x + 1 < grid.nx) visit(x + 1, y, z);
       if (y > 0) visit(x, y - 1, z);
@@ -253,7 +257,7 @@ OuterBalls buildOuterBalls(const LinkGeometry& link, const OuterBallOptions& opt
     pass(nz, nx * ny, nx * ny, [&](int l) { return l; });
   }
 
-  // 3. Greedy cover of the marked cells by candidate balls.
+  // 3. Greedy cover of the items by candidate balls.
   std::vector<int> candidates;
   for (int z = 0; z < grid.nz; ++z)
     for (int y = 0; y < grid.ny; ++y)
@@ -279,7 +283,7 @@ OuterBalls buildOuterBalls(const LinkGeometry& link, const OuterBallOptions& opt
     const Vec3 o = grid.center(c);
     const double r = radiusAt(c);
     const int span = static_cast<int>(std::ceil(r / step)) + 1;
-    const int x0 = c % grid.nx, y0 = (c / grid.nx) % grid.ny, z0 = c / (grid.nx * grid.ny);
+    const auto [x0, y0, z0] = grid.coordinates(c);
     int count = 0;
     for (int z = std::max(0, z0 - span); z <= std::min(grid.nz - 1, z0 + span); ++z)
       for (int y = std::max(0, y0 - span); y <= std::min(grid.ny - 1, y0 + span); ++y)
@@ -320,7 +324,7 @@ OuterBalls buildOuterBalls(const LinkGeometry& link, const OuterBallOptions& opt
       }
   const auto bound = [&](int c) {
     const int span = static_cast<int>(std::ceil(radiusAt(c) / step)) + 1;
-    const int x0 = c % grid.nx, y0 = (c / grid.nx) % grid.ny, z0 = c / (grid.nx * grid.ny);
+    const auto [x0, y0, z0] = grid.coordinates(c);
     const int xa = std::max(0, x0 - span), xb = std::min(grid.nx, x0 + span + 1);
     const int ya = std::max(0, y0 - span), yb = std::min(grid.ny, y0 + span + 1);
     const int za = std::max(0, z0 - span), zb = std::min(grid.nz, z0 + span + 1);

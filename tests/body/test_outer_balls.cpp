@@ -56,10 +56,8 @@ Loose sample(const LinkGeometry& g, const OuterBalls& o, int per_triangle, int i
   }
   if (g.solidCount() == 0 || inside == 0) return l;
   const tree_ref::WorldMesh w = tree_ref::placeTriangles(g.triangles());
-  const Aabb& box = g.bounds();
   for (int i = 0; i < inside; ++i) {
-    Vec3 p;
-    for (int a = 0; a < 3; ++a) p[a] = std::uniform_real_distribution<double>(box.min[a], box.max[a])(rng);
+    const Vec3 p = tree_ref::randomInBox(rng, g.bounds());
     if (std::abs(tree_ref::windingNumber(p, w)) < 0.5) continue;
     ++l.inside;
     l.loose_inside += !held(o, p, shrink);

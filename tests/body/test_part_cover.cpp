@@ -32,10 +32,8 @@ Sampled sampleInside(const LinkGeometry& g, const Balls& balls, double margin, i
   const tree_ref::WorldMesh w = tree_ref::placeTriangles(g.triangles());
   std::mt19937_64 rng(seed);
   Sampled s;
-  const Aabb& b = g.bounds();
   for (int i = 0; i < samples; ++i) {
-    Vec3 p;
-    for (int a = 0; a < 3; ++a) p[a] = std::uniform_real_distribution<double>(b.min[a], b.max[a])(rng);
+    const Vec3 p = tree_ref::randomInBox(rng, g.bounds());
     if (std::abs(tree_ref::windingNumber(p, w)) < 0.5) continue;
     ++s.inside;
     bool held = false;

@@ -363,6 +363,13 @@ inline Vec3 randomInBall(std::mt19937_64& rng, double radius) {
   return radius * p;
 }
 
+/// A point uniform in the box (one draw per axis, x first).
+inline Vec3 randomInBox(std::mt19937_64& rng, const Aabb& box) {
+  Vec3 p;
+  for (int a = 0; a < 3; ++a) p[a] = std::uniform_real_distribution<double>(box.min[a], box.max[a])(rng);
+  return p;
+}
+
 inline double meshRadius(const TriangleMesh& m) {
   double r = 0.0;
   for (const Vec3& v : m.vertices) r = std::max(r, v.norm());
