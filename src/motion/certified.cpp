@@ -28,6 +28,7 @@ void MotionChecker::castAhead(const double* q0, const double* q1, double t0, int
   for (int k = 0; k < n_items; ++k) {
     const Item& it = items_[k];
     if (it.group >= 0) continue;  // its group's coverage decides where it starts
+    if (ctx.safe_until[k] != 0.0 || ctx.settled[k] != 0) continue;  // (a table or the rake settled some of it)
     const bool self = it.b >= 0;
     if (!self && ctx.obstacle_motion > 0.0) continue;  // (the cast holds obstacles still, where they are at t0)
     if (self ? !bound_.translates(it.a, it.b, ctx.dq.data()) : !bound_.translates(it.a, ctx.dq.data())) continue;
@@ -468,6 +469,118 @@ struct MotionChecker::Sweep {
     }
     return false;
   }
+
+  // ---- The rake: bounding balls on pieces of the segment, before any distance is measured ----
+  // Piece [m − h, m + h] is settled for item k when, at m, its bodies' bounding balls are farther apart (for
+  // the environment: farther from the obstacles' boxes) than padding + contact_distance + B·h, B the item's
+  // motion bound: over the piece neither body moves more than B·h relative to the other, so the clearance
+  // stays beyond contact_distance, the largest contactOf can be. Pieces halve from the whole segment to
+  // eighths, and only while the balls at the middle clear the contact distance: an item whose balls meet
+  // there is near, and is left to the distances (one test spent). A piece costs one subtraction and a
+  // squared norm where a measurement costs a ladder of GJKs, and one pose per piece serves every item.
+  static constexpr int kRakeLevels = 4;
+  static constexpr int kRakePieces = 1 << (kRakeLevels - 1);  // the finest pieces: bits of ctx.settled[k]
+  static constexpr std::uint8_t kRakeAll = (1u << kRakePieces) - 1u;
+  static_assert(kRakePieces <= 8, "settled pieces are bits of a byte");
+
+  enum class Raked { Settled, Halve, Near };
+  // Body `body`'s bounding ball at the rake's current piece (placed once per piece: bodies share items),
+  // grown by the rounding of its placed centre and of its radius (margins.h).
+  const motion_detail::Scratch::RakeBall& rakeBall(int body, int frame, const LinkGeometry& g, double s) {
+    motion_detail::Scratch::RakeBall& b = ctx.rake_balls[body];
+    if (b.piece != ctx.rake_piece) {
+      const Pose& p = pose(s, frame);
+      b.center = p * g.sphereCenter();
+      b.radius =
+          g.sphereRadius() * (1.0 + margins::kRounding) + margins::placedRounding(g.sphereCenter().norm(), p.t.norm());
+      b.norm = b.center.norm();
+      b.piece = ctx.rake_piece;
+    }
+    return b;
+  }
+  // Whether item k's bounding balls at s settle the piece s ± half: apart (for the environment: clear of the
+  // obstacles' boxes) by more than padding + contact + B·half; else whether they are by more than padding +
+  // contact (the piece's halves may be), or near.
+  Raked rakeTest(int k, double s, double half) {
+    const Item& it = mc.items_[k];
+    const Scene& sc = *mc.scene_;
+    const Tolerances& tol = sc.options().tolerances;
+    const double motion = ctx.bound[k] * half;  // (∞ or NaN: nothing is settled)
+    if (!(motion < INFINITY)) return Raked::Near;
+    const double contact = it.padding + mc.options_.contact_distance;
+    const motion_detail::Scratch::RakeBall& a = rakeBall(it.a, it.frame_a, *it.ga, s);
+    if (it.b >= 0) {
+      const motion_detail::Scratch::RakeBall& b = rakeBall(it.b, it.frame_b, *it.gb, s);
+      // |ca − cb| beyond both radii, the padding, the contact distance and (to settle) the motion, with the
+      // narrow phase's band (as BodyPair's first rung) and the rounding of the squares and sums added.
+      const double band = margins::narrowBand(tol.gjk_absolute) + margins::kRounding;
+      const double near =
+          a.radius + b.radius + contact + band * (a.norm + b.norm + a.radius + b.radius + contact + motion);
+      const double far = near + motion, d2 = (a.center - b.center).squaredNorm();
+      return d2 > far * far ? Raked::Settled : d2 > near * near ? Raked::Halve : Raked::Near;
+    }
+    const ObstacleBoxes* boxes = sc.environment().obstacleBoxes();
+    if (!boxes || ctx.obstacle_motion > 0.0) return Raked::Near;
+    const double grown = (a.radius + motion) * margins::kBeyond;
+    const double slack = sc.environment().linkSlack(contact, a.center.cwiseAbs().maxCoeff() + grown, tol);
+    if (boxes->ballClear(a.center, grown, slack)) return Raked::Settled;
+    return boxes->ballClear(a.center, a.radius, slack) ? Raked::Halve : Raked::Near;
+  }
+
+  // Fills ctx.settled for items [0, n_items) whose coverage starts at 0 (not the groups' members), level by
+  // level, each piece's items at once (one set of poses).
+  void rake(int n_items) {
+    std::vector<int>& due = ctx.rake_items;
+    std::vector<int>& next = ctx.rake_items_next;
+    due.clear();
+    for (int k = 0; k < n_items; ++k) {
+      ctx.settled[k] = 0;
+      ctx.rake_now[k] = 1;
+      if (mc.items_[k].group < 0 && ctx.safe_until[k] == 0.0) due.push_back(k);
+    }
+    for (int level = 0; level < kRakeLevels && !due.empty(); ++level) {
+      const int pieces = 1 << level, width = kRakePieces / pieces;  // (width in finest pieces)
+      const double half = 0.5 / pieces;
+      const bool last = level + 1 == kRakeLevels;
+      next.clear();
+      for (const int k : due) ctx.rake_next[k] = 0;
+      for (int p = 0; p < pieces; ++p) {
+        const double m = (2 * p + 1) * half;  // (exact: dyadic)
+        ++ctx.rake_piece;
+        for (const int k : due) {
+          if (!(ctx.rake_now[k] >> p & 1u)) continue;
+          const Raked t = rakeTest(k, m, half);
+          if (t == Raked::Settled) {
+            ctx.settled[k] |= static_cast<std::uint8_t>(((1u << width) - 1u) << (p * width));
+          } else if (t == Raked::Halve && !last) {
+            if (ctx.rake_next[k] == 0) next.push_back(k);
+            ctx.rake_next[k] |= static_cast<std::uint8_t>(3u << (2 * p));
+          }
+        }
+      }
+      for (const int k : next) ctx.rake_now[k] = ctx.rake_next[k];
+      std::swap(due, next);
+    }
+    for (int k = 0; k < n_items; ++k)
+      if (ctx.settled[k] == kRakeAll) ctx.safe_until[k] = 2.0;  // (beyond 1: covered)
+  }
+
+  // Covers what the rake left of item k: each run of pieces it did not settle, left first (a run after a
+  // settled piece starts where the item is certified clear).
+  template <class Cover>
+  static void coverUnsettled(int k, std::uint8_t settled, Cover&& cover) {
+    for (int i = 0; i < kRakePieces;) {
+      if (settled >> i & 1u) {
+        ++i;
+        continue;
+      }
+      int j = i;
+      while (j < kRakePieces && !(settled >> j & 1u)) ++j;
+      const double a = static_cast<double>(i) / kRakePieces, b = static_cast<double>(j) / kRakePieces;
+      cover(k, a, b, i > 0 ? a : -1.0);
+      i = j;
+    }
+  }
 };
 
 double MotionChecker::itemBound(int k, const double* dq, double obstacle_motion) const noexcept {
@@ -525,7 +638,6 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
     ctx.bound[k] = itemBound(k, ctx.dq.data(), ctx.obstacle_motion);  // (0 when nothing moves: measured once)
     ctx.safe_until[k] = 0.0;
   }
-  if (options_.mode == MotionMode::Cast) castAhead(q0, q1, t0, n_items, ctx, r);
   // Self items whose tables prove them apart along the whole segment are not swept.
   bool ends_set = false;
   for (int k = 0; k < std::min(n_items, env_begin_); ++k) {
@@ -553,12 +665,23 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
     sweep.cover(k, a, b, witness);
     if (sweep.contacts > before) ctx.lead = k;
   };
-  if (lead >= 0 && ctx.safe_until[lead] <= 1.0)
+  // The bounding balls settle the pieces of the segment they can before any distance is measured.
+  if (options_.rake) {
+    sweep.rake(n_items);
+  } else {
+    std::fill(ctx.settled.begin(), ctx.settled.begin() + n_items, 0);
+  }
+  if (options_.mode == MotionMode::Cast) castAhead(q0, q1, t0, n_items, ctx, r);
+  if (lead >= 0 && ctx.settled[lead] != 0 && ctx.safe_until[lead] <= 1.0) {
+    Sweep::coverUnsettled(lead, ctx.settled[lead], cover);
+  } else if (lead >= 0 && ctx.safe_until[lead] <= 1.0) {
     cover(lead, ctx.safe_until[lead], 1.0, ctx.safe_until[lead] > 0.0 ? ctx.safe_until[lead] : -1.0);
-  // Every other item is first measured in the middle of what is left, where one set of poses serves all.
+  }
+  // Every other item the rake left whole is first measured in the middle of what is left, where one set of
+  // poses serves all.
   const double mid = 0.5 * sweep.limit;
   for (int k = 0; k < n_items && !sweep.stop(); ++k)
-    if (k != lead && items_[k].group < 0 && ctx.safe_until[k] == 0.0) {
+    if (k != lead && items_[k].group < 0 && ctx.safe_until[k] == 0.0 && ctx.settled[k] == 0) {
       const int before = sweep.contacts;
       ctx.first_reach[k] = sweep.first(k, mid, mid);
       if (sweep.contacts > before) ctx.lead = k;
@@ -567,11 +690,13 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
     if (k == lead || items_[k].group >= 0) continue;
     const double start = ctx.safe_until[k];  // 0, or where a shape cast says the item is clear until
     if (start > 1.0) continue;
-    if (start > 0.0) {
+    if (ctx.settled[k] != 0) {
+      Sweep::coverUnsettled(k, ctx.settled[k], cover);
+    } else if (start > 0.0) {
       cover(k, start, 1.0, start);
     } else if (ctx.first_reach[k] < 0.0) {
       cover(k, 0.0, 1.0, -1.0);  // within contact in the middle: from the start, exactly
-    } else {  // what the ball in the middle leaves, left first
+    } else {                     // what the ball in the middle leaves, left first
       const double rad = ctx.first_reach[k];
       if (mid - rad > 0.0) cover(k, 0.0, mid - rad, -1.0);  // (in every mode: see Sweep::cover)
       if (mid + rad < sweep.limit) cover(k, mid + rad, 1.0, mid);

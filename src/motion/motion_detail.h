@@ -31,6 +31,20 @@ struct Scratch {
   std::vector<double> safe_until;  // per item: where its coverage starts (Cast: where its shape cast reached)
   std::vector<double> bound;       // per item: its motion bound for this segment
   std::vector<double> first_reach; // per item: how far its first measurement (in the middle) clears, −1: none
+  // Per item: the rake's settled pieces of this segment (bit i: [i, i + 1] / kRakePieces; certified.cpp),
+  // and its scratch: per item the pieces of the current and next level still to test, and the items that
+  // have some.
+  std::vector<std::uint8_t> settled, rake_now, rake_next;
+  std::vector<int> rake_items, rake_items_next;
+  // Per body of the bound (a link, or a merged body past them): its bounding ball, world frame, at the rake's
+  // piece `piece` (placed at most once per piece).
+  struct RakeBall {
+    Vec3 center = Vec3::Zero();
+    double radius = 0.0, norm = 0.0;
+    std::uint64_t piece = 0;
+  };
+  std::vector<RakeBall> rake_balls;
+  std::uint64_t rake_piece = 0;  // the rake's pieces so far (names each)
   // Per item: its contact distance at either end of this segment, set when it first comes within
   // contact_distance (contact_stamp[k] == segment): half an end's clearance where that is below
   // contact_distance (Sweep::contactOf grows it away from the end).

@@ -163,6 +163,12 @@ inline MotionOptions castMode() {
   return o;
 }
 
+// The options without the rake (every item measured: for tests of what the measurements do).
+inline MotionOptions unraked(MotionOptions o) {
+  o.rake = false;
+  return o;
+}
+
 // The rover (robots/rover: a planar joint and a revolute boom) between two thin walls, and the free flyer
 // (robots/flyer: a floating joint) over a thin plate, by a thin post (robots/scenes).
 inline std::shared_ptr<const Scene> roverScene(const TempDir&) {

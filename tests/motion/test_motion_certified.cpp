@@ -118,12 +118,17 @@ TEST(MotionCertified, RigidBodiesAreOneItemUntilNear) {
     SceneOptions without;
     without.pair_tables = false;
     const auto scene = std::make_shared<const Scene>(tabled->description(), without);
-    const MotionChecker certified(scene), fast(tabled);
-    MotionContext ctx = certified.makeContext(), fctx = fast.makeContext();
+    MotionOptions measured;  // (the rake's bounding balls would settle every item: measured, each counts once)
+    measured.rake = false;
+    const MotionChecker certified(scene, measured), fast(tabled, measured), raked(scene);
+    MotionContext ctx = certified.makeContext(), fctx = fast.makeContext(), rctx = raked.makeContext();
     const double q0[2] = {0, 0}, q1[2] = {0.02, 0};
     const MotionResult r = certified.check(q0, q1, ctx);
     EXPECT_TRUE(r.free);
     EXPECT_EQ(r.distance_queries, 2 + 4) << "link by link it would be 4 + 9";
+    const MotionResult raked_result = raked.check(q0, q1, rctx);
+    EXPECT_TRUE(raked_result.free);
+    EXPECT_EQ(raked_result.distance_queries, 0) << "far from everything, the bounding balls settle every item";
     // Items whose pairs are moved by one or two joints, which their tables prove apart over the whole
     // segment, are not measured at all.
     const MotionResult t = fast.check(q0, q1, fctx);
@@ -397,7 +402,9 @@ TEST(MotionCertified, ManyPairRobotNeverMissesWhatDenseSamplingFinds) {
 // fewer parameters than it measures (at the intervals' own midpoints, about one in two).
 TEST(MotionCertified, ManyItemsShareTheParametersTheyAreMeasuredAt) {
   const auto scene = Scene::load(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/dual_arm_shelf.yaml");
-  const MotionChecker certified(scene);
+  MotionOptions measured;  // (every item measured: the rake settles most of them)
+  measured.rake = false;
+  const MotionChecker certified(scene, measured);
   MotionContext ctx = certified.makeContext();
   std::mt19937_64 rng(7);
   const int dim = scene->dimension();
