@@ -85,8 +85,8 @@ struct Scratch {
 };
 
 // A verdict-only check's first look (probe.cpp): the states at s = 1, 1/2, 1/4 and 3/4 (those that collided
-// first most often lately before the others), checked as the validity checker checks states (all their
-// obstacles before any of their self pairs: Scene::anyCollides). True, with r filled (a contact at that s,
+// first most often lately before the others), each checked as the validity checker checks states, until one
+// collides (Scene::anyCollides). True, with r filled (a contact at that s,
 // the state's report), when one collides: the segment is then not free whatever the items would measure.
 // Only where it has lately paid for itself (planners' segments often collide; a path's or a benchmark's
 // seldom do).

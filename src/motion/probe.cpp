@@ -38,8 +38,7 @@ bool probeCollides(const MotionChecker& checker, const double* q0, double t0, co
     for (; at > 0 && ctx.probe_hits[order[at - 1]] < ctx.probe_hits[k]; --at) order[at] = order[at - 1];
     order[at] = k;
   }
-  // All four at once: their kinematics in SIMD lanes, then every state's obstacles before any self pair (a
-  // planner's colliding segments mostly meet obstacles).
+  // Each in full, in that order, until one collides (Scene::anyCollides).
   const int dim = checker.scene().dimension();
   double times[kProbes];
   for (int k = 0; k < kProbes; ++k) {

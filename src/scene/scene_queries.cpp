@@ -294,46 +294,12 @@ int Scene::anyCollides(const double* states, int count, SceneContext& context, C
   CollisionReport& r = report ? *report : local;
   r = CollisionReport{};
   const int dim = dimension();
-  const auto state = [&](int s) { return states + static_cast<std::ptrdiff_t>(s) * dim; };
-  const auto time = [&](int s) { return times ? times[s] : 0.0; };
-  // A context made for another robot (or before lanes existed) takes the states one at a time.
-  if (!lanesFit(ctx)) {
-    for (int s = 0; s < count; ++s)
-      if (!checkState(state(s), ctx, &r, time(s))) return s;
-    return -1;
-  }
-  adopt(ctx);  // (lanesFit: it fits)
-  const Effects& fx = description_.effects;
-  const double* lane_q[KinematicLanes::kMaxLanes];
-  Pose* lane_poses[KinematicLanes::kMaxLanes];
-  // In chunks of as many states as the lanes' scratch holds: every environment check of a chunk, then every
-  // self check, each pass in the order given.
-  for (int first = 0; first < count; first += KinematicLanes::kMaxLanes) {
-    const int n = std::min(count - first, KinematicLanes::kMaxLanes);
-    for (int l = 0; l < n; ++l) {
-      const double* x = state(first + l);
-      ++ctx.counters.states;
-      if (!withinBounds(x) || !withinTime(time(first + l))) {
-        ++ctx.counters.invalid_states;
-        r.kind = CollisionReport::Kind::Invalid;
-        return first + l;
-      }
-      if (static_collision_.kind != CollisionReport::Kind::None) {
-        r = static_collision_;
-        return first + l;
-      }
-      toLane(x, l, ctx, lane_q, lane_poses);
-    }
-    if (!fx.self && !fx.environment) continue;
-    ctx.lanes->compute(lane_q, n, lane_poses);
-    for (int l = 0; l < n; ++l) {
-      bool balls_placed = false;
-      if (!environmentFree(lane_poses[l], ctx, r, time(first + l), balls_placed)) return first + l;
-    }
-    // (The balls were placed for another state's grid look-ups: the self check places its own.)
-    for (int l = 0; l < n; ++l)
-      if (!selfFree(lane_poses[l], lane_q[l], ctx, r, false)) return first + l;
-  }
+  // One state at a time and in full: the probe gives the likeliest first, and on the shared problems its first
+  // state collides with itself as often as with obstacles (the UR5's three times as often), so checking every
+  // state's obstacles before any state's self pairs, with their kinematics in lanes, cost 3 to 9% more per
+  // planner-like segment.
+  for (int s = 0; s < count; ++s)
+    if (!checkState(states + static_cast<std::ptrdiff_t>(s) * dim, ctx, &r, times ? times[s] : 0.0)) return s;
   return -1;
 }
 

@@ -207,13 +207,10 @@ class Scene {
   /// SIMD lanes (KinematicLanes); then each state's links meet the obstacles and each other.
   void areFree(const double* states, int count, SceneContext& context, bool* free, double t = 0.0) const noexcept;
 
-  /// A colliding state among `count` states (state s at states + s·dimension(), at time times[s], or 0
-  /// without times): its index, with `report` (optional) saying what collided, or −1 when every state is free
-  /// (each verdict as isFree gives it). Verdict only, for a segment's probe: in each chunk of
-  /// KinematicLanes::kMaxLanes states, every state's environment check comes before any self check, so an
-  /// obstacle met in a later state ends the query before the self pairs of the earlier ones are tested;
-  /// the index is a colliding state, not necessarily the first. The kinematics run in SIMD lanes, as in
-  /// areFree.
+  /// The first colliding state among `count` states (state s at states + s·dimension(), at time times[s], or
+  /// 0 without times): its index, with `report` (optional) saying what collided, or −1 when every state is
+  /// free (each verdict as isFree gives it). For a segment's probe: each state is checked in full before the
+  /// next, and the states after the first colliding one are not checked.
   int anyCollides(const double* states, int count, SceneContext& context, CollisionReport* report = nullptr,
                   const double* times = nullptr) const noexcept;
 
