@@ -11,7 +11,7 @@
 namespace clearway::motion_detail {
 
 // How many states the probe checks.
-constexpr int kProbes = 2;
+constexpr int kProbes = 4;
 
 // What one thread's checks of one MotionChecker keep between and within segments (MotionContext holds it).
 struct Scratch {
@@ -84,7 +84,7 @@ struct Scratch {
   std::vector<double> probe_states;  // the probe's states, one after another (kProbes·dimension)
 };
 
-// A verdict-only check's first look (probe.cpp): the states at s = 1 and 1/2 (the one that collided
+// A verdict-only check's first look (probe.cpp): the states at s = 1, 1/2, 1/4 and 3/4 (those that collided
 // first most often lately before the others), each checked as the validity checker checks states, until one
 // collides (Scene::anyCollides). True, with r filled (a contact at that s,
 // the state's report), when one collides: the segment is then not free whatever the items would measure.

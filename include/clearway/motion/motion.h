@@ -254,8 +254,8 @@ class MotionChecker {
   /// measurement still certifies half the contact distance). Without it, only the verdict: the first
   /// measurement within contact_distance ends the check (first_contact is then a contact, not
   /// necessarily the first, and last_valid 0) — OMPL's checkMotion(s1, s2), where planners try many
-  /// colliding motions; while many of a context's segments collide, the states at s = 1 and 1/2
-  /// are checked first, and one that collides ends it there. It says free exactly where the located check
+  /// colliding motions; while many of a context's segments collide, the states at s = 1, 1/2, 1/4
+  /// and 3/4 are checked first, and one that collides ends it there. It says free exactly where the located check
   /// does (both measure the same parameters until a contact, and a colliding state is within contact);
   /// its verdict depends on the segment alone, its first_contact and report also on the context's
   /// earlier segments.
