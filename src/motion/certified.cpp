@@ -488,20 +488,21 @@ struct MotionChecker::Sweep {
   // grown by the rounding of its placed centre and of its radius (margins.h).
   const motion_detail::Scratch::RakeBall& rakeBall(int body, int frame, const LinkGeometry& g, double s) {
     motion_detail::Scratch::RakeBall& b = ctx.rake_balls[body];
-    if (b.piece != ctx.rake_piece) {
+    if (b.piece != ctx.rake_piece || b.geometry != &g) {  // (an index names one geometry; checked, not assumed)
       const Pose& p = pose(s, frame);
       b.center = p * g.sphereCenter();
       b.radius =
           g.sphereRadius() * (1.0 + margins::kRounding) + margins::placedRounding(g.sphereCenter().norm(), p.t.norm());
       b.norm = b.center.norm();
       b.piece = ctx.rake_piece;
+      b.geometry = &g;
     }
     return b;
   }
   // Whether item k's bounding balls at s settle the piece s ± half: apart (for the environment: clear of the
-  // obstacles' boxes) by more than padding + contact + B·half; else whether they are by more than padding +
-  // contact (the piece's halves may be), or near.
-  Raked rakeTest(int k, double s, double half) {
+  // obstacles' boxes) by more than padding + contact + B·half; else, unless `last` (no halves follow), whether
+  // they are by more than padding + contact (the piece's halves may be), or near.
+  Raked rakeTest(int k, double s, double half, bool last) {
     const Item& it = mc.items_[k];
     const Scene& sc = *mc.scene_;
     const Tolerances& tol = sc.options().tolerances;
@@ -524,7 +525,7 @@ struct MotionChecker::Sweep {
     const double grown = (a.radius + motion) * margins::kBeyond;
     const double slack = sc.environment().linkSlack(contact, a.center.cwiseAbs().maxCoeff() + grown, tol);
     if (boxes->ballClear(a.center, grown, slack)) return Raked::Settled;
-    return boxes->ballClear(a.center, a.radius, slack) ? Raked::Halve : Raked::Near;
+    return !last && boxes->ballClear(a.center, a.radius, slack) ? Raked::Halve : Raked::Near;
   }
 
   // Fills ctx.settled for items [0, n_items) whose coverage starts at 0 (not the groups' members), level by
@@ -549,7 +550,7 @@ struct MotionChecker::Sweep {
         ++ctx.rake_piece;
         for (const int k : due) {
           if (!(ctx.rake_now[k] >> p & 1u)) continue;
-          const Raked t = rakeTest(k, m, half);
+          const Raked t = rakeTest(k, m, half, last);
           if (t == Raked::Settled) {
             ctx.settled[k] |= static_cast<std::uint8_t>(((1u << width) - 1u) << (p * width));
           } else if (t == Raked::Halve && !last) {

@@ -42,6 +42,7 @@ struct Scratch {
     Vec3 center = Vec3::Zero();
     double radius = 0.0, norm = 0.0;
     std::uint64_t piece = 0;
+    const LinkGeometry* geometry = nullptr;  // the body's geometry it was placed for
   };
   std::vector<RakeBall> rake_balls;
   std::uint64_t rake_piece = 0;  // the rake's pieces so far (names each)
