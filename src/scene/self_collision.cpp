@@ -108,7 +108,7 @@ bool SelfCollision::pairCollides(int k, const Pose* poses, SelfCollisionContext&
 
 bool SelfCollision::pairHits(int k, const Pose* poses, SelfScratch& ctx, EnclosingBalls* balls) const noexcept {
   const Screen s = pairScreen(k, poses, ctx, balls);
-  return s == Screen::Unsure ? pairExactly(k, poses) : s == Screen::Touching;
+  return s == Screen::Unsure ? pairExactly(k, poses, ctx) : s == Screen::Touching;
 }
 
 Screen SelfCollision::pairScreen(int k, const Pose* poses, SelfScratch& ctx, EnclosingBalls* balls) const noexcept {
@@ -122,10 +122,12 @@ Screen SelfCollision::pairScreen(int k, const Pose* poses, SelfScratch& ctx, Enc
   return BodyPair(*geometry_->link(p.a), *geometry_->link(p.b)).screen(poses[p.a], poses[p.b], options_.tolerances, q);
 }
 
-bool SelfCollision::pairExactly(int k, const Pose* poses) const noexcept {
+bool SelfCollision::pairExactly(int k, const Pose* poses, SelfScratch& ctx) const noexcept {
   const LinkPair& p = pairs_[k];
-  return meshesIntersectExactly(*geometry_->link(p.a), poses[p.a], *geometry_->link(p.b), poses[p.b],
-                                options_.tolerances, pair_padding_[k]);
+  if (ctx.owner == serial_ && k < static_cast<int>(ctx.bodies.size()))  // (as in pairScreen)
+    return ctx.bodies[k].intersectsExactly(poses[p.a], poses[p.b], options_.tolerances, pair_padding_[k]);
+  return BodyPair(*geometry_->link(p.a), *geometry_->link(p.b))
+      .intersectsExactly(poses[p.a], poses[p.b], options_.tolerances, pair_padding_[k]);
 }
 
 const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionContext& context, const double* q,
@@ -183,7 +185,7 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
   }
   if (two_pass)
     for (int k : ctx.unsure)
-      if (pairExactly(k, poses)) return hit(k, ctx);
+      if (pairExactly(k, poses, ctx)) return hit(k, ctx);
   ctx.last_hit = -1;
   return nullptr;
 }

@@ -1,6 +1,7 @@
 // Self-collision: the filter, an analytic robot built in code, and the Panda and UR5 against brute
 // force over triangle pairs on random configurations.
 #include <clearway/kinematics/forward_kinematics.h>
+#include <clearway/body/proximity.h>
 #include <clearway/load/robot_loader.h>
 #include <clearway/scene/self_collision.h>
 
@@ -242,6 +243,53 @@ TEST(SelfCollision, PandaMeshModeMatchesBruteForce) {
 
 TEST(SelfCollision, Arm6MeshModeMatchesBruteForce) {
   differential(test::sourceRobot("arm6/arm6.urdf"), "", 2000, 8);
+}
+
+// The convex parts' rung (links past 512 triangles: the UR5's arm and gripper) keeps every pair's verdict:
+// on random states, with and without padding, each pair's answer (cheap rungs, parts, triangles) is the
+// triangle search's alone, and the first collision is found exactly when some pair collides. The parts
+// must settle pairs the cheaper rungs left, else this would test nothing.
+TEST(SelfCollision, UR5PartsRungKeepsEveryVerdict) {
+  CLEARWAY_SHARED_ROBOT_OR_SKIP(urdf, "ur5/ur5.urdf");
+  auto model = std::make_shared<const RobotModel>(loadRobot(urdf, test::sharedRobot("ur5/ur5.srdf")));
+  auto geometry = std::make_shared<const RobotGeometry>(model);
+  const CollisionFilter filter(*model);
+  SelfCollisionOptions padded;
+  padded.link_padding.assign(model->linkCount(), 0.005);
+  const Tolerances tol;
+  std::mt19937_64 rng(41);
+  std::vector<Pose> poses(model->linkCount());
+  int by_parts = 0, colliding = 0, pairs_hit = 0;
+  for (const SelfCollisionOptions& options : {SelfCollisionOptions{}, padded}) {
+    const SelfCollision checker(geometry, filter, options);
+    SelfCollisionContext ctx = checker.makeContext();
+    for (int s = 0; s < 600; ++s) {
+      computeLinkPoses(*model, randomState(*model, rng).data(), poses.data());
+      bool any = false;
+      for (int k = 0; k < static_cast<int>(checker.pairs().size()); ++k) {
+        const LinkPair& p = checker.pairs()[k];
+        const LinkGeometry &a = *geometry->link(p.a), &b = *geometry->link(p.b);
+        const double padding = checker.pairPadding(k);
+        const bool truth = meshesIntersectExactly(a, poses[p.a], b, poses[p.b], tol, padding);
+        any |= truth;
+        pairs_hit += truth;
+        EXPECT_EQ(checker.pairCollides(k, poses.data(), ctx), truth)
+            << "state " << s << " pair " << model->link(p.a).name << "/" << model->link(p.b).name;
+        const IntersectQuery q{padding, GeometryMode::Mesh};
+        BodyPair cold(a, b);
+        if (cold.screen(poses[p.a], poses[p.b], tol, q) != Screen::Unsure) continue;
+        if (screenMeshes(a, poses[p.a], b, poses[p.b], tol, GeometryMode::Mesh, padding) != Screen::Apart) continue;
+        ++by_parts;  // the cheap rungs left it; the parts proved it apart
+        EXPECT_FALSE(truth) << "state " << s << ": the parts cleared a colliding pair";
+      }
+      colliding += any;
+      EXPECT_EQ(checker.firstCollision(poses.data(), ctx) != nullptr, any) << "state " << s;
+    }
+  }
+  std::printf("  1200 states: %d colliding (%d colliding pairs), %d pairs cleared by the parts\n", colliding, pairs_hit,
+              by_parts);
+  EXPECT_GT(by_parts, 50);
+  EXPECT_GT(colliding, 100);
 }
 
 TEST(SelfCollision, ContextsMakeThreadsIndependent) {

@@ -27,7 +27,7 @@ bool meshesIntersect(const LinkGeometry& a, const Pose& pose_a, const LinkGeomet
                      SimplexCache* hull_cache = nullptr) noexcept;
 
 /// What the cheap rungs of meshesIntersect (bounding balls, boxes, hulls, cores; convex parts where a link
-/// has more than 4096 triangles) tell of a pair.
+/// has more than 512 triangles) tell of a pair.
 enum class Screen : char { Apart, Touching, Unsure };
 /// meshesIntersect's rungs short of the triangles: Apart or Touching where they settle it (the answer
 /// meshesIntersect gives), Unsure where only meshesIntersectExactly can. Hull mode is never Unsure.
@@ -193,11 +193,13 @@ class BodyPair {
     if (shape_) return shapeIntersectsLink(*shape_, pose_b, *a_, pose_a, tol, q.mode, q.padding, &hullCache());
     return meshesIntersect(*a_, pose_a, *b_, pose_b, tol, q.mode, q.padding, &hullCache());
   }
-  /// intersects() split in two: its rungs short of the triangles (screenMeshes, warm), then, for an Unsure
-  /// pair, the triangles (meshesIntersectExactly). Together they answer as intersects() does.
+  /// intersects() split in two: its cheap rungs (screenMeshes' short of the convex parts, warm), then, for
+  /// an Unsure pair, intersectsExactly(). Together they answer as intersects() does.
   Screen screen(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, const IntersectQuery& q) noexcept;
-  /// The triangles' rung alone: meshesIntersectExactly on the two bodies (no warm start used or kept).
-  bool intersectsExactly(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, double padding) const noexcept;
+  /// The dear rungs: the convex parts (warm: the part pair too near last time is tried first), then the
+  /// triangles (meshesIntersectExactly). Left for the pairs screen() leaves Unsure, so that a query that
+  /// ends on another pair's contact never pays them.
+  bool intersectsExactly(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, double padding) noexcept;
   /// A certified lower bound on the distance between the bodies (see BoundQuery); 0 for non-finite input or
   /// a narrow-phase failure.
   double lowerBound(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, const BoundQuery& q) noexcept;
@@ -237,6 +239,7 @@ class BodyPair {
   SimplexCache hull_;
   std::vector<SimplexCache> parts_;  // a's part i against b's part j at i·nb + j
   bool parts_stale_ = false;
+  int parts_first_ = -1;  // the part pair intersectsExactly() tries first: the one too near last time
   Rung rung_ = Rung::Balls;
 };
 

@@ -118,9 +118,10 @@ class SelfCollision {
   EnclosingBalls* placeBalls(const Pose* link_poses, scene_detail::SelfScratch& s) const noexcept;
   // pairCollides, first asking the enclosing balls when given (placed at these poses).
   bool pairHits(int k, const Pose* link_poses, scene_detail::SelfScratch& s, EnclosingBalls* balls) const noexcept;
-  // pairHits in two halves: the enclosing balls and the pair's cheap rungs, then (for Unsure) the triangles.
+  // pairHits in two halves: the enclosing balls and the pair's cheap rungs, then (for Unsure) the convex parts
+  // and the triangles (BodyPair::intersectsExactly).
   Screen pairScreen(int k, const Pose* link_poses, scene_detail::SelfScratch& s, EnclosingBalls* balls) const noexcept;
-  bool pairExactly(int k, const Pose* link_poses) const noexcept;
+  bool pairExactly(int k, const Pose* link_poses, scene_detail::SelfScratch& s) const noexcept;
   // Pair k's table verdict at q (Unsure without a table or q).
   PairTable::Verdict tabled(int k, const double* q) const noexcept {
     return q && !tables_.empty() && tables_[k] ? tables_[k]->lookup(q) : PairTable::Verdict::Unsure;
