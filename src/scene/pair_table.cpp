@@ -2,12 +2,14 @@
 
 #include <clearway/body/proximity.h>
 #include <clearway/detail/margins.h>
+#include <clearway/shape/convex_hull.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <tuple>
 
 namespace clearway {
@@ -65,6 +67,60 @@ Pose jointMotion(const Joint& j, double x) {
 
 double axisDistance(const Vec3& p, const Vec3& u) { return (p - p.dot(u) * u).norm(); }
 
+// A closed convex mesh holding every turn of `points` about the axis u through the origin: each point's
+// circle lies in the regular kSides-gon about it whose sides touch it (corners at radius r / cos(π/kSides),
+// grown for rounding), and the hull of the polygons' corners holds them all. Only the points whose (height
+// along u, distance from u) is a corner of the profile's convex hull, the profile mirrored across the axis,
+// need their circles: every other point's circle lies in the hull of theirs (its profile point is a mix of
+// corners, mirrored ones standing for the circle's far side). Empty for a flat hull.
+TriangleMesh revolvedHull(const std::vector<Vec3>& points, const Vec3& u) {
+  constexpr int kSides = 16;
+  const double grow = margins::kBeyond / std::cos(kPi / kSides);
+  struct Profile {
+    double z, r;
+    int point;
+  };
+  std::vector<Profile> profile;
+  for (int i = 0; i < static_cast<int>(points.size()); ++i) {
+    const double z = points[i].dot(u), r = (points[i] - z * u).norm();
+    profile.push_back({z, r, i});
+    profile.push_back({z, -r, i});
+  }
+  std::sort(profile.begin(), profile.end(),
+            [](const Profile& a, const Profile& b) { return a.z < b.z || (a.z == b.z && a.r < b.r); });
+  // Andrew's monotone chain; a corner kept in doubt (a turn rounded to zero) only adds a circle.
+  const auto cross = [](const Profile& o, const Profile& a, const Profile& b) {
+    return (a.z - o.z) * (b.r - o.r) - (a.r - o.r) * (b.z - o.z);
+  };
+  std::vector<Profile> chain(2 * profile.size());
+  std::size_t k = 0;
+  for (const Profile& p : profile) {
+    while (k >= 2 && cross(chain[k - 2], chain[k - 1], p) < 0.0) --k;
+    chain[k++] = p;
+  }
+  for (std::size_t i = profile.size() - 1, lower = k + 1; i-- > 0;) {
+    while (k >= lower && cross(chain[k - 2], chain[k - 1], profile[i]) < 0.0) --k;
+    chain[k++] = profile[i];
+  }
+  std::vector<char> kept(points.size(), 0);
+  for (std::size_t i = 0; i < k; ++i) kept[chain[i].point] = 1;
+  std::vector<Vec3> corners;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!kept[i]) continue;
+    const Vec3& p = points[i];
+    const Vec3 along = p.dot(u) * u, off = p - along, side = u.cross(off);
+    for (int j = 0; j < kSides; ++j) {
+      const double angle = 2.0 * kPi * j / kSides;
+      corners.push_back(along + grow * (std::cos(angle) * off + std::sin(angle) * side));
+    }
+  }
+  const ConvexHull hull(corners);
+  TriangleMesh mesh;
+  mesh.vertices = hull.vertices();
+  for (const auto& t : hull.triangles()) mesh.triangles.push_back({t[0], t[1], t[2]});
+  return mesh;
+}
+
 bool isAncestor(const RobotModel& model, int ancestor, int link) {
   for (int l = link; l >= 0; l = model.parentLink(l))
     if (l == ancestor) return true;
@@ -96,6 +152,9 @@ struct Builder {
   const Tolerances& tol;
   BodyPair pair;
   double reach_last = 0.0;  // ρ of the lowest moved joint (configuration-independent)
+  // The lower body holds more than the lower link (its solid of revolution, revolvedHull): a cell it keeps
+  // apart is Free, but its cores prove nothing, and its triangles are not the link's.
+  bool free_only = false;
 
   Builder(const LinkGeometry& u, const LinkGeometry& d, double pad, GeometryMode m, const Tolerances& t)
       : up(u), down(d), padding(pad), mode(m), tol(t), pair(u, d) {}
@@ -168,7 +227,7 @@ struct Builder {
     // The rounding of this pose against the one forward kinematics computes, and of the bounds below.
     const double scale = up.boundingRadius() + down.boundingRadius() + t.t.norm();
     const double margin = margins::kSlack + 1e-7 * scale;
-    for (const LinkGeometry::CoreGroup& gb : down.coreGroups()) {
+    for (const LinkGeometry::CoreGroup& gb : free_only ? std::vector<LinkGeometry::CoreGroup>{} : down.coreGroups()) {
       const Vec3 gc = t * gb.center;
       for (const LinkGeometry::CoreGroup& ga : up.coreGroups()) {
         if (!((ga.center - gc).norm() < ga.radius + gb.radius)) continue;  // (a filter: it decides nothing)
@@ -327,14 +386,51 @@ std::unique_ptr<const PairTable> PairTable::build(const RobotModel& model, int a
   const auto heldValue = [&](int var) {
     return var >= 0 && var < static_cast<int>(held.size()) && std::isfinite(held[var]) ? held[var] : NAN;
   };
-  Builder bld(up == a ? ga : gb, up == a ? gb : ga, padding, mode, tol);
+  const auto leaderOf = [&](const Joint& j) {
+    return j.isMimic() ? model.joint(j.mimic.joint).first_variable : j.first_variable;
+  };
+  const auto moves = [&](const Joint& j) {
+    return j.type != JointType::Fixed && !std::isfinite(heldValue(leaderOf(j)));
+  };
+  // A third moving joint, the lowest, that turns the lower link about its own axis (a wrist's last joint,
+  // below it only fixed or held ones): the lower body becomes the solid the link sweeps about that axis,
+  // fixed to the joint's parent, and the table is over the other two variables (Free cells only).
+  const LinkGeometry& lower = up == a ? gb : ga;
+  std::optional<LinkGeometry> revolved;
+  std::size_t end = chain.size();  // the chain's joints walked below (the revolved joint's origin after them)
+  if (std::count_if(chain.begin(), chain.end(), [&](int ji) { return moves(model.joints()[ji]); }) == 3) {
+    std::size_t last = chain.size();
+    while (!moves(model.joints()[chain[last - 1]])) --last;
+    const Joint& turn = model.joints()[chain[last - 1]];
+    Pose below = Pose::identity();  // the lower link in the turning joint's frame
+    bool rigid = true;
+    for (std::size_t k = last; k < chain.size() && rigid; ++k) {
+      const Joint& j = model.joints()[chain[k]];
+      below = below * j.origin;
+      if (j.type == JointType::Fixed) continue;
+      rigid = j.type == JointType::Revolute || j.type == JointType::Continuous || j.type == JointType::Prismatic;
+      const double value = heldValue(leaderOf(j));
+      if (rigid) below = below * jointMotion(j, j.isMimic() ? j.mimic.multiplier * value + j.mimic.offset : value);
+    }
+    const bool turns = turn.type == JointType::Revolute || turn.type == JointType::Continuous;
+    if (rigid && turns && !turn.isMimic() && std::abs(turn.axis.norm() - 1.0) <= margins::kSlack && below.isFinite()) {
+      std::vector<Vec3> points;
+      for (const Vec3& v : lower.hull().vertices()) points.push_back(below * v);
+      const TriangleMesh mesh = revolvedHull(points, turn.axis);
+      if (mesh.triangles.empty()) return nullptr;
+      revolved.emplace(mesh);
+      end = last - 1;
+    }
+  }
+  Builder bld(up == a ? ga : gb, revolved ? *revolved : lower, padding, mode, tol);
+  bld.free_only = revolved.has_value();
   const auto small = [&](const LinkGeometry& g) {
     return g.triangles().size() <= static_cast<std::size_t>(std::max(0, options.max_exact_triangles));
   };
-  bld.exact_left = small(ga) && small(gb) ? options.max_exact_checks : 0;
+  bld.exact_left = small(ga) && small(gb) && !revolved ? options.max_exact_checks : 0;
   Pose cur = Pose::identity();
-  for (int ji : chain) {
-    const Joint& j = model.joints()[ji];
+  for (std::size_t k = 0; k < end; ++k) {
+    const Joint& j = model.joints()[chain[k]];
     cur = cur * j.origin;
     if (j.type == JointType::Fixed) continue;
     const bool turns = j.type == JointType::Revolute || j.type == JointType::Continuous;
@@ -357,9 +453,11 @@ std::unique_ptr<const PairTable> PairTable::build(const RobotModel& model, int a
     cur = Pose::identity();
   }
   if (bld.moved.empty()) return nullptr;  // a rigid pair: decided once by the scene
+  if (revolved) cur = cur * model.joints()[chain[end]].origin;  // (the body turns about the origin's axis)
   bld.fixed.push_back(cur);
 
   std::unique_ptr<PairTable> t(new PairTable());
+  t->free_only_ = bld.free_only;
   const int dims = static_cast<int>(bld.moved.size());
   const int coarse = dims == 1 ? options.coarse_one : options.coarse_two;
   // Fine cells per coarse one: a power of two, for the halving below.
@@ -448,7 +546,8 @@ std::unique_ptr<const PairTable> PairTable::build(const RobotModel& model, int a
     if (probed) probe.push_back(c);
   }
   refine(probe_cells);
-  if (share(probe) < options.min_probe_share) return nullptr;
+  // (A free-only table, asked only where the balls meet, must settle twice the share to pay its build.)
+  if (share(probe) < (bld.free_only ? 2.0 : 1.0) * options.min_probe_share) return nullptr;
   refine(rest);
   // Blocks all of one verdict fold into their coarse cell.
   const std::size_t per = static_cast<std::size_t>(f) * f1;

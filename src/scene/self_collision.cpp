@@ -79,8 +79,14 @@ SelfCollision::SelfCollision(std::shared_ptr<const RobotGeometry> geometry, cons
       tables_.push_back(PairTable::shared(geometry_, pairs_[k].a, pairs_[k].b, pair_padding_[k], options_.mode,
                                           options_.tolerances, options_.held, table));
   }
-  for (std::size_t k = 0; k < tables_.size(); ++k)
-    if (tables_[k]) with_table_.push_back(static_cast<int>(k));
+  free_table_.assign(pairs_.size(), 0);
+  for (std::size_t k = 0; k < tables_.size(); ++k) {
+    if (!tables_[k]) continue;
+    if (tables_[k]->freeOnly())
+      free_table_[k] = 1;
+    else
+      with_table_.push_back(static_cast<int>(k));
+  }
 }
 
 SelfCollisionContext SelfCollision::makeContext() const {
@@ -159,7 +165,10 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
                        ctx.bounds_apart.data());
   // A pair that collided a moment ago probably still does: trying it first ends most colliding queries
   // of a planner exploring near an obstacle after one pair test.
+  // (A free-only table, one of a wrist's turning link, clears nothing the balls have not: it is asked after
+  // them, for the pairs they leave, where a lookup costs less than the screen it saves.)
   const auto tableFree = [&](int k) {
+    if (free_table_[k]) return tabled(k, q) == PairTable::Verdict::Free;
     return kept ? ctx.table_free[k] != 0 : tabled(k, q) == PairTable::Verdict::Free;
   };
   if (ctx.last_hit >= 0 && ctx.last_hit < n && !tableFree(ctx.last_hit) &&
@@ -170,11 +179,12 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
   const bool two_pass = static_cast<int>(ctx.unsure.capacity()) >= n;  // (else pushing would allocate)
   if (two_pass) ctx.unsure.clear();
   for (int k = 0; k < n; ++k) {
-    if (k == ctx.last_hit || tableFree(k)) continue;
+    if (k == ctx.last_hit || (!free_table_[k] && tableFree(k))) continue;
     if (bounds && ctx.bounds_apart[k]) {  // as pairScreen would have found it: counted, apart
       ++ctx.pair_tests;
       continue;
     }
+    if (free_table_[k] && tableFree(k)) continue;
     if (!two_pass) {
       if (pairHits(k, poses, ctx, balls)) return hit(k, ctx);
       continue;

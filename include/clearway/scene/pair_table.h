@@ -14,6 +14,11 @@
 // to the axes and moves far less than the link's farthest point.
 // Other cells are Unsure and the pair is checked as before, after one triangle test of the pair that
 // touched at the cell's centre. A coarse grid is refined where it is unsure.
+// A pair moved by three variables, the lowest of which turns the lower link about its own axis (a wrist's
+// last link, and what it carries, against the forearm), is tabulated over the other two: the lower body is
+// then the solid the link sweeps over the whole turn (the hull of circumscribed polygons about the axis,
+// one per corner of the link's profile), so a cell is Free for every angle of the turn; such a table is
+// free-only (never Colliding, no witness).
 #include <clearway/body/proximity.h>
 #include <clearway/body/robot_geometry.h>
 #include <clearway/kinematics/robot_model.h>
@@ -65,8 +70,8 @@ class PairTable {
 
   /// The table of links a and b (geometries ga, gb), checked with `padding` in `mode`; null when their
   /// relative pose depends on other than one or two revolute, continuous or prismatic, non-mimic joints
-  /// (a prismatic one with finite limits). held[v], when finite, fixes variable v at that value (a joint
-  /// the scene holds is then fixed); empty: every variable moves.
+  /// (a prismatic one with finite limits), or three whose lowest turns the lower link (freeOnly()). held[v], when
+  /// finite, fixes variable v at that value (a joint the scene holds is then fixed); empty: every variable moves.
   static std::unique_ptr<const PairTable> build(const RobotModel& model, int a, const LinkGeometry& ga, int b,
                                                 const LinkGeometry& gb, double padding, GeometryMode mode,
                                                 const Tolerances& tol, const std::vector<double>& held = {},
@@ -101,8 +106,11 @@ class PairTable {
   /// leaving the table, through a cell not Free, or crossing more cells than the table has per turn).
   bool freeAlong(const double* q0, const double* q1) const noexcept;
 
-  /// The variables the pair's relative pose depends on (one or two).
+  /// The variables the table is over (one or two).
   const std::vector<int>& variables() const noexcept { return var_; }
+  /// True when the lower link's own joint, a third variable, is swept rather than tabulated: the table then
+  /// answers Free or Unsure, never Colliding, and gives no witness.
+  bool freeOnly() const noexcept { return free_only_; }
   /// The share of the variables' range (by volume) whose cells are certified Free or Colliding.
   double certifiedShare() const noexcept { return certified_; }
   /// How many cell centres were checked to build the table.
@@ -129,6 +137,7 @@ class PairTable {
   std::vector<TrianglePair> witness_;  // per fine cell
   double certified_ = 0.0;
   int checked_ = 0;
+  bool free_only_ = false;
 };
 
 }  // namespace clearway

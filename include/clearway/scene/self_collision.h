@@ -134,7 +134,8 @@ class SelfCollision {
   std::vector<double> pair_padding_;
   std::vector<std::int64_t> pair_a_, pair_b_;  // pairs_' links, as the enclosing layer's lanes read them
   std::vector<std::shared_ptr<const PairTable>> tables_;  // per pair when options_.pair_tables
-  std::vector<int> with_table_;                          // the pairs that have one
+  std::vector<int> with_table_;                           // the pairs whose table may prove a collision
+  std::vector<std::uint8_t> free_table_;  // per pair: its table is freeOnly(), asked only when the balls meet
   SelfCollisionOptions options_;
   // Which checker made a context: its warm starts (one BodyPair per pair, by index) serve only the checker
   // whose pairs they were made for. A copy keeps it (the same pairs, the same shared geometry).
