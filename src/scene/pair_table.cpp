@@ -67,58 +67,82 @@ Pose jointMotion(const Joint& j, double x) {
 
 double axisDistance(const Vec3& p, const Vec3& u) { return (p - p.dot(u) * u).norm(); }
 
-// A closed convex mesh holding every turn of `points` about the axis u through the origin: each point's
-// circle lies in the regular kSides-gon about it whose sides touch it (corners at radius r / cos(π/kSides),
-// grown for rounding), and the hull of the polygons' corners holds them all. Only the points whose (height
-// along u, distance from u) is a corner of the profile's convex hull, the profile mirrored across the axis,
-// need their circles: every other point's circle lies in the hull of theirs (its profile point is a mix of
-// corners, mirrored ones standing for the circle's far side). Empty for a flat hull.
-TriangleMesh revolvedHull(const std::vector<Vec3>& points, const Vec3& u) {
-  constexpr int kSides = 16;
+// A body holding every turn of `points` about the axis u through the origin. A point's turn is a circle, and
+// the profile of the turn (height along u, ± distance from it) lies in the convex hull of the points'
+// profiles, mirrored across the axis; so the body of that polygon's circles holds them all. The polygon is
+// cut across the axis into kSlabs slabs, one convex piece each (a part of its own: near a joint, the slab
+// near the axes moves less than the far one); each piece is the hull of the regular kSides-gons whose sides
+// touch its corners' circles (corners at radius r / cos(π/kSides), grown for rounding). Primitives, not a
+// mesh: they need no cores or triangles, which cost a mesh ten times as long to build. Nothing when a
+// piece is flat (a profile without area).
+std::optional<LinkGeometry> revolvedHull(const std::vector<Vec3>& points, const Vec3& u) {
+  constexpr int kSides = 16, kSlabs = 4;
   const double grow = margins::kBeyond / std::cos(kPi / kSides);
   struct Profile {
     double z, r;
-    int point;
   };
   std::vector<Profile> profile;
-  for (int i = 0; i < static_cast<int>(points.size()); ++i) {
-    const double z = points[i].dot(u), r = (points[i] - z * u).norm();
-    profile.push_back({z, r, i});
-    profile.push_back({z, -r, i});
+  for (const Vec3& p : points) {
+    const double z = p.dot(u), r = (p - z * u).norm();
+    profile.push_back({z, r});
+    profile.push_back({z, -r});
   }
   std::sort(profile.begin(), profile.end(),
             [](const Profile& a, const Profile& b) { return a.z < b.z || (a.z == b.z && a.r < b.r); });
-  // Andrew's monotone chain; a corner kept in doubt (a turn rounded to zero) only adds a circle.
+  // Andrew's monotone chain, counter-clockwise; a corner kept in doubt (a turn rounded to zero) only adds
+  // a circle.
   const auto cross = [](const Profile& o, const Profile& a, const Profile& b) {
     return (a.z - o.z) * (b.r - o.r) - (a.r - o.r) * (b.z - o.z);
   };
-  std::vector<Profile> chain(2 * profile.size());
+  std::vector<Profile> polygon(2 * profile.size());
   std::size_t k = 0;
   for (const Profile& p : profile) {
-    while (k >= 2 && cross(chain[k - 2], chain[k - 1], p) < 0.0) --k;
-    chain[k++] = p;
+    while (k >= 2 && cross(polygon[k - 2], polygon[k - 1], p) < 0.0) --k;
+    polygon[k++] = p;
   }
   for (std::size_t i = profile.size() - 1, lower = k + 1; i-- > 0;) {
-    while (k >= lower && cross(chain[k - 2], chain[k - 1], profile[i]) < 0.0) --k;
-    chain[k++] = profile[i];
+    while (k >= lower && cross(polygon[k - 2], polygon[k - 1], profile[i]) < 0.0) --k;
+    polygon[k++] = profile[i];
   }
-  std::vector<char> kept(points.size(), 0);
-  for (std::size_t i = 0; i < k; ++i) kept[chain[i].point] = 1;
-  std::vector<Vec3> corners;
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    if (!kept[i]) continue;
-    const Vec3& p = points[i];
-    const Vec3 along = p.dot(u) * u, off = p - along, side = u.cross(off);
-    for (int j = 0; j < kSides; ++j) {
-      const double angle = 2.0 * kPi * j / kSides;
-      corners.push_back(along + grow * (std::cos(angle) * off + std::sin(angle) * side));
+  polygon.resize(k > 0 ? k - 1 : 0);  // (the chain ends where it began)
+  if (polygon.size() < 3) return std::nullopt;
+  // The slabs' cuts: each edge crossing a cut is cut at the same point for the slabs on both sides.
+  const auto clip = [](const std::vector<Profile>& in, double c, bool keep_above) {
+    std::vector<Profile> out;
+    for (std::size_t i = 0; i < in.size(); ++i) {
+      const Profile& p = in[i];
+      const Profile& q = in[(i + 1) % in.size()];
+      const bool p_in = keep_above ? p.z >= c : p.z <= c, q_in = keep_above ? q.z >= c : q.z <= c;
+      if (p_in) out.push_back(p);
+      if (p_in != q_in) {
+        const Profile& lo = p.z < q.z ? p : q;  // (from the same end on both sides of the cut)
+        const Profile& hi = p.z < q.z ? q : p;
+        out.push_back({c, lo.r + (hi.r - lo.r) * ((c - lo.z) / (hi.z - lo.z))});
+      }
     }
+    return out;
+  };
+  const Vec3 e1 = u.unitOrthogonal(), e2 = u.cross(e1);
+  const double z0 = profile.front().z, z1 = profile.back().z;
+  std::vector<CollisionElement> pieces;
+  for (int slab = 0; slab < kSlabs; ++slab) {
+    std::vector<Profile> piece = polygon;
+    if (slab > 0) piece = clip(piece, z0 + (z1 - z0) * slab / kSlabs, true);
+    if (slab + 1 < kSlabs) piece = clip(piece, z0 + (z1 - z0) * (slab + 1) / kSlabs, false);
+    std::vector<Vec3> corners;
+    for (const Profile& p : piece)
+      for (int j = 0; j < kSides; ++j) {
+        const double angle = 2.0 * kPi * j / kSides;
+        corners.push_back(p.z * u + (grow * std::abs(p.r)) * (std::cos(angle) * e1 + std::sin(angle) * e2));
+      }
+    if (corners.empty()) return std::nullopt;
+    ConvexHull hull(corners);
+    if (hull.triangles().empty()) return std::nullopt;
+    CollisionElement solid;
+    solid.primitive = Shape{std::move(hull)};
+    pieces.push_back(std::move(solid));
   }
-  const ConvexHull hull(corners);
-  TriangleMesh mesh;
-  mesh.vertices = hull.vertices();
-  for (const auto& t : hull.triangles()) mesh.triangles.push_back({t[0], t[1], t[2]});
-  return mesh;
+  return LinkGeometry(pieces, std::vector<TriangleMesh>{});
 }
 
 bool isAncestor(const RobotModel& model, int ancestor, int link) {
@@ -416,9 +440,8 @@ std::unique_ptr<const PairTable> PairTable::build(const RobotModel& model, int a
     if (rigid && turns && !turn.isMimic() && std::abs(turn.axis.norm() - 1.0) <= margins::kSlack && below.isFinite()) {
       std::vector<Vec3> points;
       for (const Vec3& v : lower.hull().vertices()) points.push_back(below * v);
-      const TriangleMesh mesh = revolvedHull(points, turn.axis);
-      if (mesh.triangles.empty()) return nullptr;
-      revolved.emplace(mesh);
+      revolved = revolvedHull(points, turn.axis);
+      if (!revolved) return nullptr;
       end = last - 1;
     }
   }
