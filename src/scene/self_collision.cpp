@@ -165,8 +165,8 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
                        ctx.bounds_apart.data());
   // A pair that collided a moment ago probably still does: trying it first ends most colliding queries
   // of a planner exploring near an obstacle after one pair test.
-  // (A free-only table, one of a wrist's turning link, clears nothing the balls have not: it is asked after
-  // them, for the pairs they leave, where a lookup costs less than the screen it saves.)
+  // (A free-only table, of a wrist's turning link, never ends a query: it is asked after the balls, only for
+  // the pairs they leave, where its lookup costs less than the screen it saves.)
   const auto tableFree = [&](int k) {
     if (free_table_[k]) return tabled(k, q) == PairTable::Verdict::Free;
     return kept ? ctx.table_free[k] != 0 : tabled(k, q) == PairTable::Verdict::Free;
