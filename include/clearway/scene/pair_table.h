@@ -16,9 +16,9 @@
 // touched at the cell's centre. A coarse grid is refined where it is unsure.
 // A pair moved by three variables, the lowest of which turns the lower link about its own axis (a wrist's
 // last link, and what it carries, against the forearm), is tabulated over the other two: the lower body is
-// then the solid the link sweeps over the whole turn (the hull of circumscribed polygons about the axis,
-// one per corner of the link's profile), so a cell is Free for every angle of the turn; such a table is
-// free-only (never Colliding, no witness).
+// then the solid the link sweeps over the whole turn (its profile about the axis cut into four slabs, each
+// the hull of the polygons circumscribing its corners' circles), so a cell is Free for every angle of the
+// turn; such a table is free-only (never Colliding, no witness).
 #include <clearway/body/proximity.h>
 #include <clearway/body/robot_geometry.h>
 #include <clearway/kinematics/robot_model.h>
@@ -61,8 +61,9 @@ struct PairTableOptions {
   PairTableOptions within(double seconds) const;
 };
 
-/// Certified verdicts of one self pair moved by one or two joint variables, per cell of those variables'
-/// values. Immutable once built; lookups are const and thread-safe.
+/// Certified verdicts of one self pair moved by one or two joint variables (or three, the lowest turning
+/// the lower link: freeOnly()), per cell of those variables' values. Immutable once built; lookups are
+/// const and thread-safe.
 class PairTable {
  public:
   /// A cell's verdict: Free or Colliding at every configuration in it, or Unsure (check the pair).

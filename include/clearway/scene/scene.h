@@ -93,8 +93,8 @@ struct SceneOptions {
   /// How robot and mesh files are read (package:// folders searched before the scene file's own; the
   /// COLLADA up axis).
   LoadOptions load;
-  /// Tabulate the self pairs moved by one or two joints at load (scene/pair_table.h): same verdicts,
-  /// faster queries, a longer load.
+  /// Tabulate the self pairs moved by one or two joints, or three whose lowest turns the lower link, at load
+  /// (scene/pair_table.h): same verdicts, faster queries, a longer load.
   bool pair_tables = true;
   /// Seconds the tables may take to build (SelfCollisionOptions::table_seconds): none by default.
   double pair_table_seconds = std::numeric_limits<double>::infinity();

@@ -34,8 +34,9 @@ struct SelfCollisionOptions {
   /// Metres added around each link (indexed by link; empty: none). A pair collides when its links are
   /// within padding[a] + padding[b]. Must be finite and ≥ 0.
   std::vector<double> link_padding;
-  /// Tabulate the verdicts of pairs whose relative pose depends on one or two joint variables
-  /// (scene/pair_table.h), for queries that pass the configuration. Same verdicts, built at construction.
+  /// Tabulate the verdicts of pairs whose relative pose depends on one or two joint variables, or three
+  /// whose lowest turns the lower link (scene/pair_table.h), for queries that pass the configuration. Same
+  /// verdicts, built at construction.
   bool pair_tables = true;
   /// held[v], when finite: variable v never leaves this value in queries that pass the configuration (a
   /// joint the scene holds), so the tables treat its joint as fixed. Empty: every variable may move.
