@@ -274,11 +274,13 @@ constexpr std::size_t kPartsScreenTriangles = 512;
 
 // The convex parts' rung: every part pair more than padding apart (beyond the band), stopping at the first
 // pair too near (`first`, when given, is tried first and set to it).
+// (`apart`: |b's origin − a's|, b_in_a.t's norm, which a caller that has b_in_a passes rather than have it
+// computed again.)
 bool partsScreen(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
-                 const Tolerances& tol, double padding, int* first) noexcept {
+                 const Tolerances& tol, double padding, double apart, int* first) noexcept {
   if (a.parts().size() <= 1 && b.parts().size() <= 1) return false;  // (one part is the hull: no tighter)
   if (std::max(a.triangles().size(), b.triangles().size()) <= kPartsScreenTriangles) return false;
-  const double scale = a.boundingRadius() + b.boundingRadius() + relativePose(pose_a, pose_b).t.norm();
+  const double scale = a.boundingRadius() + b.boundingRadius() + apart;
   const double need = (padding + narrowBand(scale + padding, tol)) * margins::kBeyond;
   return partsClear(
       a, pose_a, b, pose_b, tol, [need](int) { return need; }, first);
@@ -306,7 +308,7 @@ Screen screenRungs(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry
   if (coresOverlap(a, b, b_in_a) || coreInPrimitive(a, b, b_in_a)) return Screen::Touching;
   // A pair the parts clear skips the triangle search, which costs tens of thousands of operations near a
   // mesh of a thousand triangles.
-  if (parts && partsScreen(a, pose_a, b, pose_b, tol, padding, nullptr)) return Screen::Apart;
+  if (parts && partsScreen(a, pose_a, b, pose_b, tol, padding, b_in_a.t.norm(), nullptr)) return Screen::Apart;
   return Screen::Unsure;
 }
 }  // namespace
@@ -610,7 +612,7 @@ bool BodyPair::intersectsExactly(const Pose& pose_a, const Pose& pose_b, const T
                                  double padding) noexcept {
   if (shape_) return shapeIntersectsLink(*shape_, pose_b, *a_, pose_a, tol, GeometryMode::Mesh, padding);
   if (pose_a.isFinite() && pose_b.isFinite() && validPadding(padding) &&
-      partsScreen(*a_, pose_a, *b_, pose_b, tol, padding, &parts_first_))
+      partsScreen(*a_, pose_a, *b_, pose_b, tol, padding, relativePose(pose_a, pose_b).t.norm(), &parts_first_))
     return false;
   return meshesIntersectExactly(*a_, pose_a, *b_, pose_b, tol, padding);
 }

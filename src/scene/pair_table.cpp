@@ -251,20 +251,21 @@ struct Builder {
     // The rounding of this pose against the one forward kinematics computes, and of the bounds below.
     const double scale = up.boundingRadius() + down.boundingRadius() + t.t.norm();
     const double margin = margins::kSlack + 1e-7 * scale;
-    for (const LinkGeometry::CoreGroup& gb : free_only ? std::vector<LinkGeometry::CoreGroup>{} : down.coreGroups()) {
-      const Vec3 gc = t * gb.center;
-      for (const LinkGeometry::CoreGroup& ga : up.coreGroups()) {
-        if (!((ga.center - gc).norm() < ga.radius + gb.radius)) continue;  // (a filter: it decides nothing)
-        for (int j = gb.first; j < gb.first + gb.count; ++j) {
-          const LinkGeometry::Ball& b = down.cores()[j];
-          const Vec3 c = t * b.center;
-          for (int i = ga.first; i < ga.first + ga.count; ++i) {
-            const LinkGeometry::Ball& a = up.cores()[i];
-            if ((a.center - c).norm() + delta + margin < a.radius + b.radius) return PairTable::Verdict::Colliding;
+    if (!free_only)  // (the swept body's cores are not the link's)
+      for (const LinkGeometry::CoreGroup& gb : down.coreGroups()) {
+        const Vec3 gc = t * gb.center;
+        for (const LinkGeometry::CoreGroup& ga : up.coreGroups()) {
+          if (!((ga.center - gc).norm() < ga.radius + gb.radius)) continue;  // (a filter: it decides nothing)
+          for (int j = gb.first; j < gb.first + gb.count; ++j) {
+            const LinkGeometry::Ball& b = down.cores()[j];
+            const Vec3 c = t * b.center;
+            for (int i = ga.first; i < ga.first + ga.count; ++i) {
+              const LinkGeometry::Ball& a = up.cores()[i];
+              if ((a.center - c).norm() + delta + margin < a.radius + b.radius) return PairTable::Verdict::Colliding;
+            }
           }
         }
       }
-    }
     const double need = padding + delta + margin;
     BoundQuery q;
     q.enough = need;
