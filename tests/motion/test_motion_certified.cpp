@@ -2,6 +2,7 @@
 // contact parameters), agrees with dense sampling on our robots and the shared ones, and leaves a free state
 // at any clearance.
 #include "motion/motion_fixtures.h"
+#include "scene_cache.h"
 
 #include <gtest/gtest.h>
 
@@ -619,7 +620,8 @@ TEST(MotionCertified, PairTablesKeepEveryVerdict) {
     SCOPED_TRACE(d.name);
     SceneOptions without;
     without.pair_tables = false;
-    const auto fast = std::make_shared<const Scene>(d), plain = std::make_shared<const Scene>(d, without);
+    const auto fast = std::make_shared<const Scene>(d);
+    const auto plain = std::make_shared<const Scene>(d, fast->geometryPtr(), fast->environmentPtr(), without);
     for (const MotionMode mode : {MotionMode::Certified, MotionMode::Cast}) {
       MotionOptions o;
       o.mode = mode;
@@ -898,7 +900,7 @@ void expectShortcutKeepsMotions(const std::vector<std::string>& scenes, Environm
                                 int per_scene, unsigned seed, int& colliding, int& total) {
   std::mt19937 rng(seed);
   for (const std::string& path : scenes) {
-    const auto with = Scene::load(path);
+    const auto with = test::loadScene(path);
     const auto other = with->withEnvironment(std::make_shared<Environment>(without(with->environment())));
     with->environment().prepareClearanceGrid();
     const MotionChecker a(with), b(other);

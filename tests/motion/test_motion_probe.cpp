@@ -1,6 +1,7 @@
 // The probe (src/motion/probe.cpp): a verdict-only check learns which state collides first and keeps every
 // verdict of the located check.
 #include "motion/motion_fixtures.h"
+#include "scene_cache.h"
 
 #include <gtest/gtest.h>
 
@@ -77,7 +78,7 @@ TEST(MotionCertified, ProbeKeepsEveryVerdict) {
   if (!shared.empty() && std::filesystem::exists(shared + "/box_panda"))
     for (const char* name : {"box_panda/box_panda_0001.yaml", "cage_ur5/cage_ur5_0001.yaml",
                              "cage_panda/cage_panda_0001.octomap.yaml"})
-      cases.push_back({name, Scene::load(shared + "/" + name)});
+      cases.push_back({name, test::loadScene(shared + "/" + name)});
   else
     std::printf("shared scenes not found: the probe is compared on our own scenes only\n");
   for (const Case& c : cases) {

@@ -3,6 +3,7 @@
 // 562 items, the twin arm's fork, a rover and a flyer whose joints slide and spin) and the shared ones, in
 // both forms of the check, and it saves measurements.
 #include "motion/motion_fixtures.h"
+#include "scene_cache.h"
 
 #include <gtest/gtest.h>
 
@@ -83,7 +84,7 @@ TEST(MotionRake, KeepsEveryVerdictOnTheSharedRobots) {
   for (const char* name : {"box_panda/box_panda_0001.yaml", "bookshelf_small_panda/bookshelf_small_panda_0001.yaml",
                            "cage_ur5/cage_ur5_0001.yaml", "box_ur5/box_ur5_0001.octomap.yaml"}) {
     SCOPED_TRACE(name);
-    const RakeRun run = compareRake(Scene::load(shared + "/" + name), 37, 300);
+    const RakeRun run = compareRake(test::loadScene(shared + "/" + name), 37, 300);
     std::printf("%s: %d segments, %d collide; distances measured %ld with the rake, %ld without\n", name, run.segments,
                 run.colliding, run.queries_with, run.queries_without);
     EXPECT_EQ(run.segments, 300);

@@ -6,6 +6,7 @@
 #include <clearway/scene/scene.h>
 
 #include "load/robot_files.h"
+#include "scene_cache.h"
 
 #include <gtest/gtest.h>
 #include <hwy/targets.h>
@@ -123,7 +124,8 @@ TEST(SceneBatch, EverySharedFamilyInBothForms) {
     const std::string stem = family.path().string() + "/" + family.path().filename().string() + "_0001";
     for (const std::string file : {stem + ".yaml", stem + ".octomap.yaml"}) {
       if (!std::filesystem::exists(file)) continue;
-      const Scene scene(parseSceneFile(file));
+      const auto loaded = test::loadScene(file);
+      const Scene& scene = *loaded;
       const std::vector<double> q = randomStates(scene, 240, 7 + scenes);
       colliding += expectBatchEqualsOneByOne(scene, q, file);
       states += static_cast<int>(q.size()) / scene.dimension();

@@ -251,7 +251,7 @@ TEST(PairTable, SegmentsAreWalkedThroughEveryCellTheyCross) {
 void sameVerdicts(const SceneDescription& d, int states, std::uint64_t seed) {
   SceneOptions without;
   without.pair_tables = false;
-  const Scene fast(d), plain(d, without);
+  const Scene fast(d), plain(d, fast.geometryPtr(), fast.environmentPtr(), without);  // (one robot: one load)
   SceneContext a = fast.makeContext(), b = plain.makeContext();
   std::mt19937_64 rng(seed);
   std::vector<double> x(fast.dimension());

@@ -6,6 +6,7 @@
 
 #include "forced_target.h"
 #include "load/robot_files.h"
+#include "scene_cache.h"
 
 #include <gtest/gtest.h>
 #include <hwy/targets.h>
@@ -528,13 +529,6 @@ TEST(Scene, ThreadsShareOneScene) {
 TEST(Scene, SharedProblemsStartAndGoal) {
   CLEARWAY_SHARED_SCENES_OR_SKIP();
   int problems = 0, free_states = 0, agree = 0, margin = 0;
-  std::map<std::string, std::shared_ptr<const RobotGeometry>> robots;  // each robot loaded once
-  auto load = [&](const std::string& path) {
-    const SceneDescription d = parseSceneFile(path);
-    auto& g = robots[d.urdf];
-    if (!g) g = loadRobotGeometry(d);
-    return std::make_shared<const Scene>(d, g, loadEnvironment(d));
-  };
   for (const auto& family : std::filesystem::directory_iterator(sharedScenes())) {
     if (!family.is_directory()) continue;
     for (const auto& f : std::filesystem::directory_iterator(family.path())) {
@@ -542,8 +536,8 @@ TEST(Scene, SharedProblemsStartAndGoal) {
       if (f.path().extension() != ".yaml" || p.find(".octomap.") != std::string::npos) continue;
       std::string mp = p;
       mp.replace(mp.size() - 5, 5, ".octomap.yaml");
-      const auto prim = load(p);
-      const auto map = load(mp);
+      const auto prim = test::loadScene(p);
+      const auto map = test::loadScene(mp);
       ++problems;
       SceneDescription padded_d = parseSceneFile(p);
       padded_d.padding = 0.035;  // a voxel diagonal (0.0346 m) and rounding
@@ -757,7 +751,8 @@ TEST(Scene, TheLinkThatHitLastGoesFirstAndNoVerdictChanges) {
     if (!family.is_directory()) continue;
     const std::string stem = family.path().string() + "/" + family.path().filename().string() + "_0001";
     for (const std::string form : {".yaml", ".octomap.yaml"})
-      if (std::filesystem::exists(stem + form)) expectLeadKeepsVerdicts(*Scene::load(stem + form), stem + form, rng, changed);
+      if (std::filesystem::exists(stem + form))
+        expectLeadKeepsVerdicts(*test::loadScene(stem + form), stem + form, rng, changed);
   }
   EXPECT_GT(changed, 0) << "the lead never changed which link is reported: is it taken at all?";
   std::printf("the lead changed the reported link on %d colliding states\n", changed);
@@ -921,12 +916,13 @@ long long expectShortcutKeepsVerdicts(Shortcut shortcut, unsigned seed) {
     for (const std::string form : {".yaml", ".octomap.yaml"}) {
       if (!std::filesystem::exists(stem + form)) continue;
       if (shortcut == Shortcut::Boxes && form != ".yaml") {
-        EXPECT_EQ(Scene::load(stem + form)->environment().obstacleBoxes(), nullptr) << stem + form;
+        EXPECT_EQ(test::loadScene(stem + form)->environment().obstacleBoxes(), nullptr) << stem + form;
         continue;
       }
-      expectShortcutKeepsVerdicts(shortcut, Scene::load(stem + form), stem + form, rng, clears, targets);
+      expectShortcutKeepsVerdicts(shortcut, test::loadScene(stem + form), stem + form, rng, clears, targets);
       if (form == ".yaml")
-        expectShortcutKeepsVerdicts(shortcut, Scene::load(stem + form, hull), stem + form + " (hull)", rng, clears, {});
+        expectShortcutKeepsVerdicts(shortcut, test::loadScene(stem + form, hull), stem + form + " (hull)", rng, clears,
+                                    {});
     }
   }
   return clears;
