@@ -129,11 +129,19 @@ std::optional<LinkGeometry> revolvedHull(const std::vector<Vec3>& points, const 
     std::vector<Profile> piece = polygon;
     if (slab > 0) piece = clip(piece, z0 + (z1 - z0) * slab / kSlabs, true);
     if (slab + 1 < kSlabs) piece = clip(piece, z0 + (z1 - z0) * (slab + 1) / kSlabs, false);
+    // The piece is mirrored across the axis (so are its cuts, negation being exact): a corner and its
+    // mirror give one circle, and one on the axis a point.
+    for (Profile& p : piece) p.r = std::abs(p.r);
+    std::sort(piece.begin(), piece.end(),
+              [](const Profile& a, const Profile& b) { return std::tie(a.z, a.r) < std::tie(b.z, b.r); });
+    piece.erase(std::unique(piece.begin(), piece.end(),
+                            [](const Profile& a, const Profile& b) { return a.z == b.z && a.r == b.r; }),
+                piece.end());
     std::vector<Vec3> corners;
     for (const Profile& p : piece)
-      for (int j = 0; j < kSides; ++j) {
+      for (int j = 0; j < (p.r > 0.0 ? kSides : 1); ++j) {
         const double angle = 2.0 * kPi * j / kSides;
-        corners.push_back(p.z * u + (grow * std::abs(p.r)) * (std::cos(angle) * e1 + std::sin(angle) * e2));
+        corners.push_back(p.z * u + (grow * p.r) * (std::cos(angle) * e1 + std::sin(angle) * e2));
       }
     if (corners.empty()) return std::nullopt;
     ConvexHull hull(corners);

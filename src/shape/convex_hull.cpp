@@ -641,24 +641,26 @@ ConvexHull::ConvexHull(const std::vector<Vec3>& points) {
   }
   center_ /= static_cast<double>(vertices_.size());
 
-  // The cube map, by brute force (once): a direction's cell holds a vertex near its answer, so a climb
-  // from it takes a step or two where one from a stale hint (another pose, or GJK's first, far-apart
-  // directions) crosses much of a fine hull.
+  // The cube map (once): a direction's cell holds a vertex near its answer, so a climb from it takes a
+  // step or two where one from a stale hint (another pose, or GJK's first, far-apart directions) crosses
+  // much of a fine hull. Each cell's vertex is climbed to from its neighbour's (the cells of a face in a
+  // snake, so neighbours' directions are close): a few steps each, where a scan over every vertex made
+  // the map most of building a hull of a few hundred vertices. It only says where support() starts.
   if (!adjacency_.empty() && vertices_.size() >= kBruteForceBelow) {
     cube_.resize(6 * kCube * kCube);
-    for (int face = 0; face < 6; ++face)
+    for (int face = 0; face < 6; ++face) {
+      std::int32_t hint = starts_[face];  // (the extreme vertex along the face's axis)
       for (int i = 0; i < kCube; ++i)
-        for (int j = 0; j < kCube; ++j) {
+        for (int jj = 0; jj < kCube; ++jj) {
+          const int j = i % 2 ? kCube - 1 - jj : jj;
           Vec3 d = Vec3::Zero();
           const int axis = face / 2;
           d[axis] = face % 2 ? -1.0 : 1.0;
           d[(axis + 1) % 3] = (i + 0.5) * 2.0 / kCube - 1.0;
           d[(axis + 2) % 3] = (j + 0.5) * 2.0 / kCube - 1.0;
-          std::int32_t best = 0;
-          for (std::size_t v = 1; v < vertices_.size(); ++v)
-            if (d.dot(vertices_[v]) > d.dot(vertices_[best])) best = static_cast<std::int32_t>(v);
-          cube_[(face * kCube + i) * kCube + j] = best;
+          cube_[(face * kCube + i) * kCube + j] = hint = climb(d, hint, d.dot(vertices_[hint]));
         }
+    }
   }
 }
 
@@ -721,6 +723,11 @@ Vec3 ConvexHull::support(const Vec3& d, std::int32_t& hint) const noexcept {
       if (x > cur_dot) cur = starts_[i], cur_dot = x;
     }
   }
+  hint = climb(d, cur, cur_dot);
+  return vertices_[hint];
+}
+
+std::int32_t ConvexHull::climb(const Vec3& d, std::int32_t cur, double cur_dot) const noexcept {
   // Steepest ascent over the edge graph. Every move strictly increases d·v (so no vertex is visited
   // twice and there are fewer moves than vertices); a NaN d compares false and stops at once. On a
   // convex polytope whose vertices are all corners, a vertex with no better neighbour is a maximiser.
@@ -735,8 +742,7 @@ Vec3 ConvexHull::support(const Vec3& d, std::int32_t& hint) const noexcept {
     cur = next;
     cur_dot = next_dot;
   }
-  hint = cur;
-  return vertices_[cur];
+  return cur;
 }
 
 }  // namespace clearway

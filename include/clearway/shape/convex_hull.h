@@ -40,10 +40,12 @@ class ConvexHull {
   // Start vertices for hill climbing: the extreme vertex along ±x, ±y, ±z.
   std::array<std::int32_t, 6> starts_{};
   // A cube map of start vertices (hulls that hill-climb): per face of the cube (±x, ±y, ±z) a kCube × kCube
-  // grid, each cell's extreme vertex along the direction through its centre.
+  // grid, each cell's extreme vertex along the direction through its centre (climbed to).
   static constexpr int kCube = 8;
   std::vector<std::int32_t> cube_;
   Vec3 center_ = Vec3::Zero();
+  // The vertex where steepest ascent of d·v over the edge graph stops, from vertex `from` (d·v = from_dot).
+  std::int32_t climb(const Vec3& d, std::int32_t from, double from_dot) const noexcept;
 };
 
 }  // namespace clearway
