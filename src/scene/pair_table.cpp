@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <tuple>
@@ -151,6 +152,26 @@ std::optional<LinkGeometry> revolvedHull(const std::vector<Vec3>& points, const 
     pieces.push_back(std::move(solid));
   }
   return LinkGeometry(pieces, std::vector<TriangleMesh>{});
+}
+
+// revolvedHull's body, shared by every call with the same points and axis (compared exactly, so a body is
+// never another's): a wrist's turning link is the lower body of a table for each link above it, and
+// building the body took a quarter of loading the dual arm. Null: revolvedHull gave none. At most 64 kept.
+std::shared_ptr<const LinkGeometry> revolvedBody(const std::vector<Vec3>& points, const Vec3& u) {
+  static std::mutex mutex;
+  static std::map<std::vector<double>, std::shared_ptr<const LinkGeometry>> bodies;
+  std::vector<double> key = {u.x(), u.y(), u.z()};
+  for (const Vec3& p : points) key.insert(key.end(), {p.x(), p.y(), p.z()});
+  {
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (const auto it = bodies.find(key); it != bodies.end()) return it->second;
+  }
+  std::optional<LinkGeometry> body = revolvedHull(points, u);
+  auto shared = body ? std::make_shared<const LinkGeometry>(std::move(*body)) : nullptr;
+  const std::lock_guard<std::mutex> lock(mutex);
+  if (bodies.size() >= 64) bodies.clear();
+  bodies.emplace(std::move(key), shared);
+  return shared;
 }
 
 bool isAncestor(const RobotModel& model, int ancestor, int link) {
@@ -429,7 +450,7 @@ std::unique_ptr<const PairTable> PairTable::build(const RobotModel& model, int a
   // below it only fixed or held ones): the lower body becomes the solid the link sweeps about that axis,
   // fixed to the joint's parent, and the table is over the other two variables (Free cells only).
   const LinkGeometry& lower = up == a ? gb : ga;
-  std::optional<LinkGeometry> revolved;
+  std::shared_ptr<const LinkGeometry> revolved;
   std::size_t end = chain.size();  // the chain's joints walked below (the revolved joint's origin after them)
   if (std::count_if(chain.begin(), chain.end(), [&](int ji) { return moves(model.joints()[ji]); }) == 3) {
     std::size_t last = chain.size();
@@ -449,13 +470,13 @@ std::unique_ptr<const PairTable> PairTable::build(const RobotModel& model, int a
     if (rigid && turns && !turn.isMimic() && std::abs(turn.axis.norm() - 1.0) <= margins::kSlack && below.isFinite()) {
       std::vector<Vec3> points;
       for (const Vec3& v : lower.hull().vertices()) points.push_back(below * v);
-      revolved = revolvedHull(points, turn.axis);
+      revolved = revolvedBody(points, turn.axis);
       if (!revolved) return nullptr;
       end = last - 1;
     }
   }
   Builder bld(up == a ? ga : gb, revolved ? *revolved : lower, padding, mode, tol);
-  bld.free_only = revolved.has_value();
+  bld.free_only = revolved != nullptr;
   const auto small = [&](const LinkGeometry& g) {
     return g.triangles().size() <= static_cast<std::size_t>(std::max(0, options.max_exact_triangles));
   };
