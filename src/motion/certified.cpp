@@ -171,6 +171,17 @@ struct MotionChecker::Sweep {
     return mid;
   }
 
+  // Item k's motion bound for this segment (MotionChecker::itemBound), computed when first asked: the rake
+  // settles most of a many-link robot's far pairs by their bodies' own motions (body_bound), and their
+  // paths' bounds, a walk each, are then never needed (our dual arm: 595 self items every segment).
+  double boundOf(int k) const noexcept {  // (ctx is a reference: the cache is the scratch's)
+    if (ctx.bound_stamp[k] != ctx.segment) {
+      ctx.bound[k] = mc.itemBound(k, ctx.dq.data(), ctx.obstacle_motion);
+      ctx.bound_stamp[k] = ctx.segment;
+    }
+    return ctx.bound[k];
+  }
+
   // One item's warm starts, the block of n at `slot` in `all` (none for −1), emptied when this segment
   // first uses them: a verdict depends on nothing but its segment.
   SimplexCache* warmStarts(std::vector<SimplexCache>& all, int slot, std::uint64_t& stamp, std::size_t n) {
@@ -191,7 +202,7 @@ struct MotionChecker::Sweep {
     if (ctx.contact_stamp[k] != ctx.segment) return c;
     const std::array<double, 2>& e = ctx.contact[k];
     if (!(e[0] < c) && !(e[1] < c)) return c;
-    const double g = kContactGrowth * ctx.bound[k];  // (∞ for an unbounded motion: c away from the ends)
+    const double g = kContactGrowth * boundOf(k);  // (∞ for an unbounded motion: c away from the ends)
     const auto grown = [&](double end, double ds) { return ds > 0.0 ? end + g * ds : end; };
     return std::min({c, grown(e[0], s), grown(e[1], 1.0 - s)});
   }
@@ -360,7 +371,7 @@ struct MotionChecker::Sweep {
     const double* dq = ctx.dq.data();
     const Pose* poses = measuredPoses();  // (at the parameter d was measured at)
     // The static bound first: where it reaches as far as asked, the reaches from the axes now are not needed.
-    double h = d / ctx.bound[k];  // (∞ when the item does not move)
+    double h = d / boundOf(k);                              // (∞ when the item does not move)
     if (std::isnan(h)) h = d == INFINITY ? INFINITY : 0.0;  // (∞ / ∞: nothing near, and an unbounded motion)
     if (!(h < want)) return h;
     if (it.b < 0) return std::max(h, mc.bound_.linkStep(it.a, dq, poses, d, ctx.obstacle_motion));
@@ -382,7 +393,7 @@ struct MotionChecker::Sweep {
   // How far either way from s item k is clear, measured for the interval s ± half; −1 within contact.
   double first(int k, double s, double half) {
     CollisionReport report;
-    const double d = measureItem(k, s, ctx.bound[k] * half, report);
+    const double d = measureItem(k, s, boundOf(k) * half, report);
     if (d > contactOf(k, s)) return reach(k, d, half);
     if (verdict_only && mc.items_[k].last <= mc.items_[k].first) found(s, report);
     return -1.0;
@@ -410,13 +421,10 @@ struct MotionChecker::Sweep {
       const double hi = std::min(iv.b, limit);
       if (iv.a > hi || (hit && iv.a >= hi)) continue;
       const double m = measuringPoint(iv.a, hi);
-      const double d = measureItem(k, m, ctx.bound[k] * std::max(m - iv.a, hi - m), report);
+      const double d = measureItem(k, m, boundOf(k) * std::max(m - iv.a, hi - m), report);
       if (d <= contactOf(k, m)) {
         if (it.last > it.first) {  // a group within contact: its members take over here, exactly
-          for (int member = it.first; member < it.last && !stop(); ++member) {
-            ctx.bound[member] = mc.itemBound(member, ctx.dq.data(), ctx.obstacle_motion);
-            cover(member, iv.a, hi, iv.witness);
-          }
+          for (int member = it.first; member < it.last && !stop(); ++member) cover(member, iv.a, hi, iv.witness);
           continue;
         }
         if (verdict_only) {
@@ -447,7 +455,7 @@ struct MotionChecker::Sweep {
     CollisionReport report;
     double s = a, prev = std::max(witness, 0.0), prev_d = 0.0;  // the clearance measured at prev (0: none)
     while (!capped) {
-      const double d = measureItem(k, s, ctx.bound[k] * (until - s), report);
+      const double d = measureItem(k, s, boundOf(k) * (until - s), report);
       if (d <= contactOf(k, s)) {
         if (!hit || s < limit) {
           limit = s;
@@ -506,8 +514,6 @@ struct MotionChecker::Sweep {
     const Item& it = mc.items_[k];
     const Scene& sc = *mc.scene_;
     const Tolerances& tol = sc.options().tolerances;
-    const double motion = ctx.bound[k] * half;  // (∞ or NaN: nothing is settled)
-    if (!(motion < INFINITY)) return Raked::Near;
     const double contact = it.padding + mc.options_.contact_distance;
     const motion_detail::Scratch::RakeBall& a = rakeBall(it.a, it.frame_a, *it.ga, s);
     if (it.b >= 0) {
@@ -515,11 +521,25 @@ struct MotionChecker::Sweep {
       // |ca − cb| beyond both radii, the padding, the contact distance and (to settle) the motion, with the
       // narrow phase's band (as BodyPair's first rung) and the rounding of the squares and sums added.
       const double band = margins::narrowBand(tol.gjk_absolute) + margins::kRounding;
-      const double near =
-          a.radius + b.radius + contact + band * (a.norm + b.norm + a.radius + b.radius + contact + motion);
-      const double far = near + motion, d2 = (a.center - b.center).squaredNorm();
-      return d2 > far * far ? Raked::Settled : d2 > near * near ? Raked::Halve : Raked::Near;
+      const double d2 = (a.center - b.center).squaredNorm();
+      const auto test = [&](double motion) {
+        const double near =
+            a.radius + b.radius + contact + band * (a.norm + b.norm + a.radius + b.radius + contact + motion);
+        const double far = near + motion;
+        return d2 > far * far ? Raked::Settled : d2 > near * near ? Raked::Halve : Raked::Near;
+      };
+      // Until the pair's bound is known, the bodies' own motions: their sum bounds the pair's (the cheapest
+      // split of the same joints' terms between the two) and costs two loads where the pair's walks its path;
+      // it settles most far pairs (one arm against the other).
+      if (ctx.bound_stamp[k] != ctx.segment) {
+        const double loose = (ctx.body_bound[it.a] + ctx.body_bound[it.b]) * half;
+        if (loose < INFINITY && test(loose) == Raked::Settled) return Raked::Settled;
+      }
+      const double motion = boundOf(k) * half;
+      return motion < INFINITY ? test(motion) : Raked::Near;  // (∞ or NaN: nothing is settled)
     }
+    const double motion = boundOf(k) * half;
+    if (!(motion < INFINITY)) return Raked::Near;
     const ObstacleBoxes* boxes = sc.environment().obstacleBoxes();
     if (!boxes || ctx.obstacle_motion > 0.0) return Raked::Near;
     const double grown = (a.radius + motion) * margins::kBeyond;
@@ -641,11 +661,10 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
   }
   if (!locate_contact && motion_detail::probeCollides(*this, q0, t0, q1, t1, ctx, r)) return r;
   // (After the probe: a segment it settles needs no bounds.) Members wait until their group comes within contact.
-  for (int k = 0; k < n_items; ++k) {
-    if (items_[k].group >= 0) continue;
-    ctx.bound[k] = itemBound(k, ctx.dq.data(), ctx.obstacle_motion);  // (0 when nothing moves: measured once)
-    ctx.safe_until[k] = 0.0;
-  }
+  // (Their motion bounds are computed as the sweep first asks: Sweep::boundOf.)
+  for (int k = 0; k < n_items; ++k)
+    if (items_[k].group < 0) ctx.safe_until[k] = 0.0;
+  if (options_.rake) bound_.links(ctx.dq.data(), static_cast<int>(ctx.body_bound.size()), ctx.body_bound.data());
   // Self items whose tables prove them apart along the whole segment are not swept.
   bool ends_set = false;
   for (int k = 0; k < std::min(n_items, env_begin_); ++k) {

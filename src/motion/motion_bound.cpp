@@ -69,6 +69,7 @@ struct MotionBound::Tables {
   std::uint64_t serial_ = detail::nextSerial();
   std::vector<int> frame_;                        // per link: the link whose pose places it (a body's anchor)
   std::vector<double> link_coef_;                 // links × dim
+  std::vector<double> link_coef_t_;               // the same, dim × links (MotionBound::links)
   std::vector<std::vector<int>> chain_;           // per link: the joints from the root, in order
   std::vector<std::vector<double>> prefix_;       // per link: running sum of step_ along its chain
   // Σ step_ over chain_[link][i + 1 .. j] (i = −1: from the start): a difference of the running sums where
@@ -256,6 +257,10 @@ MotionBound::Tables::Tables(const Scene& scene, const std::vector<Body>& bodies)
       link_coef_[static_cast<std::size_t>(i) * dim_ + joint_var_[j]] += joint_mult_[j] * w;
     }
   }
+  link_coef_t_.assign(link_coef_.size(), 0.0);
+  for (int i = 0; i < links_; ++i)
+    for (int v = 0; v < dim_; ++v)
+      link_coef_t_[static_cast<std::size_t>(v) * links_ + i] = link_coef_[static_cast<std::size_t>(i) * dim_ + v];
 }
 
 bool MotionBound::Tables::translates(int a, int b, const double* dq) const noexcept {
@@ -525,6 +530,19 @@ MotionBound::MotionBound(const Scene& scene, const std::vector<Body>& bodies)
     : t_(std::make_shared<const Tables>(scene, bodies)) {}
 double MotionBound::link(int link, const double* dq) const noexcept { return t_->link(link, dq); }
 double MotionBound::pair(int a, int b, const double* dq) const noexcept { return t_->pair(a, b, dq); }
+void MotionBound::links(const double* dq, int count, double* out) const noexcept {
+  // Tables::link's sums, state entry by entry over all bodies at once (link_coef_t_: contiguous per entry, so
+  // the compiler's lanes do several bodies per step); entries that do not move are skipped, as link() does.
+  const Tables& t = *t_;
+  count = std::min(count, t.links_);
+  std::fill(out, out + count, 0.0);
+  for (int v = 0; v < t.dim_; ++v) {
+    if (dq[v] == 0.0) continue;
+    const double w = std::abs(dq[v]);
+    const double* c = &t.link_coef_t_[static_cast<std::size_t>(v) * t.links_];
+    for (int i = 0; i < count; ++i) out[i] += c[i] * w;
+  }
+}
 MotionBound::PairPath MotionBound::path(int a, int b) const {
   PairPath p;
   p.a_ = a, p.b_ = b;

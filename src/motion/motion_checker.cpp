@@ -283,6 +283,7 @@ MotionContext MotionChecker::makeContext() const {
   c.dq.resize(scene_->dimension());
   c.safe_until.resize(items_.size());
   c.bound.resize(items_.size());
+  c.bound_stamp.assign(items_.size(), 0);
   c.first_reach.resize(items_.size());
   c.settled.assign(items_.size(), 0);
   c.rake_now.assign(items_.size(), 0);
@@ -290,6 +291,7 @@ MotionContext MotionChecker::makeContext() const {
   int bodies = 0;
   for (const Item& it : items_) bodies = std::max({bodies, it.a + 1, it.b + 1});
   c.rake_balls.assign(bodies, {});
+  c.body_bound.assign(bodies, 0.0);
   c.contact.assign(items_.size(), {options_.contact_distance, options_.contact_distance});
   c.contact_stamp.assign(items_.size(), 0);
   c.split_slot.assign(env_begin_, 0);

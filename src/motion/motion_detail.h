@@ -29,7 +29,11 @@ struct Scratch {
   std::array<std::vector<std::uint64_t>, kPoseSlots> pose_stamp;
   std::vector<double> ends[2];  // the segment's ends as full variable vectors (for the pair tables)
   std::vector<double> safe_until;  // per item: where its coverage starts (Cast: where its shape cast reached)
-  std::vector<double> bound;       // per item: its motion bound for this segment
+  // Per item: its motion bound for this segment, computed when first asked (bound_stamp[k] == segment).
+  std::vector<double> bound;
+  std::vector<std::uint64_t> bound_stamp;
+  // Per body of the bound: how far its points move over this segment (MotionBound::link), for the rake.
+  std::vector<double> body_bound;
   std::vector<double> first_reach; // per item: how far its first measurement (in the middle) clears, −1: none
   // Per item: the rake's settled pieces of this segment (bit i: [i, i + 1] / kRakePieces; certified.cpp),
   // and its scratch: per item the pieces of the current and next level still to test, and the items that

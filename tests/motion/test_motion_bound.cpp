@@ -228,6 +228,44 @@ TEST(MotionBound, PathsGiveThePairBoundExactly) {
   for (const char* f : {"box_panda/box_panda_0001.yaml", "box_ur5/box_ur5_0001.yaml"}) check(root + "/" + f);
 }
 
+// links() is link() of every body, bit for bit; and the sum of two bodies' own bounds is never below their
+// pair's (the rake settles a far pair by it before walking the pair's path): our robots with every convex
+// part as a body of its own, steps where some joints stand still, the shared Panda and UR5.
+TEST(MotionBound, LinksAreEachLinksAndTheirSumBoundsThePair) {
+  std::mt19937 rng(37);
+  long compared = 0;
+  const auto check = [&](const std::string& file) {
+    const auto scene = Scene::load(file);
+    std::vector<MotionBound::Body> parts;
+    for (const int l : scene->geometry().geometricLinks())
+      for (const LinkGeometry::Part& part : scene->geometry().link(l)->parts())
+        parts.push_back({l, &part.hull, part.center, part.radius});
+    const MotionBound bound(*scene, parts);
+    const int links = scene->robot().linkCount() + static_cast<int>(parts.size()), n = scene->dimension();
+    std::vector<double> q0(n), q1(n), dq(n), own(links);
+    for (int trial = 0; trial < 20; ++trial) {
+      randomStep(*scene, rng, q0, q1, dq);
+      for (int i = 0; i < n; ++i)
+        if (trial % 3 == 0 && rng() % 3 == 0) dq[i] = 0.0;
+      bound.links(dq.data(), links, own.data());
+      for (int a = 0; a < links; ++a) {
+        ASSERT_EQ(own[a], bound.link(a, dq.data())) << file << ": " << a;
+        for (int b = 0; b < links; b += 1 + (trial + b) % 3) {
+          const double pair = bound.pair(a, b, dq.data());
+          EXPECT_GE((own[a] + own[b]) * (1.0 + 1e-12), pair) << file << ": " << a << " / " << b;
+          ++compared;
+        }
+      }
+    }
+  };
+  for (const char* f : {"arm6_wall", "twin_arm_table", "rover_gap", "flyer_post", "dual_arm_shelf"})
+    check(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/" + f + ".yaml");
+  EXPECT_GT(compared, 5000);
+  CLEARWAY_REQUIRE_SHARED("robots/panda/panda.urdf");
+  CLEARWAY_SHARED_OR_SKIP(root, "scenes");
+  for (const char* f : {"box_panda/box_panda_0001.yaml", "box_ur5/box_ur5_0001.yaml"}) check(root + "/" + f);
+}
+
 // A link's convex parts as links of the bound of their own (as the certified check splits a pair whose
 // hulls are near): no distance between a part's hull vertices and the other link's changes by more than
 // pair(part, other) says; and a part next to the axes that turn it gets a bound well below its link's

@@ -57,6 +57,8 @@ class MotionBound {
 
   /// Upper bound on how far any point of link `link` moves (world frame) for the state step dq.
   double link(int link, const double* dq) const noexcept;
+  /// link(i, dq) of the first `count` bodies (links, then merged bodies) into out[i].
+  void links(const double* dq, int count, double* out) const noexcept;
   /// Upper bound on how much the distance between links a and b can change for the step dq.
   double pair(int a, int b, const double* dq) const noexcept;
   /// The joints between two links and their reaches to either, set up once by path(a, b) for pair(path, dq)
