@@ -192,6 +192,30 @@ TEST(MotionBound, VelocityFieldHoldsOnTheSharedRobots) {
   expectTwistHoldsOn(scenes, 19);
 }
 
+// The bound of file's robot with every convex part a body of its own, over 20 random steps (in every third,
+// some joints still): visit(bound, bodies, dq, trial) for each.
+template <class Visit>
+void forBoundSteps(const std::string& file, std::mt19937& rng, Visit&& visit) {
+  const auto scene = Scene::load(file);
+  std::vector<MotionBound::Body> parts;
+  for (const int l : scene->geometry().geometricLinks())
+    for (const LinkGeometry::Part& part : scene->geometry().link(l)->parts())
+      parts.push_back({l, &part.hull, part.center, part.radius});
+  const MotionBound bound(*scene, parts);
+  const int bodies = scene->robot().linkCount() + static_cast<int>(parts.size()), n = scene->dimension();
+  std::vector<double> q0(n), q1(n), dq(n);
+  for (int trial = 0; trial < 20; ++trial) {
+    randomStep(*scene, rng, q0, q1, dq);
+    for (int i = 0; i < n; ++i)
+      if (trial % 3 == 0 && rng() % 3 == 0) dq[i] = 0.0;
+    visit(bound, bodies, dq, trial);
+  }
+}
+
+// Our robots' scenes and the shared Panda's and UR5's (the latter only where the shared data is).
+const char* const kOurScenes[] = {"arm6_wall", "twin_arm_table", "rover_gap", "flyer_post", "dual_arm_shelf"};
+const char* const kSharedScenes[] = {"box_panda/box_panda_0001.yaml", "box_ur5/box_ur5_0001.yaml"};
+
 // pair(path(a, b), dq), the certified check's form (its paths set up once), is pair(a, b, dq) to the bit: on
 // our robots (a forked twin arm, a planar rover and a floating flyer, with their unbounded slides) and the
 // shared ones, for every pair of links and of the links' convex parts, over random steps that leave some
@@ -200,32 +224,20 @@ TEST(MotionBound, PathsGiveThePairBoundExactly) {
   std::mt19937 rng(31);
   long compared = 0;
   const auto check = [&](const std::string& file) {
-    const auto scene = Scene::load(file);
-    std::vector<MotionBound::Body> parts;
-    for (const int l : scene->geometry().geometricLinks())
-      for (const LinkGeometry::Part& part : scene->geometry().link(l)->parts())
-        parts.push_back({l, &part.hull, part.center, part.radius});
-    const MotionBound bound(*scene, parts);
-    const int links = scene->robot().linkCount() + static_cast<int>(parts.size()), n = scene->dimension();
-    std::vector<double> q0(n), q1(n), dq(n);
-    for (int trial = 0; trial < 20; ++trial) {
-      randomStep(*scene, rng, q0, q1, dq);
-      for (int i = 0; i < n; ++i)
-        if (trial % 3 == 0 && rng() % 3 == 0) dq[i] = 0.0;
+    forBoundSteps(file, rng, [&](const MotionBound& bound, int links, const std::vector<double>& dq, int trial) {
       for (int a = 0; a < links; a += 1 + (trial + a) % 3)
         for (int b = 0; b < links; ++b) {
           const MotionBound::PairPath path = bound.path(a, b);
           EXPECT_EQ(bound.pair(path, dq.data()), bound.pair(a, b, dq.data())) << file << ": " << a << " / " << b;
           ++compared;
         }
-    }
+    });
   };
-  for (const char* f : {"arm6_wall", "twin_arm_table", "rover_gap", "flyer_post", "dual_arm_shelf"})
-    check(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/" + f + ".yaml");
+  for (const char* f : kOurScenes) check(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/" + f + ".yaml");
   EXPECT_GT(compared, 5000);
   CLEARWAY_REQUIRE_SHARED("robots/panda/panda.urdf");
   CLEARWAY_SHARED_OR_SKIP(root, "scenes");
-  for (const char* f : {"box_panda/box_panda_0001.yaml", "box_ur5/box_ur5_0001.yaml"}) check(root + "/" + f);
+  for (const char* f : kSharedScenes) check(root + "/" + f);
 }
 
 // links() is link() of every body, bit for bit; and the sum of two bodies' own bounds is never below their
@@ -235,18 +247,8 @@ TEST(MotionBound, LinksAreEachLinksAndTheirSumBoundsThePair) {
   std::mt19937 rng(37);
   long compared = 0;
   const auto check = [&](const std::string& file) {
-    const auto scene = Scene::load(file);
-    std::vector<MotionBound::Body> parts;
-    for (const int l : scene->geometry().geometricLinks())
-      for (const LinkGeometry::Part& part : scene->geometry().link(l)->parts())
-        parts.push_back({l, &part.hull, part.center, part.radius});
-    const MotionBound bound(*scene, parts);
-    const int links = scene->robot().linkCount() + static_cast<int>(parts.size()), n = scene->dimension();
-    std::vector<double> q0(n), q1(n), dq(n), own(links);
-    for (int trial = 0; trial < 20; ++trial) {
-      randomStep(*scene, rng, q0, q1, dq);
-      for (int i = 0; i < n; ++i)
-        if (trial % 3 == 0 && rng() % 3 == 0) dq[i] = 0.0;
+    forBoundSteps(file, rng, [&](const MotionBound& bound, int links, const std::vector<double>& dq, int trial) {
+      std::vector<double> own(links);
       bound.links(dq.data(), links, own.data());
       for (int a = 0; a < links; ++a) {
         ASSERT_EQ(own[a], bound.link(a, dq.data())) << file << ": " << a;
@@ -256,14 +258,13 @@ TEST(MotionBound, LinksAreEachLinksAndTheirSumBoundsThePair) {
           ++compared;
         }
       }
-    }
+    });
   };
-  for (const char* f : {"arm6_wall", "twin_arm_table", "rover_gap", "flyer_post", "dual_arm_shelf"})
-    check(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/" + f + ".yaml");
+  for (const char* f : kOurScenes) check(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/" + f + ".yaml");
   EXPECT_GT(compared, 5000);
   CLEARWAY_REQUIRE_SHARED("robots/panda/panda.urdf");
   CLEARWAY_SHARED_OR_SKIP(root, "scenes");
-  for (const char* f : {"box_panda/box_panda_0001.yaml", "box_ur5/box_ur5_0001.yaml"}) check(root + "/" + f);
+  for (const char* f : kSharedScenes) check(root + "/" + f);
 }
 
 // A link's convex parts as links of the bound of their own (as the certified check splits a pair whose
