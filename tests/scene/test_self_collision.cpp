@@ -3,10 +3,13 @@
 #include <clearway/kinematics/forward_kinematics.h>
 #include <clearway/body/proximity.h>
 #include <clearway/load/robot_loader.h>
+#include <clearway/scene/scene.h>
 #include <clearway/scene/self_collision.h>
 
 #include "load/robot_files.h"
 #include "scene/scissors.h"
+#include "scene_cache.h"
+#include "shared_data.h"
 #include "tree/mesh_reference.h"
 
 #include <gtest/gtest.h>
@@ -99,6 +102,43 @@ TEST(SelfCollision, ScissorsMatchesTheAnalyticAnswer) {
   EXPECT_GT(collide, 50);
   EXPECT_GT(free, 2000);
   EXPECT_EQ(ctx.pairTests(), collide + free) << "one pair tested per query";
+}
+
+// The loop over pairs eight at a time (a context of this checker, with its tables' verdicts and the balls'
+// kept) gives the plain loop's verdict (a context of a checker of other pairs, which keeps neither), state by
+// state: our dual arm and the shared UR5, whose pair tables and hundreds of pairs span many steps of eight.
+// (Which pair they name may differ: each context tries its own last hit first.)
+TEST(SelfCollision, EightPairsAtATimeAsOneByOne) {
+  std::mt19937 rng(41);
+  const auto check = [&](const std::string& file) {
+    const auto scene = test::loadScene(file);
+    const SelfCollision& checker = scene->selfCollision();
+    ASSERT_GT(checker.pairs().size(), 16u) << file;
+    CollisionFilter fewer = scene->filter();
+    fewer.disable(checker.pairs()[0].a, checker.pairs()[0].b, "test");
+    const SelfCollision other(scene->geometryPtr(), fewer, checker.options());
+    ASSERT_NE(other.pairs().size(), checker.pairs().size());
+    SelfCollisionContext kept = checker.makeContext(), plain = other.makeContext();
+    SceneContext placed = scene->makeContext();
+    std::vector<double> q(scene->dimension());
+    int colliding = 0;
+    for (int i = 0; i < 3000; ++i) {
+      for (int v = 0; v < scene->dimension(); ++v) {
+        const double lo = std::max(scene->validLower(v), -M_PI), hi = std::min(scene->validUpper(v), M_PI);
+        q[v] = std::uniform_real_distribution<double>(lo, hi)(rng);
+      }
+      scene->computePoses(q.data(), placed);
+      const LinkPair* a = checker.firstCollision(placed.poses().data(), kept, placed.jointValues().data());
+      const LinkPair* b = checker.firstCollision(placed.poses().data(), plain, placed.jointValues().data());
+      ASSERT_EQ(a != nullptr, b != nullptr) << file << ", state " << i;
+      colliding += a != nullptr;
+    }
+    EXPECT_GT(colliding, 100) << file;
+    EXPECT_LT(colliding, 2900) << file;
+  };
+  check(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/dual_arm_shelf.yaml");
+  CLEARWAY_SHARED_OR_SKIP(root, "scenes");
+  check(root + "/box_ur5/box_ur5_0001.yaml");
 }
 
 TEST(SelfCollision, PaddingWidensTheContact) {
