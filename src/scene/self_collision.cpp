@@ -196,6 +196,9 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
     // the apart pairs it would count are those not also table-free. Most steps leave none (the UR5's hundred-odd
     // pairs at a free state leave a few), and the pairs left are visited in the same order.
     constexpr std::uint64_t kOnes = 0x0101010101010101ull;
+    const auto count = [](std::uint64_t bytes) {  // bytes of 0 or 1: their sum lands in the top byte
+      return static_cast<long long>((bytes * kOnes) >> 56);
+    };
     for (int base = 0; base < n; base += 8) {
       const int m = std::min(8, n - base);
       std::uint64_t table = 0, apart = 0;
@@ -211,11 +214,11 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
       for (; left != 0; left &= left - 1) {
         const int j = __builtin_ctzll(left) / 8;
         if (screened(base + j)) {
-          ctx.pair_tests += __builtin_popcountll(apart & ((std::uint64_t{1} << (8 * j)) - 1));
+          ctx.pair_tests += count(apart & ((std::uint64_t{1} << (8 * j)) - 1));
           return hit(base + j, ctx);
         }
       }
-      ctx.pair_tests += __builtin_popcountll(apart);
+      ctx.pair_tests += count(apart);
     }
     visited = true;
   }
