@@ -294,6 +294,10 @@ struct MotionChecker::Sweep {
     double d;
     if (it.b >= 0) {
       const Pose& pb = pose(s, it.frame_b);
+      if (ctx.pair_stamp[k] != ctx.segment) {  // (its first measurement on this segment: no warm start)
+        ctx.pairs[k].forget();
+        ctx.pair_stamp[k] = ctx.segment;
+      }
       d = ctx.pairs[k].lowerBound(pa, pb, tol, q) - it.padding;
       // (The hulls' last GJK axis, this measurement's or an earlier one's, where the hulls cleared it. Not in
       // Hull mode: the parts hold the triangles, not all of the hull that decides there.)
@@ -647,9 +651,9 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
   const bool check_env = sc.effects().environment && !sc.environment().empty();
   const int n_items = check_env ? static_cast<int>(items_.size()) : env_begin_;
   // No warm start from other segments: a segment's verdict then depends on nothing but its ends (a planner's
-  // threads, and a later re-check of its path, must agree even on pairs within the contact distance).
-  for (BodyPair& p : ctx.pairs) p.forget();
-  ++ctx.segment;  // (the obstacles' warm starts are emptied as their items first need them)
+  // threads, and a later re-check of its path, must agree even on pairs within the contact distance). The
+  // pairs' and the obstacles' warm starts are emptied as their items are first measured (pair_stamp).
+  ++ctx.segment;
   // How far moving obstacles travel over the segment (per unit of s): it adds to every environment item's
   // motion; none unless the scene declares them.
   const bool timed = sc.effects().moving && sc.environment().hasMovingObstacles();
@@ -704,19 +708,25 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
   } else if (lead >= 0 && ctx.safe_until[lead] <= 1.0) {
     cover(lead, ctx.safe_until[lead], 1.0, ctx.safe_until[lead] > 0.0 ? ctx.safe_until[lead] : -1.0);
   }
-  // Every other item the rake left whole is first measured in the middle of what is left, where one set of
-  // poses serves all.
+  // The other items with work left, in order: not a group's members (their group decides when they are
+  // covered), nor those the tables, the rake or a cast cleared whole (most of a many-link robot's).
+  std::vector<int>& live = ctx.live;  // (room for every item: makeContext)
+  live.clear();
+  for (int k = 0; k < n_items; ++k)
+    if (k != lead && items_[k].group < 0 && ctx.safe_until[k] <= 1.0) live.push_back(k);
+  // Each the rake left whole is first measured in the middle of what is left, where one set of poses serves all.
   const double mid = 0.5 * sweep.limit;
-  for (int k = 0; k < n_items && !sweep.stop(); ++k)
-    if (k != lead && items_[k].group < 0 && ctx.safe_until[k] == 0.0 && ctx.settled[k] == 0) {
+  for (const int k : live) {
+    if (sweep.stop()) break;
+    if (ctx.safe_until[k] == 0.0 && ctx.settled[k] == 0) {
       const int before = sweep.contacts;
       ctx.first_reach[k] = sweep.first(k, mid, mid);
       if (sweep.contacts > before) ctx.lead = k;
     }
-  for (int k = 0; k < n_items && !sweep.stop(); ++k) {
-    if (k == lead || items_[k].group >= 0) continue;
+  }
+  for (const int k : live) {
+    if (sweep.stop()) break;
     const double start = ctx.safe_until[k];  // 0, or where a shape cast says the item is clear until
-    if (start > 1.0) continue;
     if (ctx.settled[k] != 0) {
       Sweep::coverUnsettled(k, ctx.settled[k], cover);
     } else if (start > 0.0) {

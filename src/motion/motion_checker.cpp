@@ -285,6 +285,7 @@ MotionContext MotionChecker::makeContext() const {
   c.bound.resize(items_.size());
   c.bound_stamp.assign(items_.size(), 0);
   c.first_reach.resize(items_.size());
+  c.live.reserve(items_.size());
   c.settled.assign(items_.size(), 0);
   c.rake_now.assign(items_.size(), 0);
   c.rake_next.assign(items_.size(), 0);
@@ -296,6 +297,7 @@ MotionContext MotionChecker::makeContext() const {
   c.contact_stamp.assign(items_.size(), 0);
   c.split_slot.assign(env_begin_, 0);
   c.split_stamp.assign(env_begin_, 0);
+  c.pair_stamp.assign(env_begin_, 0);
   for (int k = 0; k < env_begin_; ++k) {
     const Item& it = items_[k];
     c.split_slot[k] = static_cast<int>(c.split_bound.size());

@@ -35,6 +35,7 @@ struct Scratch {
   // Per body of the bound: how far its points move over this segment (MotionBound::link), for the rake.
   std::vector<double> body_bound;
   std::vector<double> first_reach; // per item: how far its first measurement (in the middle) clears, −1: none
+  std::vector<int> live;           // the items a segment still has to measure after the rake (certified.cpp)
   // Per item: the rake's settled pieces of this segment (bit i: [i, i + 1] / kRakePieces; certified.cpp),
   // and its scratch: per item the pieces of the current and next level still to test, and the items that
   // have some.
@@ -55,7 +56,10 @@ struct Scratch {
   // contact_distance (Sweep::contactOf grows it away from the end).
   std::vector<std::array<double, 2>> contact;
   std::vector<std::uint64_t> contact_stamp;
-  std::vector<BodyPair> pairs;  // per self item: its bodies and their warm starts (forgotten every segment)
+  // Per self item: its bodies and their warm starts, forgotten when the item is first measured on a segment
+  // (pair_stamp[k] == segment once it is).
+  std::vector<BodyPair> pairs;
+  std::vector<std::uint64_t> pair_stamp;
   // Per environment item, its hull's GJK axes against each static obstacle, kept the same way (the
   // item's block starts at env_slot[k − first environment item], −1: none).
   std::vector<SimplexCache> env_cache;
