@@ -714,7 +714,8 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
   live.clear();
   for (int k = 0; k < n_items; ++k)
     if (k != lead && items_[k].group < 0 && ctx.safe_until[k] <= 1.0) live.push_back(k);
-  // Each the rake left whole is first measured in the middle of what is left, where one set of poses serves all.
+  // An item the rake left whole is first measured in the middle of what is left, where one set of poses serves
+  // all.
   const double mid = 0.5 * sweep.limit;
   for (const int k : live) {
     if (sweep.stop()) break;

@@ -534,13 +534,14 @@ void MotionBound::links(const double* dq, int count, double* out) const noexcept
   // Tables::link's sums, state entry by entry over all bodies at once (link_coef_t_: contiguous per entry, so
   // the compiler's lanes do several bodies per step); entries that do not move are skipped, as link() does.
   const Tables& t = *t_;
-  count = std::min(count, t.links_);
-  std::fill(out, out + count, 0.0);
+  const int known = std::min(count, t.links_);
+  std::fill(out, out + known, 0.0);
+  std::fill(out + known, out + std::max(count, known), INFINITY);  // (no such body: no bound)
   for (int v = 0; v < t.dim_; ++v) {
     if (dq[v] == 0.0) continue;
     const double w = std::abs(dq[v]);
     const double* c = &t.link_coef_t_[static_cast<std::size_t>(v) * t.links_];
-    for (int i = 0; i < count; ++i) out[i] += c[i] * w;
+    for (int i = 0; i < known; ++i) out[i] += c[i] * w;
   }
 }
 MotionBound::PairPath MotionBound::path(int a, int b) const {

@@ -240,16 +240,18 @@ TEST(MotionBound, PathsGiveThePairBoundExactly) {
   for (const char* f : kSharedScenes) check(root + "/" + f);
 }
 
-// links() is link() of every body, bit for bit; and the sum of two bodies' own bounds is never below their
-// pair's (the rake settles a far pair by it before walking the pair's path): our robots with every convex
-// part as a body of its own, steps where some joints stand still, the shared Panda and UR5.
+// links() is link() of every body, bit for bit (∞ past the last); and the sum of two bodies' own bounds is
+// never below their pair's (the rake settles a far pair by it before walking the pair's path): our robots
+// with every convex part as a body of its own, steps where some joints stand still, the shared Panda and UR5.
 TEST(MotionBound, LinksAreEachLinksAndTheirSumBoundsThePair) {
   std::mt19937 rng(37);
   long compared = 0;
   const auto check = [&](const std::string& file) {
     forBoundSteps(file, rng, [&](const MotionBound& bound, int links, const std::vector<double>& dq, int trial) {
-      std::vector<double> own(links);
-      bound.links(dq.data(), links, own.data());
+      std::vector<double> own(links + 2);  // (two past the last body: no bound there)
+      bound.links(dq.data(), links + 2, own.data());
+      EXPECT_EQ(own[links], INFINITY);
+      EXPECT_EQ(own[links + 1], INFINITY);
       for (int a = 0; a < links; ++a) {
         ASSERT_EQ(own[a], bound.link(a, dq.data())) << file << ": " << a;
         for (int b = 0; b < links; b += 1 + (trial + b) % 3) {

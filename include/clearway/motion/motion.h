@@ -57,7 +57,7 @@ class MotionBound {
 
   /// Upper bound on how far any point of link `link` moves (world frame) for the state step dq.
   double link(int link, const double* dq) const noexcept;
-  /// link(i, dq) of the first `count` bodies (links, then merged bodies) into out[i].
+  /// link(i, dq) of the first `count` bodies (links, then merged bodies) into out[i] (∞ past the last body).
   void links(const double* dq, int count, double* out) const noexcept;
   /// Upper bound on how much the distance between links a and b can change for the step dq.
   double pair(int a, int b, const double* dq) const noexcept;
