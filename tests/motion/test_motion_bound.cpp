@@ -1,6 +1,7 @@
 // MotionBound (src/motion/motion_bound.cpp): the bound on how far any point of a link moves along a segment
 // holds for every joint kind, robot and convex part, on our robots and the shared ones.
 #include "motion/motion_fixtures.h"
+#include "scene_cache.h"
 
 #include <gtest/gtest.h>
 
@@ -196,7 +197,7 @@ TEST(MotionBound, VelocityFieldHoldsOnTheSharedRobots) {
 // some joints still): visit(bound, bodies, dq, trial) for each.
 template <class Visit>
 void forBoundSteps(const std::string& file, std::mt19937& rng, Visit&& visit) {
-  const auto scene = Scene::load(file);
+  const auto scene = test::loadScene(file);  // (the robot and its tables loaded once per process)
   std::vector<MotionBound::Body> parts;
   for (const int l : scene->geometry().geometricLinks())
     for (const LinkGeometry::Part& part : scene->geometry().link(l)->parts())
