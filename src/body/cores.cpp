@@ -334,7 +334,7 @@ bool coresOverlap(const LinkGeometry& a, const LinkGeometry& b, const Pose& b_in
   return false;
 }
 
-bool coreMeetsShape(const Shape& shape, const Pose& shape_in_link, const LinkGeometry& link) noexcept {
+bool coreMeetsShape(const Shape& shape, const Pose& shape_in_link, const LinkGeometry& link, double depth) noexcept {
   if (link.cores().empty()) return false;
   const Pose link_in_shape = shape_in_link.inverse();
   const double m = margin(link.boundingRadius() + shape_in_link.t.norm() + boundingRadius(shape));
@@ -345,7 +345,7 @@ bool coreMeetsShape(const Shape& shape, const Pose& shape_in_link, const LinkGeo
       const LinkGeometry::Ball& c = link.cores()[k];
       const Vec3 p = link_in_shape * c.center;
       const double d = std::visit(PointDistance{p}, shape);
-      if (d < c.radius - m) return true;  // (a NaN distance decides nothing)
+      if (d < c.radius - m - depth) return true;  // (a NaN distance, or depth, decides nothing)
     }
   }
   return false;

@@ -220,8 +220,10 @@ bool shapeInsideLink(const Shape& shape, const Pose& shape_in_link, const LinkGe
 /// True when a core of `a` and a core of `b` overlap (b placed in a's frame by b_in_a): the links collide.
 /// False proves nothing. The comparison keeps a margin far above the rounding of placing the centres.
 bool coresOverlap(const LinkGeometry& a, const LinkGeometry& b, const Pose& b_in_a) noexcept;
-/// True when a core of the link overlaps the convex shape (placed in the link's frame): they collide.
+/// True when a core of the link reaches into the convex shape (placed in the link's frame) by more than
+/// `depth` (metres, ≥ 0): they collide, and still do with the core moved up to `depth` from there.
 /// Decided for boxes, spheres and capsules (exact point distances); other shapes answer false.
-bool coreMeetsShape(const Shape& shape, const Pose& shape_in_link, const LinkGeometry& link) noexcept;
+bool coreMeetsShape(const Shape& shape, const Pose& shape_in_link, const LinkGeometry& link,
+                    double depth = 0.0) noexcept;
 
 }  // namespace clearway
