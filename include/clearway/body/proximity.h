@@ -26,7 +26,7 @@ bool meshesIntersect(const LinkGeometry& a, const Pose& pose_a, const LinkGeomet
                      const Tolerances& tol, GeometryMode mode, double padding = 0.0,
                      SimplexCache* hull_cache = nullptr) noexcept;
 
-/// What the cheap rungs of meshesIntersect (bounding balls, boxes, hulls, cores; convex parts where a link
+/// What the cheap rungs of meshesIntersect (bounding balls, boxes, cores, hulls; convex parts where a link
 /// has more than 512 triangles) tell of a pair.
 enum class Screen : char { Apart, Touching, Unsure };
 /// meshesIntersect's rungs short of the triangles: Apart or Touching where they settle it (the answer
