@@ -13,6 +13,9 @@ namespace clearway::scene_detail {
 
 struct SceneScratch {
   std::vector<double> q;      // the full joint vector (group values, held values, defaults)
+  // The full joint vector of a state the pair tables are asked before it is placed (q and poses stay the
+  // last placed state's until it is).
+  std::vector<double> tabled_q;
   std::vector<Pose> poses;    // world pose of every link
   SelfCollisionContext self;  // the self-collision checker's scratch
   // The links' enclosing balls at the current query's poses: the clearance grid's look-ups, shared with

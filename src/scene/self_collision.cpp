@@ -20,6 +20,13 @@ struct SelfScratch {
   std::vector<int> unsure;                 // pairs the cheap rungs left to the triangles (scratch of one query)
   std::vector<std::uint8_t> table_free;    // per pair: its table called it Free at this query's q
   std::vector<std::uint8_t> bounds_apart;  // per pair: its bounding balls apart at this query's poses
+  // The tables' look-ups of tabledCollision, kept for the firstCollision that follows at the same q: that q
+  // (every variable), whether they are still to be used and by which checker (its serial), and the pairs
+  // whose unsure cell has a witness.
+  std::vector<double> tabled_q;
+  bool tabled = false;
+  std::uint64_t tabled_by = 0;
+  std::vector<std::pair<int, TrianglePair>> witnesses;
   int last_hit = -1;                       // the pair (index into pairs()) that last collided, tried first; -1: none
   long long pair_tests = 0;  // pairs that reached the narrow phase (bounding spheres not apart), cumulative
   std::uint64_t owner = 0;   // the serial of the checker that made it (its pairs are `bodies`' pairs)
@@ -101,6 +108,8 @@ SelfCollisionContext SelfCollision::makeContext() const {
   c.unsure.reserve(pairs_.size());
   c.table_free.assign(pairs_.size(), 0);
   c.bounds_apart.assign(pairs_.size(), 0);
+  c.tabled_q.assign(geometry_->model().variableCount(), 0.0);
+  c.witnesses.reserve(with_table_.size());
   return SelfCollisionContext(std::move(scratch));
 }
 
@@ -142,23 +151,26 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
                                               EnclosingBalls* placed) const noexcept {
   SelfScratch& ctx = scratchOf(context.scratch_);
   const int n = static_cast<int>(pairs_.size());
-  // The tables first: a pair they prove colliding ends the query before any geometry is placed.
-  // A witness (two triangles that touched at the centre of the pair's unsure cell) proves a collision
-  // with one triangle test where the search would spend hundreds.
+  // The tables first: a pair they prove colliding ends the query before any geometry is placed (unless
+  // tabledCollision looked them up at this q already). A witness (two triangles that touched at the centre
+  // of the pair's unsure cell) proves a collision with one triangle test where the search would spend hundreds.
   // Each verdict is kept for the pass below (a context of another checker looks the tables up again).
   const bool kept = ctx.table_free.size() == pairs_.size();
-  if (kept) std::fill(ctx.table_free.begin(), ctx.table_free.end(), std::uint8_t{0});
-  if (q)
-    for (int k : with_table_) {
-      TrianglePair w;
-      const PairTable::Verdict v = tables_[k]->lookup(q, &w);
-      if (v == PairTable::Verdict::Colliding) return hit(k, ctx);
-      if (kept) ctx.table_free[k] = v == PairTable::Verdict::Free;
-      const LinkPair& p = pairs_[k];
-      if (w.valid() && trianglesTouch(*geometry_->link(p.a), poses[p.a], *geometry_->link(p.b), poses[p.b], w,
-                                      options_.tolerances, pair_padding_[k]))
-        return hit(k, ctx);
-    }
+  const bool looked_up =
+      q && ctx.tabled && ctx.tabled_by == serial_ && std::equal(ctx.tabled_q.begin(), ctx.tabled_q.end(), q);
+  ctx.tabled = false;
+  if (!q) {
+    if (kept) std::fill(ctx.table_free.begin(), ctx.table_free.end(), std::uint8_t{0});
+    ctx.witnesses.clear();
+  } else if (!looked_up) {
+    if (const LinkPair* p = lookUp(q, ctx)) return p;
+  }
+  for (const auto& [k, w] : ctx.witnesses) {
+    const LinkPair& p = pairs_[k];
+    if (trianglesTouch(*geometry_->link(p.a), poses[p.a], *geometry_->link(p.b), poses[p.b], w, options_.tolerances,
+                       pair_padding_[k]))
+      return hit(k, ctx);
+  }
   EnclosingBalls* balls = placed ? placed : placeBalls(poses, ctx);
   // The enclosing layer's first rung for every pair at once (SIMD lanes): most pairs end here.
   const bool bounds = balls && ctx.bounds_apart.size() == pairs_.size();
@@ -235,6 +247,35 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
     for (int k : ctx.unsure)
       if (pairExactly(k, poses, ctx)) return hit(k, ctx);
   ctx.last_hit = -1;
+  return nullptr;
+}
+
+const LinkPair* SelfCollision::lookUp(const double* q, SelfScratch& ctx) const noexcept {
+  const bool kept = ctx.table_free.size() == pairs_.size();
+  if (kept) std::fill(ctx.table_free.begin(), ctx.table_free.end(), std::uint8_t{0});
+  ctx.witnesses.clear();
+  const bool room = ctx.witnesses.capacity() >= with_table_.size();  // (else keeping one would allocate)
+  for (int k : with_table_) {
+    TrianglePair w;
+    const PairTable::Verdict v = tables_[k]->lookup(q, room ? &w : nullptr);
+    if (v == PairTable::Verdict::Colliding) return hit(k, ctx);
+    if (kept) ctx.table_free[k] = v == PairTable::Verdict::Free;
+    if (w.valid()) ctx.witnesses.emplace_back(k, w);
+  }
+  return nullptr;
+}
+
+const LinkPair* SelfCollision::tabledCollision(const double* q, SelfCollisionContext& context) const noexcept {
+  SelfScratch& ctx = scratchOf(context.scratch_);
+  ctx.tabled = false;
+  if (const LinkPair* p = lookUp(q, ctx)) return p;
+  // (Kept only where the context holds this checker's verdicts and room for q: else asked again.)
+  if (ctx.table_free.size() == pairs_.size() &&
+      ctx.tabled_q.size() == static_cast<std::size_t>(geometry_->model().variableCount())) {
+    std::copy(q, q + ctx.tabled_q.size(), ctx.tabled_q.begin());
+    ctx.tabled = true;
+    ctx.tabled_by = serial_;
+  }
   return nullptr;
 }
 

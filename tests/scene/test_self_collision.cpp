@@ -141,6 +141,78 @@ TEST(SelfCollision, EightPairsAtATimeAsOneByOne) {
   check(root + "/box_ur5/box_ur5_0001.yaml");
 }
 
+// tabledCollision (the tables alone, before any pose) and then firstCollision at the same configuration
+// answer as firstCollision alone, state by state; and a firstCollision at another configuration than the
+// tables were last asked at looks them up again rather than use their verdicts (here: the previous state's).
+// The shared UR5, whose tables prove over half its self-colliding random states colliding.
+TEST(SelfCollision, TablesFirstAnswerAsTheWholeCheck) {
+  CLEARWAY_SHARED_OR_SKIP(root, "scenes");
+  const auto scene = test::loadScene(root + "/box_ur5/box_ur5_0001.yaml");
+  const SelfCollision& checker = scene->selfCollision();
+  ASSERT_TRUE(checker.hasTables());
+  SelfCollisionContext split = checker.makeContext(), whole = checker.makeContext(), stale = checker.makeContext();
+  SceneContext placed = scene->makeContext();
+  std::mt19937 rng(43);
+  std::vector<double> q(scene->dimension());
+  std::vector<double> previous;
+  int tabled = 0, colliding = 0;
+  for (int i = 0; i < 3000; ++i) {
+    for (int v = 0; v < scene->dimension(); ++v) {
+      const double lo = std::max(scene->validLower(v), -M_PI), hi = std::min(scene->validUpper(v), M_PI);
+      q[v] = std::uniform_real_distribution<double>(lo, hi)(rng);
+    }
+    scene->computePoses(q.data(), placed);
+    const double* full = placed.jointValues().data();
+    const bool expected = checker.firstCollision(placed.poses().data(), whole, full) != nullptr;
+    const LinkPair* first = checker.tabledCollision(full, split);
+    tabled += first != nullptr;
+    if (!first) first = checker.firstCollision(placed.poses().data(), split, full);
+    ASSERT_EQ(first != nullptr, expected) << "state " << i;
+    if (!previous.empty()) {  // the tables asked at the previous state, the pairs at this one
+      checker.tabledCollision(previous.data(), stale);
+      ASSERT_EQ(checker.firstCollision(placed.poses().data(), stale, full) != nullptr, expected) << "state " << i;
+    }
+    previous = placed.jointValues();
+    colliding += expected;
+  }
+  std::printf("  %d of %d colliding states proved so by the tables alone\n", tabled, colliding);
+  EXPECT_GT(tabled, colliding / 4);
+  EXPECT_LT(colliding, 2900);
+}
+
+// A state check that a pair table settles (before any pose) leaves the context's placed state as it was:
+// poses() and jointValues() still describe one state, the last one placed.
+TEST(SelfCollision, AStateTheTablesSettleLeavesThePlacedState) {
+  CLEARWAY_SHARED_OR_SKIP(root, "scenes");
+  const auto scene = test::loadScene(root + "/box_ur5/box_ur5_0001.yaml");
+  const SelfCollision& checker = scene->selfCollision();
+  SceneContext ctx = scene->makeContext(), scratch = scene->makeContext();
+  SelfCollisionContext tables = checker.makeContext();
+  std::mt19937 rng(47);
+  std::vector<double> q(scene->dimension());
+  int settled = 0;
+  for (int i = 0; i < 2000 && settled < 50; ++i) {
+    for (int v = 0; v < scene->dimension(); ++v) {
+      const double lo = std::max(scene->validLower(v), -M_PI), hi = std::min(scene->validUpper(v), M_PI);
+      q[v] = std::uniform_real_distribution<double>(lo, hi)(rng);
+    }
+    scene->computePoses(q.data(), scratch);
+    const bool by_table = checker.tabledCollision(scratch.jointValues().data(), tables) != nullptr;
+    const std::vector<double> joints = ctx.jointValues();
+    const std::vector<Pose> poses = ctx.poses();
+    CollisionReport report;
+    const bool free = scene->isFree(q.data(), ctx, &report);
+    if (!by_table) continue;
+    ++settled;
+    ASSERT_FALSE(free) << "state " << i;
+    EXPECT_EQ(report.kind, CollisionReport::Kind::Self) << "state " << i;
+    ASSERT_EQ(ctx.jointValues(), joints) << "state " << i;
+    for (std::size_t l = 0; l < poses.size(); ++l)
+      ASSERT_TRUE(ctx.poses()[l].t == poses[l].t && ctx.poses()[l].R == poses[l].R) << "state " << i << " link " << l;
+  }
+  EXPECT_EQ(settled, 50);
+}
+
 TEST(SelfCollision, PaddingWidensTheContact) {
   const auto model = test::scissors();
   auto geometry = std::make_shared<const RobotGeometry>(model);

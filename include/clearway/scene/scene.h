@@ -63,7 +63,8 @@ class SceneContext {
   ///@}
   ~SceneContext();
 
-  /// Every link's world pose at the state the context's last query (or Scene::computePoses) placed.
+  /// Every link's world pose at the state the context's last query (or Scene::computePoses) placed. A
+  /// query that needs no poses places none: a state out of bounds, or one a pair table proves colliding.
   const std::vector<Pose>& poses() const noexcept;
   /// The robot's full joint vector at that state (group values, held values, defaults).
   const std::vector<double>& jointValues() const noexcept;

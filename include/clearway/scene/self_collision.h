@@ -88,6 +88,8 @@ class SelfCollision {
   const SelfCollisionOptions& options() const noexcept { return options_; }
   /// The padding of pair k (the sum of its links' paddings).
   double pairPadding(int k) const noexcept { return pair_padding_[k]; }
+  /// True when some pair has a table that may prove it colliding (tabledCollision can then answer).
+  bool hasTables() const noexcept { return !with_table_.empty(); }
   /// Pair k's table, or null when it has none.
   const PairTable* pairTable(int k) const noexcept { return tables_.empty() ? nullptr : tables_[k].get(); }
   /// A fresh context for this checker (allocates; make one per thread and reuse it).
@@ -102,6 +104,10 @@ class SelfCollision {
   /// other checks); without them the context's own are placed.
   const LinkPair* firstCollision(const Pose* link_poses, SelfCollisionContext& context, const double* q = nullptr,
                                  EnclosingBalls* placed = nullptr) const noexcept;
+  /// firstCollision's first stage, which needs no poses: a pair whose table proves it colliding at q (every
+  /// variable of the robot, held ones at their held values), or nullptr. Its look-ups are kept in the
+  /// context for the next firstCollision at the same q, which then does not repeat them.
+  const LinkPair* tabledCollision(const double* q, SelfCollisionContext& context) const noexcept;
   /// Every colliding pair at these poses, appended to `out` in pair order.
   void allCollisions(const Pose* link_poses, SelfCollisionContext& context, std::vector<LinkPair>& out) const;
   /// True when pair index k collides at these poses.
@@ -127,6 +133,9 @@ class SelfCollision {
   PairTable::Verdict tabled(int k, const double* q) const noexcept {
     return q && !tables_.empty() && tables_[k] ? tables_[k]->lookup(q) : PairTable::Verdict::Unsure;
   }
+  // Looks every table up at q: the first pair one proves colliding, else nullptr with the Free verdicts
+  // (table_free) and the witnesses kept in s.
+  const LinkPair* lookUp(const double* q, scene_detail::SelfScratch& s) const noexcept;
   // Records pair k as the last hit and returns it.
   const LinkPair* hit(int k, scene_detail::SelfScratch& s) const noexcept;
 
