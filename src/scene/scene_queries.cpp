@@ -355,6 +355,11 @@ void Scene::areFree(const double* states, int count, SceneContext& context, bool
       continue;
     }
     toLane(state, n, ctx, lane_q, lane_poses);
+    // The pair tables first, as checkState asks them: a state they prove colliding takes no lane.
+    if (fx.self && self_.hasTables() && self_.tabledCollision(lane_q[n], ctx.self)) {
+      free[s] = false;
+      continue;
+    }
     pending[n++] = s;
     if (n == width) flush();
   }

@@ -20,13 +20,22 @@ struct SelfScratch {
   std::vector<int> unsure;                 // pairs the cheap rungs left to the triangles (scratch of one query)
   std::vector<std::uint8_t> table_free;    // per pair: its table called it Free at this query's q
   std::vector<std::uint8_t> bounds_apart;  // per pair: its bounding balls apart at this query's poses
-  // The tables' look-ups of tabledCollision, kept for the firstCollision that follows at the same q: that q
-  // (every variable), whether they are still to be used and by which checker (its serial), and the pairs
-  // whose unsure cell has a witness.
-  std::vector<double> tabled_q;
-  bool tabled = false;
+  std::vector<std::pair<int, TrianglePair>> witnesses;  // pairs whose unsure cell has a witness, at this q
+  // The tables' look-ups of tabledCollision, kept for the firstCollision at the same q that follows, up to
+  // kTabledSlots states later (Scene::areFree asks the tables of a lane's states before their kinematics):
+  // each slot's q (every variable), its table_free and witnesses (swapped in and out, never copied), and
+  // whether it is still to be used; all by the checker of serial tabled_by.
+  struct Tabled {
+    std::vector<double> q;
+    std::vector<std::uint8_t> table_free;
+    std::vector<std::pair<int, TrianglePair>> witnesses;
+    bool valid = false;
+  };
+  static constexpr int kTabledSlots = 8;  // (a power of two)
+  std::vector<Tabled> tabled;             // kTabledSlots of them (none in a default context)
+  int next_tabled = 0;
   std::uint64_t tabled_by = 0;
-  std::vector<std::pair<int, TrianglePair>> witnesses;
+  bool slots_fit = false;                  // the slots are sized for tabled_by's robot and pairs
   int last_hit = -1;                       // the pair (index into pairs()) that last collided, tried first; -1: none
   long long pair_tests = 0;  // pairs that reached the narrow phase (bounding spheres not apart), cumulative
   std::uint64_t owner = 0;   // the serial of the checker that made it (its pairs are `bodies`' pairs)
@@ -108,8 +117,15 @@ SelfCollisionContext SelfCollision::makeContext() const {
   c.unsure.reserve(pairs_.size());
   c.table_free.assign(pairs_.size(), 0);
   c.bounds_apart.assign(pairs_.size(), 0);
-  c.tabled_q.assign(geometry_->model().variableCount(), 0.0);
   c.witnesses.reserve(with_table_.size());
+  c.tabled.resize(SelfScratch::kTabledSlots);
+  for (SelfScratch::Tabled& t : c.tabled) {
+    t.q.assign(geometry_->model().variableCount(), 0.0);
+    t.table_free.assign(pairs_.size(), 0);
+    t.witnesses.reserve(with_table_.size());
+  }
+  c.tabled_by = serial_;
+  c.slots_fit = true;
   return SelfCollisionContext(std::move(scratch));
 }
 
@@ -156,9 +172,18 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
   // of the pair's unsure cell) proves a collision with one triangle test where the search would spend hundreds.
   // Each verdict is kept for the pass below (a context of another checker looks the tables up again).
   const bool kept = ctx.table_free.size() == pairs_.size();
-  const bool looked_up =
-      q && ctx.tabled && ctx.tabled_by == serial_ && std::equal(ctx.tabled_q.begin(), ctx.tabled_q.end(), q);
-  ctx.tabled = false;
+  bool looked_up = false;
+  if (q && ctx.tabled_by == serial_ && ctx.slots_fit)
+    for (int i = 1; i <= SelfScratch::kTabledSlots; ++i) {  // (the latest first: checkState asks it right before)
+      SelfScratch::Tabled& t = ctx.tabled[(ctx.next_tabled - i) & (SelfScratch::kTabledSlots - 1)];
+      if (t.valid && std::equal(t.q.begin(), t.q.end(), q)) {
+        std::swap(ctx.table_free, t.table_free);
+        std::swap(ctx.witnesses, t.witnesses);
+        t.valid = false;
+        looked_up = true;
+        break;
+      }
+    }
   if (!q) {
     if (kept) std::fill(ctx.table_free.begin(), ctx.table_free.end(), std::uint8_t{0});
     ctx.witnesses.clear();
@@ -267,15 +292,24 @@ const LinkPair* SelfCollision::lookUp(const double* q, SelfScratch& ctx) const n
 
 const LinkPair* SelfCollision::tabledCollision(const double* q, SelfCollisionContext& context) const noexcept {
   SelfScratch& ctx = scratchOf(context.scratch_);
-  ctx.tabled = false;
-  if (const LinkPair* p = lookUp(q, ctx)) return p;
-  // (Kept only where the context holds this checker's verdicts and room for q: else asked again.)
-  if (ctx.table_free.size() == pairs_.size() &&
-      ctx.tabled_q.size() == static_cast<std::size_t>(geometry_->model().variableCount())) {
-    std::copy(q, q + ctx.tabled_q.size(), ctx.tabled_q.begin());
-    ctx.tabled = true;
+  if (ctx.tabled_by != serial_) {  // (another checker's verdicts, for its pairs: dropped; its slots' sizes checked)
+    ctx.slots_fit = ctx.tabled.size() == SelfScratch::kTabledSlots;
+    for (SelfScratch::Tabled& t : ctx.tabled) {
+      t.valid = false;
+      ctx.slots_fit = ctx.slots_fit && t.q.size() == static_cast<std::size_t>(geometry_->model().variableCount()) &&
+                      t.table_free.size() == pairs_.size() && t.witnesses.capacity() >= with_table_.size();
+    }
     ctx.tabled_by = serial_;
   }
+  if (const LinkPair* p = lookUp(q, ctx)) return p;
+  // (Kept only where the context holds this checker's verdicts and room for q and them: else asked again.)
+  if (!ctx.slots_fit || ctx.table_free.size() != pairs_.size()) return nullptr;
+  SelfScratch::Tabled& t = ctx.tabled[ctx.next_tabled];
+  ctx.next_tabled = (ctx.next_tabled + 1) & (SelfScratch::kTabledSlots - 1);
+  std::copy(q, q + t.q.size(), t.q.begin());
+  std::swap(ctx.table_free, t.table_free);
+  std::swap(ctx.witnesses, t.witnesses);
+  t.valid = true;
   return nullptr;
 }
 

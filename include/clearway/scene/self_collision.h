@@ -106,7 +106,8 @@ class SelfCollision {
                                  EnclosingBalls* placed = nullptr) const noexcept;
   /// firstCollision's first stage, which needs no poses: a pair whose table proves it colliding at q (every
   /// variable of the robot, held ones at their held values), or nullptr. Its look-ups are kept in the
-  /// context for the next firstCollision at the same q, which then does not repeat them.
+  /// context for a firstCollision at the same q among the next few (up to eight states later), which then
+  /// does not repeat them.
   const LinkPair* tabledCollision(const double* q, SelfCollisionContext& context) const noexcept;
   /// Every colliding pair at these poses, appended to `out` in pair order.
   void allCollisions(const Pose* link_poses, SelfCollisionContext& context, std::vector<LinkPair>& out) const;
