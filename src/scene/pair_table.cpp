@@ -296,8 +296,8 @@ struct Builder {
         }
       }
     // So does a core of the lower link that reaches into a primitive of the upper one by more than δ: its
-    // centre moves at most δ over the cell (the box a UR5 stands on: half its pair's colliding lookups were
-    // Unsure, each a screen of the upper arm's hull).
+    // centre moves at most δ over the cell (the box a UR5 stands on, whose cores against the upper arm's
+    // leave half the pair's colliding cells Unsure).
     if (!free_only && !down.cores().empty() && !up.primitives().empty()) {
       const Pose up_in_down = t.inverse();
       for (const LinkGeometry::Primitive& p : up.primitives())
