@@ -142,8 +142,8 @@ TEST(SelfCollision, EightPairsAtATimeAsOneByOne) {
 }
 
 // tabledCollision (the tables alone, before any pose) and then firstCollision at the same configuration
-// answer as firstCollision alone, state by state; and a firstCollision at another configuration than the
-// tables were last asked at looks them up again rather than use their verdicts (here: the previous state's).
+// answer as firstCollision alone, state by state; and a firstCollision at a configuration none of the tables'
+// kept look-ups was made at looks them up again rather than use those (here: the previous states').
 // The shared UR5, whose tables prove over half its self-colliding random states colliding.
 TEST(SelfCollision, TablesFirstAnswerAsTheWholeCheck) {
   CLEARWAY_SHARED_OR_SKIP(root, "scenes");
