@@ -104,6 +104,14 @@ TEST(SelfCollision, ScissorsMatchesTheAnalyticAnswer) {
   EXPECT_EQ(ctx.pairTests(), collide + free) << "one pair tested per query";
 }
 
+// A state uniform in the scene's bounds (unbounded joints: ±π), into q.
+void uniformState(const Scene& scene, std::mt19937& rng, std::vector<double>& q) {
+  for (int v = 0; v < scene.dimension(); ++v) {
+    const double lo = std::max(scene.validLower(v), -M_PI), hi = std::min(scene.validUpper(v), M_PI);
+    q[v] = std::uniform_real_distribution<double>(lo, hi)(rng);
+  }
+}
+
 // The loop over pairs eight at a time (a context of this checker, with its tables' verdicts and the balls'
 // kept) gives the plain loop's verdict (a context of a checker of other pairs, which keeps neither), state by
 // state: our dual arm and the shared UR5, whose pair tables and hundreds of pairs span many steps of eight.
@@ -123,10 +131,7 @@ TEST(SelfCollision, EightPairsAtATimeAsOneByOne) {
     std::vector<double> q(scene->dimension());
     int colliding = 0;
     for (int i = 0; i < 3000; ++i) {
-      for (int v = 0; v < scene->dimension(); ++v) {
-        const double lo = std::max(scene->validLower(v), -M_PI), hi = std::min(scene->validUpper(v), M_PI);
-        q[v] = std::uniform_real_distribution<double>(lo, hi)(rng);
-      }
+      uniformState(*scene, rng, q);
       scene->computePoses(q.data(), placed);
       const LinkPair* a = checker.firstCollision(placed.poses().data(), kept, placed.jointValues().data());
       const LinkPair* b = checker.firstCollision(placed.poses().data(), plain, placed.jointValues().data());
@@ -157,10 +162,7 @@ TEST(SelfCollision, TablesFirstAnswerAsTheWholeCheck) {
   std::vector<double> previous;
   int tabled = 0, colliding = 0;
   for (int i = 0; i < 3000; ++i) {
-    for (int v = 0; v < scene->dimension(); ++v) {
-      const double lo = std::max(scene->validLower(v), -M_PI), hi = std::min(scene->validUpper(v), M_PI);
-      q[v] = std::uniform_real_distribution<double>(lo, hi)(rng);
-    }
+    uniformState(*scene, rng, q);
     scene->computePoses(q.data(), placed);
     const double* full = placed.jointValues().data();
     const bool expected = checker.firstCollision(placed.poses().data(), whole, full) != nullptr;
@@ -192,10 +194,7 @@ TEST(SelfCollision, AStateTheTablesSettleLeavesThePlacedState) {
   std::vector<double> q(scene->dimension());
   int settled = 0;
   for (int i = 0; i < 2000 && settled < 50; ++i) {
-    for (int v = 0; v < scene->dimension(); ++v) {
-      const double lo = std::max(scene->validLower(v), -M_PI), hi = std::min(scene->validUpper(v), M_PI);
-      q[v] = std::uniform_real_distribution<double>(lo, hi)(rng);
-    }
+    uniformState(*scene, rng, q);
     scene->computePoses(q.data(), scratch);
     const bool by_table = checker.tabledCollision(scratch.jointValues().data(), tables) != nullptr;
     const std::vector<double> joints = ctx.jointValues();
