@@ -367,10 +367,29 @@ struct MotionChecker::Sweep {
     return bound;
   }
 
-  // How far from s a clearance d of item k reaches, either way. Beyond `want` nothing is asked; only short
-  // of it does a self item look at its links' parts: where the near part lies close to the axes that turn
-  // it, the far parts' larger clearances make up for their larger motion.
+  // A ball keeps back kHeldBack of its reach: over the rest, the item's motion uses at most 1 − kHeldBack of
+  // the clearance d measured at its centre (the bounds are convex in the step and 0 at 0), so every point
+  // it covers stays kHeldBack·d clear. That is the margin a segment certified free reports
+  // (MotionResult::margin). A measurement asks for kAskMore of what its ball must reach, so that the share
+  // held back does not leave a sliver to measure again.
+  static constexpr double kHeldBack = 0x1p-12;
+  static constexpr double kAskMore = 1.0 + 0x1p-11;
+  double min_clear = INFINITY;  // the least clearance a ball was formed from
+
+  // The clearance item k's ball must have to reach `width` either way, as a measurement asks for it.
+  double asked(int k, double width) const noexcept { return boundOf(k) * width * kAskMore; }
+
+  // How far from s a clearance d of item k reaches, either way, with kHeldBack of it kept back. Beyond
+  // `want` nothing is asked.
   double reach(int k, double d, double want) {
+    min_clear = std::min(min_clear, d);
+    return fullReach(k, d, want * kAskMore) * (1.0 - kHeldBack);
+  }
+
+  // reach() before the share kept back. Only short of `want` does a self item look at its links' parts:
+  // where the near part lies close to the axes that turn it, the far parts' larger clearances make up for
+  // their larger motion.
+  double fullReach(int k, double d, double want) {
     const Item& it = mc.items_[k];
     const double* dq = ctx.dq.data();
     const Pose* poses = measuredPoses();  // (at the parameter d was measured at)
@@ -397,7 +416,7 @@ struct MotionChecker::Sweep {
   // How far either way from s item k is clear, measured for the interval s ± half; −1 within contact.
   double first(int k, double s, double half) {
     CollisionReport report;
-    const double d = measureItem(k, s, boundOf(k) * half, report);
+    const double d = measureItem(k, s, asked(k, half), report);
     if (d > contactOf(k, s)) return reach(k, d, half);
     if (verdict_only && mc.items_[k].last <= mc.items_[k].first) found(s, report);
     return -1.0;
@@ -425,7 +444,7 @@ struct MotionChecker::Sweep {
       const double hi = std::min(iv.b, limit);
       if (iv.a > hi || (hit && iv.a >= hi)) continue;
       const double m = measuringPoint(iv.a, hi);
-      const double d = measureItem(k, m, boundOf(k) * std::max(m - iv.a, hi - m), report);
+      const double d = measureItem(k, m, asked(k, std::max(m - iv.a, hi - m)), report);
       if (d <= contactOf(k, m)) {
         if (it.last > it.first) {  // a group within contact: its members take over here, exactly
           for (int member = it.first; member < it.last && !stop(); ++member) cover(member, iv.a, hi, iv.witness);
@@ -459,7 +478,7 @@ struct MotionChecker::Sweep {
     CollisionReport report;
     double s = a, prev = std::max(witness, 0.0), prev_d = 0.0;  // the clearance measured at prev (0: none)
     while (!capped) {
-      const double d = measureItem(k, s, boundOf(k) * (until - s), report);
+      const double d = measureItem(k, s, asked(k, until - s), report);
       if (d <= contactOf(k, s)) {
         if (!hit || s < limit) {
           limit = s;
@@ -779,6 +798,10 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
   }
   r.free = true;
   r.report = CollisionReport{};
+  // The rake, the tables and the casts leave every item they settle beyond the contact distance; the balls,
+  // a share of their clearance (Sweep::kHeldBack; half of it, for the roundings of the bounds and steps).
+  const double held = 0.5 * Sweep::kHeldBack * sweep.min_clear;
+  r.margin = timed ? 0.0 : std::min(options_.contact_distance, held);
   return r;
 }
 

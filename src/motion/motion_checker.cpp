@@ -3,6 +3,7 @@
 #include <clearway/motion/motion.h>
 
 #include <clearway/body/proximity.h>
+#include <clearway/detail/margins.h>
 
 #include <algorithm>
 #include <cmath>
@@ -356,19 +357,63 @@ MotionResult MotionChecker::check(const double* q0, double t0, const double* q1,
     r.report.kind = CollisionReport::Kind::Invalid;
     return r;
   }
-  // A context made by another checker (of another robot: a World before an attach, say; of another group:
-  // its buffers sized for another dimension; or of the same robot elsewhere: its pairs and warm starts are
-  // that checker's items', perhaps freed with it) does not fit: refused.
-  const std::size_t dim = static_cast<std::size_t>(scene_->dimension());
-  if (ctx.owner != serial_ || ctx.safe_until.size() != items_.size() ||
-      ctx.poses[0].size() != static_cast<std::size_t>(scene_->robot().linkCount()) || ctx.q.size() != dim ||
-      ctx.dq.size() != dim || ctx.probe_states.size() != motion_detail::kProbes * dim) {
+  if (!fits(ctx)) {
     MotionResult r;
     r.report.kind = CollisionReport::Kind::Invalid;
     return r;
   }
   return options_.mode == MotionMode::Sampled ? sampled(q0, t0, q1, t1, ctx)
                                               : certified(q0, t0, q1, t1, ctx, locate_contact);
+}
+
+bool MotionChecker::fits(const motion_detail::Scratch& ctx) const noexcept {
+  // A context made by another checker (of another robot: a World before an attach, say; of another group:
+  // its buffers sized for another dimension; or of the same robot elsewhere: its pairs and warm starts are
+  // that checker's items', perhaps freed with it) does not fit.
+  const std::size_t dim = static_cast<std::size_t>(scene_->dimension());
+  return ctx.owner == serial_ && ctx.safe_until.size() == items_.size() &&
+         ctx.poses[0].size() == static_cast<std::size_t>(scene_->robot().linkCount()) && ctx.q.size() == dim &&
+         ctx.dq.size() == dim && ctx.probe_states.size() == motion_detail::kProbes * dim;
+}
+
+bool MotionChecker::within(const double* q0, const double* q1, const double* p0, const double* p1, double margin,
+                           MotionContext& context) const noexcept {
+  const Scene& sc = *scene_;
+  if (!context.scratch_ || !fits(*context.scratch_) || !(margin > 0.0) || !std::isfinite(margin)) return false;
+  if (!quaternions_.empty() || (sc.effects().moving && sc.environment().hasMovingObstacles())) return false;
+  if (!sc.validState(q0) || !sc.validState(q1)) return false;
+  motion_detail::Scratch& ctx = *context.scratch_;
+  const int n = sc.dimension();
+  double uu = 0.0;
+  for (int i = 0; i < n; ++i) uu += (p1[i] - p0[i]) * (p1[i] - p0[i]);
+  if (!(uu > 0.0 && uu < INFINITY)) return false;  // (a segment of length 0 holds only its own ends)
+  // Each end's distance, entry by entry, from the point of p0 → p1 at its projection's parameter t (clamped:
+  // the exact point p0 + t·(p1 − p0) then lies on the segment), with the roundings of computing it. The
+  // states between q0 and q1 are convex combinations of the ends, and so of the nearest points: no entry
+  // differs by more than the larger of the ends' (the checker's own interpolation rounds both alike).
+  std::vector<double>& dev = ctx.dq;
+  std::fill(dev.begin(), dev.end(), 0.0);
+  for (const double* x : {q0, q1}) {
+    double along = 0.0;
+    for (int i = 0; i < n; ++i) along += (x[i] - p0[i]) * (p1[i] - p0[i]);
+    const double t = along / uu;
+    if (std::isnan(t)) return false;
+    const double s = std::clamp(t, 0.0, 1.0);
+    for (int i = 0; i < n; ++i) {
+      const double u = p1[i] - p0[i];
+      const double rounding = 4.0 * margins::kUlp * (std::abs(x[i]) + std::abs(p0[i]) + std::abs(u));
+      dev[i] = std::max(dev[i], std::abs(x[i] - (p0[i] + s * u)) + rounding);
+    }
+  }
+  // No body moves farther than its motion bound for that step; a pair's clearance changes by at most the
+  // sum of its bodies' moves, a link's from the (static) obstacles by its own.
+  bound_.links(dev.data(), static_cast<int>(ctx.body_bound.size()), ctx.body_bound.data());
+  const std::vector<double>& moved = ctx.body_bound;
+  for (const Item& it : items_) {
+    const double d = it.b >= 0 ? moved[it.a] + moved[it.b] : moved[it.a];
+    if (!(d * margins::kBeyond < margin)) return false;  // (NaN or ∞: not within)
+  }
+  return true;
 }
 
 }  // namespace clearway

@@ -28,8 +28,10 @@
 // grown by the item's motion over the piece, stay farther apart than the contact distance; only the rest is
 // covered by measurements. A self item whose pairs are tabulated (scene/pair_table.h) over joints that keep
 // them more than padding + 2·contact_distance apart in every cell the segment crosses is not swept at all.
-// Every ball is at least contact_distance / B wide, so the loops end; a cap on the
-// number of distance queries ends them too (reported as a collision).
+// A ball keeps back 2⁻¹² of its reach, so every state of a free segment stays a share of the least clearance
+// measured farther than touching: its margin (MotionResult::margin), which makes the segments that lie within
+// it free too (MotionChecker::within). Every ball is at least contact_distance / B wide, so the loops end;
+// a cap on the number of distance queries ends them too (reported as a collision).
 #include <clearway/serial.h>
 #include <clearway/scene/scene.h>
 
@@ -194,6 +196,10 @@ struct MotionResult {
   double first_contact = 0.0;
   double last_valid = 0.0;
   ///@}
+  /// When free and certified: every body stays farther than this (metres, beyond its padding) from what it
+  /// is checked against all along the segment, so a segment within it (MotionChecker::within) is free too;
+  /// 0 otherwise (sampled, a scene with moving obstacles, not free).
+  double margin = 0.0;
   CollisionReport report;   ///< what collided
   int steps = 0;            ///< parameters whose poses were computed (certified) or states checked (sampled)
   int distance_queries = 0; ///< pair or link distances computed (certified)
@@ -271,8 +277,18 @@ class MotionChecker {
   /// The state at parameter s of q0 → q1, into out: linear, except that a floating joint's quaternion
   /// follows the short great arc at constant speed (slerp, as OMPL's SO(3) space), normalized.
   void interpolate(const double* q0, const double* q1, double s, double* out) const noexcept;
+  /// True when q0 → q1 is free because it lies within p0 → p1, a segment check() certified free with
+  /// `margin` (its MotionResult::margin): both ends are valid states within a few roundings of p0 → p1 (in
+  /// the entries), and no checked body moves by more than the margin between a state of q0 → q1 and the
+  /// nearest state of p0 → p1. (A check of q0 → q1 alone could still stop within the contact distance, at a
+  /// parameter p0 → p1's check did not measure.) False proves nothing; always false for a context this
+  /// checker did not make, for floating joints (slerp is not linear in the entries) and for moving obstacles.
+  bool within(const double* q0, const double* q1, const double* p0, const double* p1, double margin,
+              MotionContext& context) const noexcept;
 
  private:
+  // True when the context was made by this checker (makeContext) and fits it.
+  bool fits(const motion_detail::Scratch& ctx) const noexcept;
   MotionResult certified(const double* q0, double t0, const double* q1, double t1, motion_detail::Scratch& ctx,
                          bool locate_contact) const noexcept;
   MotionResult sampled(const double* q0, double t0, const double* q1, double t1, motion_detail::Scratch& ctx) const noexcept;
