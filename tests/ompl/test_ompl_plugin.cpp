@@ -279,6 +279,64 @@ TEST(OmplPlugin, TheMotionValidatorRemembersItsLastAnswers) {
   EXPECT_EQ(c.motion->counters().remembered.load(), before_edit);
 }
 
+// A segment between points OMPL interpolates on a segment certified free is answered free at once, as lying
+// within it (counters().within), and its states are free; a segment that runs past the free one's end is
+// checked, and so is one after an edit of the world (a new snapshot keeps nothing).
+TEST(OmplPlugin, SegmentsWithinAFreeOneAreAnsweredFree) {
+  auto world = World::load(bundledScene());
+  const auto scene = world->current().scene;
+  auto si = std::make_shared<ob::SpaceInformation>(makeStateSpace(*scene));
+  const CollisionChecking c = setupCollisionChecking(si, world);
+  const ob::StateSpacePtr& space = si->getStateSpace();
+  const StateMap map(*scene);
+  ompl::RNG::setSeed(12);
+  const ob::StateSamplerPtr sampler = si->allocStateSampler();
+  ob::ScopedState<> a(space), b(space), x(space), y(space);
+  std::vector<double> q(scene->dimension());
+  int answered = 0;
+  for (int k = 0; k < 3000 && answered < 12; ++k) {
+    sampler->sampleUniform(a.get());
+    sampler->sampleUniform(b.get());
+    if (!si->isValid(a.get()) || !c.motion->checkMotion(a.get(), b.get())) continue;
+    const double s = 0.1 * (k % 5), t = 1.0 - 0.07 * (k % 7);
+    space->interpolate(a.get(), b.get(), s, x.get());
+    space->interpolate(a.get(), b.get(), t, y.get());
+    const std::uint64_t before = c.motion->counters().within.load();
+    const MotionResult r = c.motion->check(x.get(), y.get(), /*locate_contact=*/k % 2 == 0);
+    ASSERT_TRUE(r.free) << "segment " << k;
+    EXPECT_EQ(c.motion->counters().within.load(), before + 1) << "segment " << k;
+    EXPECT_EQ(r.steps, 0) << "segment " << k;
+    for (int i = 0; i <= 100; ++i) {
+      space->interpolate(x.get(), y.get(), i / 100.0, a.get());
+      map.toVector(a.get(), q.data());
+      EXPECT_TRUE(scene->isFree(q)) << "segment " << k << " at " << i / 100.0;
+    }
+    ++answered;
+  }
+  EXPECT_EQ(answered, 12);
+  // Past the end of a free segment: checked.
+  int f = 0;
+  for (; f < 3000; ++f) {
+    sampler->sampleUniform(a.get());
+    sampler->sampleUniform(b.get());
+    space->interpolate(a.get(), b.get(), 0.9, x.get());
+    if (si->isValid(a.get()) && c.motion->checkMotion(a.get(), x.get())) break;
+  }
+  ASSERT_LT(f, 3000);
+  const std::uint64_t before = c.motion->counters().within.load();
+  space->interpolate(a.get(), b.get(), 0.5, y.get());
+  c.motion->checkMotion(y.get(), b.get());
+  EXPECT_EQ(c.motion->counters().within.load(), before);
+  EXPECT_TRUE(c.motion->checkMotion(y.get(), x.get()));
+  EXPECT_EQ(c.motion->counters().within.load(), before + 1);
+  // An obstacle on the free segment: the sub-segment through it is checked in the edited world, and collides.
+  space->interpolate(a.get(), x.get(), 0.6, b.get());
+  map.toVector(b.get(), q.data());
+  world->addObstacle(test::ballAtLink(*scene, q, "wrist_2_link", 0.05));
+  EXPECT_FALSE(c.motion->checkMotion(y.get(), x.get()));
+  EXPECT_EQ(c.motion->counters().within.load(), before + 1);
+}
+
 // Plans on the bundled scene with the given planner and checks the path independently: every segment
 // certified free, and dense samples along it valid.
 void planAndCertify(const std::function<ob::PlannerPtr(const ob::SpaceInformationPtr&)>& makePlanner,

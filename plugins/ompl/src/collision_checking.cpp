@@ -324,6 +324,14 @@ MotionResult ContinuousMotionValidator::check(const ob::State* s1, const ob::Sta
     r.steps = r.distance_queries = 0;  // (no work was done for this answer)
     return r;
   }
+  if (remembering && s.memo.inFree(s.q0.data(), s.q1.data(), [&](const double* p0, const double* p1, double margin) {
+        return w.motion->within(s.q0.data(), s.q1.data(), p0, p1, margin, s.ctx);
+      })) {
+    ++counters_.within;
+    MotionResult r;
+    r.free = true;  // (its own margin unknown: 0, and so it is not kept as a segment others lie in)
+    return r;
+  }
   const MotionResult r = w.motion->check(s.q0.data(), s.q1.data(), s.ctx, locate_contact);
   if (remembering && !r.capped) s.memo.keep(s.q0.data(), s.q1.data(), locate_contact, r);  // (a cap: no verdict)
   return r;

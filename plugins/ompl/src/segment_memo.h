@@ -5,15 +5,24 @@
 // one it made, and they take a fifth to a third of its time. A certified answer depends on nothing but the
 // segment's ends and the world's snapshot (the owner makes a new memo with each snapshot), so an answer
 // kept is the answer that would be computed.
+//
+// It also keeps the thread's last segments certified free, with their margins. The simplifier subdivides a
+// path's segments and then asks for segments between their points, which lie on the segments it was given
+// (a third of its segments on the shared Panda problems, not counting repeats): such a segment is free
+// (MotionChecker::within), an answer sound but not always the one its own check would give (that check
+// could stop within the contact distance, where the longer segment's check measured no contact).
 #include <clearway/motion/motion.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <vector>
 
 namespace clearway::ompl_detail {
 
-/// A small table of the last segments checked (direct-mapped: a new segment replaces the one in its slot).
+/// A small table of the last segments checked (direct-mapped: a new segment replaces the one in its slot),
+/// and a ring of the last segments certified free.
 class SegmentMemo {
  public:
   static constexpr int kSlots = 64;  // (a power of two)
@@ -22,7 +31,12 @@ class SegmentMemo {
   SegmentMemo() = default;
   /// For segments between states of `dimension` entries (≥ 1).
   explicit SegmentMemo(int dimension)
-      : dim_(dimension), ends_(static_cast<std::size_t>(kSlots) * 2 * dimension), slots_(kSlots) {}
+      : dim_(dimension),
+        ends_(static_cast<std::size_t>(kSlots) * 2 * dimension),
+        slots_(kSlots),
+        free_ends_(static_cast<std::size_t>(kFree) * 2 * dimension),
+        free_box_(static_cast<std::size_t>(kFree) * 2 * dimension),
+        free_margin_(kFree) {}
 
   /// The answer kept for q0 → q1 (the same bits), or null. A verdict alone (a contact, not the first) does
   /// not answer a call that locates the first contact; a free segment answers both.
@@ -45,6 +59,28 @@ class SegmentMemo {
     std::memcpy(kept, q0, bytes());
     std::memcpy(kept + dim_, q1, bytes());
     slots_[k] = Slot{true, located, h, r};
+    if (r.free && r.margin > 0.0) keepFree(q0, q1, r.margin);
+  }
+
+  /// True when within(p0, p1, margin) holds for one of the last kFree segments certified free (ends p0, p1,
+  /// their margin) that q0 → q1 may lie in, the latest first: those whose box of ends holds q0 and q1 (with
+  /// room for roundings far above within()'s). A segment within one certified free is free
+  /// (MotionChecker::within), however long ago that one was checked.
+  template <class Within>
+  bool inFree(const double* q0, const double* q1, Within&& within) const {
+    for (int n = 0; n < free_count_; ++n) {
+      const int k = (free_next_ + kFree - 1 - n) % kFree;
+      const double* lo = free_box_.data() + static_cast<std::size_t>(k) * 2 * dim_;
+      const double* hi = lo + dim_;
+      bool inside = true;
+      for (int i = 0; i < dim_ && inside; ++i) {
+        const double room = kBoxRoom * (1.0 + std::abs(lo[i]) + std::abs(hi[i]));
+        inside = q0[i] >= lo[i] - room && q0[i] <= hi[i] + room && q1[i] >= lo[i] - room && q1[i] <= hi[i] + room;
+      }
+      const double* p = free_ends_.data() + static_cast<std::size_t>(k) * 2 * dim_;
+      if (inside && within(p, p + dim_, free_margin_[k])) return true;
+    }
+    return false;
   }
 
  private:
@@ -74,9 +110,31 @@ class SegmentMemo {
     return h * 0xbf58476d1ce4e5b9ULL;
   }
 
+  // The segments certified free kept, oldest replaced first: a path's segments stay asked about while the
+  // simplifier works on it, up to a few hundred segments later on the shared problems.
+  static constexpr int kFree = 256;
+  // The room a box of ends leaves, per unit of its coordinates: ends OMPL interpolates on a segment lie
+  // within a few roundings (1e-16) of it, far inside this.
+  static constexpr double kBoxRoom = 1e-9;
+  void keepFree(const double* q0, const double* q1, double margin) {
+    const std::size_t at = static_cast<std::size_t>(free_next_) * 2 * dim_;
+    std::memcpy(free_ends_.data() + at, q0, bytes());
+    std::memcpy(free_ends_.data() + at + dim_, q1, bytes());
+    for (int i = 0; i < dim_; ++i) {
+      free_box_[at + i] = std::min(q0[i], q1[i]);
+      free_box_[at + dim_ + i] = std::max(q0[i], q1[i]);
+    }
+    free_margin_[free_next_] = margin;
+    free_next_ = (free_next_ + 1) % kFree;
+    free_count_ = std::min(free_count_ + 1, kFree);
+  }
+
   int dim_ = 0;
   std::vector<double> ends_;  // per slot: q0 then q1
   std::vector<Slot> slots_;
+  std::vector<double> free_ends_, free_box_;  // per free segment kept: q0 then q1; the ends' least, then greatest
+  std::vector<double> free_margin_;           // per free segment kept: its margin
+  int free_count_ = 0, free_next_ = 0;
 };
 
 }  // namespace clearway::ompl_detail
