@@ -72,8 +72,8 @@ struct CheckerCounters {
   /// Segments of `motions` answered from the thread's memo of its last 64: the same ends (bit for bit) on
   /// the same snapshot of the world, as OMPL's path simplifier often asks again.
   std::atomic<std::uint64_t> remembered{0};
-  /// Segments of `motions` answered free as lying within one of the thread's last 256 segments certified
-  /// free (MotionChecker::within): OMPL's simplifier subdivides a path's segments and asks for segments
+  /// Segments of `motions` answered free as lying within one of the segments certified free the thread keeps
+  /// (up to 1,024; MotionChecker::within): OMPL's simplifier subdivides a path's segments and asks for segments
   /// between their points.
   std::atomic<std::uint64_t> within{0};
 };
@@ -113,7 +113,7 @@ class ValidityChecker : public ompl::base::StateValidityChecker {
 /// lastValid) locates the first contact, reports the fraction of the last valid state before it and
 /// writes that state when lastValid.first is given. Where the first says free, so does the second. Each
 /// thread remembers its last 64 answers: a segment asked again with the same ends on the same snapshot of
-/// the world gets the answer computed the first time, at once (counters().remembered); and its last 256
+/// the world gets the answer computed the first time, at once (counters().remembered); and up to 1,024 of its
 /// segments certified free: a segment that lies within one of them is free (counters().within), though its
 /// own check could stop within the contact distance where the longer one's check measured no contact.
 class ContinuousMotionValidator : public ompl::base::MotionValidator {
