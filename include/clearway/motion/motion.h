@@ -278,11 +278,12 @@ class MotionChecker {
   /// follows the short great arc at constant speed (slerp, as OMPL's SO(3) space), normalized.
   void interpolate(const double* q0, const double* q1, double s, double* out) const noexcept;
   /// True when q0 → q1 is free because it lies within p0 → p1, a segment check() certified free with
-  /// `margin` (its MotionResult::margin): both ends are valid states within a few roundings of p0 → p1 (in
-  /// the entries), and no checked body moves by more than the margin between a state of q0 → q1 and the
-  /// nearest state of p0 → p1. (A check of q0 → q1 alone could still stop within the contact distance, at a
-  /// parameter p0 → p1's check did not measure.) False proves nothing; always false for a context this
-  /// checker did not make, for floating joints (slerp is not linear in the entries) and for moving obstacles.
+  /// `margin` (its MotionResult::margin): both ends are valid states so near p0 → p1 (entry by entry, with
+  /// the roundings of measuring it) that no checked body moves by the margin between a state of q0 → q1 and
+  /// the nearest state of p0 → p1 (MotionBound::links of that step). (A check of q0 → q1 alone could still
+  /// stop within the contact distance, at a parameter p0 → p1's check did not measure.) False proves nothing;
+  /// always false for a context this checker did not make, for floating joints (slerp is not linear in the
+  /// entries) and for moving obstacles.
   bool within(const double* q0, const double* q1, const double* p0, const double* p1, double margin,
               MotionContext& context) const noexcept;
 

@@ -6,7 +6,7 @@
 // segment's ends and the world's snapshot (the owner makes a new memo with each snapshot), so an answer
 // kept is the answer that would be computed.
 //
-// It also keeps the thread's last segments certified free, with their margins. The simplifier subdivides a
+// It also keeps the thread's segments certified free, with their margins. The simplifier subdivides a
 // path's segments and then asks for segments between their points, which lie on the segments it was given
 // (a third of its segments on the shared Panda problems, not counting repeats): such a segment is free
 // (MotionChecker::within), an answer sound but not always the one its own check would give (that check
@@ -22,7 +22,7 @@
 namespace clearway::ompl_detail {
 
 /// A small table of the last segments checked (direct-mapped: a new segment replaces the one in its slot),
-/// and a ring of the last segments certified free.
+/// and up to 1,024 segments certified free, in sets by direction.
 class SegmentMemo {
  public:
   static constexpr int kSlots = 64;  // (a power of two)
