@@ -133,9 +133,10 @@ class SegmentMemo {
     double norm2 = 0.0;
     for (int i = 0; i < dim_; ++i) norm2 += (q1[i] - q0[i]) * (q1[i] - q0[i]);
     if (!(norm2 > 0.0 && norm2 < INFINITY)) return 0;
-    double scale = 1024.0 / std::sqrt(norm2);
+    const double norm = std::sqrt(norm2);
+    double scale = 1024.0 / norm;
     for (int i = 0; i < dim_; ++i)
-      if (std::abs(q1[i] - q0[i]) * 32.0 >= std::sqrt(norm2)) {
+      if (std::abs(q1[i] - q0[i]) * 32.0 >= norm) {
         if (q1[i] < q0[i]) scale = -scale;
         break;
       }
