@@ -29,11 +29,12 @@ EnclosingBalls::EnclosingBalls(const RobotGeometry& geometry) : geometry_(&geome
   // Never apart until placed: NaN centres (a NaN compares false), and an infinite radius for links without
   // geometry; the radii never change.
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  bound_x_.assign(n, nan);
-  bound_y_.assign(n, nan);
-  bound_z_.assign(n, nan);
-  bound_norm_.assign(n, nan);
-  bound_r_.assign(n, std::numeric_limits<double>::infinity());
+  const std::size_t lanes = static_cast<std::size_t>(n + BoundsRows::kSpare);
+  bound_x_.assign(lanes, nan);
+  bound_y_.assign(lanes, nan);
+  bound_z_.assign(lanes, nan);
+  bound_norm_.assign(lanes, nan);
+  bound_r_.assign(lanes, std::numeric_limits<double>::infinity());
   for (int i = 0; i < n; ++i)
     if (links_[i].count > 0) bound_r_[i] = radii_[links_[i].first];
   for (const Vec3& c : local_) local_norms_.push_back(c.norm());

@@ -84,13 +84,15 @@ SelfCollision::SelfCollision(std::shared_ptr<const RobotGeometry> geometry, cons
     if (!(pad[i] >= 0.0) || !std::isfinite(pad[i]))
       throw std::invalid_argument("SelfCollision: link_padding of link '" + geometry_->model().link(i).name +
                                   "' is " + std::to_string(pad[i]) + ": must be finite and >= 0");
+  std::vector<std::int64_t> pair_a, pair_b;
   for (const auto& [a, b] : filter.enabledPairs()) {
     if (!geometry_->link(a) || !geometry_->link(b)) continue;
     pairs_.push_back({a, b});
     pair_padding_.push_back(pad[a] + pad[b]);
-    pair_a_.push_back(a);
-    pair_b_.push_back(b);
+    pair_a.push_back(a);
+    pair_b.push_back(b);
   }
+  bounds_rows_ = BoundsRows(pair_a, pair_b, pair_padding_, n);
   if (options_.pair_tables) {
     const PairTableOptions table = options_.table_options.within(options_.table_seconds);
     for (std::size_t k = 0; k < pairs_.size(); ++k)
@@ -116,7 +118,7 @@ SelfCollisionContext SelfCollision::makeContext() const {
   c.balls = EnclosingBalls(*geometry_);
   c.unsure.reserve(pairs_.size());
   c.table_free.assign(pairs_.size(), 0);
-  c.bounds_apart.assign(pairs_.size(), 0);
+  c.bounds_apart.assign(pairs_.size() + BoundsRows::kSpare, 0);  // (the lanes' spare bytes past the last pair)
   c.witnesses.reserve(with_table_.size());
   c.tabled.resize(SelfScratch::kTabledSlots);
   for (SelfScratch::Tabled& t : c.tabled) {
@@ -198,10 +200,8 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
   }
   EnclosingBalls* balls = placed ? placed : placeBalls(poses, ctx);
   // The enclosing layer's first rung for every pair at once (SIMD lanes): most pairs end here.
-  const bool bounds = balls && ctx.bounds_apart.size() == pairs_.size();
-  if (bounds)
-    balls->boundsApart(pair_a_.data(), pair_b_.data(), pair_padding_.data(), n, options_.tolerances,
-                       ctx.bounds_apart.data());
+  const bool bounds = balls && ctx.bounds_apart.size() == pairs_.size() + BoundsRows::kSpare;
+  if (bounds) balls->boundsApart(bounds_rows_, options_.tolerances, ctx.bounds_apart.data());
   // A pair that collided a moment ago probably still does: trying it first ends most colliding queries
   // of a planner exploring near an obstacle after one pair test.
   // (A free-only table, of a wrist's turning link, never ends a query: it is asked after the balls, only for

@@ -4,6 +4,7 @@
 // not (a layer that never fires would pass the first check).
 #include <clearway/body/enclosing.h>
 #include <clearway/body/proximity.h>
+#include <clearway/detail/margins.h>
 #include <clearway/kinematics/forward_kinematics.h>
 #include <clearway/kinematics/kinematic_lanes.h>
 #include <clearway/load/robot_loader.h>
@@ -14,6 +15,7 @@
 #include "forced_target.h"
 #include "tree/mesh_reference.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -105,9 +107,9 @@ TEST(EnclosingBalls, ApartOnlyWhereTheHullsAreApart) {
 
 TEST(EnclosingBalls, BoundsApartInLanesIsApartsFirstTest) {
   // Every pair of every robot at random states, the lanes forced to each target this machine offers (one
-  // this kernel is not compiled for falls back to one it is), in batches of every length, so that both the
-  // lanes and the one-at-a-time tail run: a pair the lanes call apart is apart by apart() and by the exact
-  // meshes, and the lanes call apart every pair whose bounding balls are apart by more than the band.
+  // this kernel is not compiled for falls back to one it is), in lists of every length, so that runs end at
+  // every lane: a pair the lanes call apart is apart by apart() and by the exact meshes, and the lanes call
+  // apart every pair whose bounding balls are apart by more than the band.
   CLEARWAY_REQUIRE_SHARED_ARMS();
   const Tolerances tol;
   for (const std::string& urdf : test::allArms()) {
@@ -133,7 +135,7 @@ TEST(EnclosingBalls, BoundsApartInLanesIsApartsFirstTest) {
     std::vector<Pose> poses(model->linkCount());
     std::mt19937_64 rng(5);
     int apart = 0;
-    std::vector<std::uint8_t> out(n);
+    std::vector<std::uint8_t> out(n + BoundsRows::kSpare);
     for (const std::int64_t target : KinematicLanes::targets()) {  // the lanes' targets (simd_targets.h)
       const test::ForcedTarget forced(target);
       for (int s = 0; s < 40; ++s) {
@@ -141,7 +143,10 @@ TEST(EnclosingBalls, BoundsApartInLanesIsApartsFirstTest) {
         computeLinkPoses(*model, q.data(), poses.data());
         balls.place(poses.data());
         const int count = 1 + s % n;  // a prefix of every length up to the pair count
-        balls.boundsApart(a.data(), b.data(), padding.data(), count, tol, out.data());
+        const BoundsRows rows(std::vector<std::int64_t>(a.begin(), a.begin() + count),
+                              std::vector<std::int64_t>(b.begin(), b.begin() + count),
+                              std::vector<double>(padding.begin(), padding.begin() + count), model->linkCount());
+        balls.boundsApart(rows, tol, out.data());
         for (int k = 0; k < count; ++k) {
           const LinkGeometry* ga = geometry.link(static_cast<int>(a[k]));
           const LinkGeometry* gb = geometry.link(static_cast<int>(b[k]));
@@ -294,6 +299,80 @@ TEST(EnclosingBalls, RandomLinksAtRandomPosesLieInTheirBalls) {
     }
   }
   EXPECT_GT(with_parts, 10) << "too few random links had parts' balls to check";
+}
+
+TEST(EnclosingBalls, BoundsRowsAnswerEachPairAsAlone) {
+  // Pair lists laid out in runs of every shape (sorted as SelfCollision's, shuffled, with repeats at other
+  // paddings, reversed pairs, links without geometry), on each target: every pair's verdict is the one it
+  // gets in a list of its own, and the formula's (apart()'s first test); the spare bytes past the last pair
+  // are the only ones written past it (ASan checks the rest).
+  Arm a(std::string(CLEARWAY_SOURCE_DIR) + "/robots/dual_arm/dual_arm.urdf");  // (34 links, some without geometry)
+  const int links = a.model->linkCount();
+  const Tolerances tol;
+  const double band = margins::narrowBand(tol.gjk_absolute);
+  std::mt19937_64 rng(17);
+  std::vector<Pose> poses(links);
+  for (const std::int64_t target : KinematicLanes::targets()) {
+    const test::ForcedTarget forced(target);
+    for (int trial = 0; trial < 60; ++trial) {
+      computeLinkPoses(*a.model, randomState(*a.model, rng).data(), poses.data());
+      a.balls.place(poses.data());
+      std::vector<std::int64_t> first, second;
+      std::vector<double> padding;
+      for (int i = 0; i < links; ++i)
+        for (int j = 0; j < links; ++j)
+          if (i != j && (trial % 3 == 0 ? i < j : std::uniform_int_distribution<int>(0, 2)(rng) == 0)) {
+            first.push_back(i);
+            second.push_back(j);
+            padding.push_back(std::uniform_real_distribution<double>(0.0, 0.05)(rng));
+            if (trial % 5 == 1 && first.size() % 7 == 0) {  // a repeat at another padding
+              first.push_back(i);
+              second.push_back(j);
+              padding.push_back(0.3);
+            }
+          }
+      if (trial % 3 == 2) {  // shuffled
+        std::vector<std::size_t> order(first.size());
+        for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+        std::shuffle(order.begin(), order.end(), rng);
+        std::vector<std::int64_t> f, s;
+        std::vector<double> p;
+        for (std::size_t k : order) f.push_back(first[k]), s.push_back(second[k]), p.push_back(padding[k]);
+        first.swap(f), second.swap(s), padding.swap(p);
+      }
+      const int n = static_cast<int>(first.size());
+      const BoundsRows rows(first, second, padding, links);
+      ASSERT_EQ(rows.size(), n);
+      std::vector<std::uint8_t> out(n + BoundsRows::kSpare + 16, 7);
+      a.balls.boundsApart(rows, tol, out.data());
+      for (int k = n + BoundsRows::kSpare; k < static_cast<int>(out.size()); ++k) ASSERT_EQ(out[k], 7) << k;
+      int apart = 0;
+      for (int k = 0; k < n; ++k) {
+        std::uint8_t alone[1 + BoundsRows::kSpare];
+        a.balls.boundsApart(BoundsRows({first[k]}, {second[k]}, {padding[k]}, links), tol, alone);
+        ASSERT_EQ(out[k], alone[0]) << hwy::TargetName(target) << ": pair " << k << " of " << n;
+        ASSERT_LE(out[k], 1);
+        const LinkGeometry* ga = a.geometry.link(static_cast<int>(first[k]));
+        const LinkGeometry* gb = a.geometry.link(static_cast<int>(second[k]));
+        bool formula = false;
+        if (ga && gb) {  // apart()'s first test, from the balls as placed
+          const Vec3 ca = poses[first[k]] * ga->sphereCenter(), cb = poses[second[k]] * gb->sphereCenter();
+          const double reach = ga->sphereRadius() + gb->sphereRadius() + padding[k];
+          const double limit = reach + band * (ca.norm() + cb.norm() + reach);
+          formula = (ca - cb).squaredNorm() > limit * limit;
+        }
+        EXPECT_EQ(out[k] != 0, formula) << hwy::TargetName(target) << ": pair " << k;
+        apart += out[k];
+      }
+      EXPECT_GT(apart, 0);
+      EXPECT_LT(apart, n);
+    }
+  }
+  EXPECT_THROW(BoundsRows({0}, {0}, {0.0}, links), std::invalid_argument);
+  EXPECT_THROW(BoundsRows({0}, {links}, {0.0}, links), std::invalid_argument);
+  EXPECT_THROW(BoundsRows({-1}, {1}, {0.0}, links), std::invalid_argument);
+  EXPECT_THROW(BoundsRows({0, 1}, {1}, {0.0}, links), std::invalid_argument);
+  EXPECT_EQ(BoundsRows().size(), 0);
 }
 
 TEST(EnclosingBalls, MadeOnlyForItsRobot) {

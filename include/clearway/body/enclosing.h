@@ -15,6 +15,45 @@
 
 namespace clearway {
 
+/// A fixed list of link pairs laid out for EnclosingBalls::boundsApart: runs of pairs that share their first
+/// link and whose second links, like their indices, follow one another, so that the lanes load the second
+/// links' balls as they lie (no gathers) and store the verdicts as they lie (no scatters). Pairs sorted by
+/// (a, b), as SelfCollision's, make few runs. Immutable; made once per pair list.
+class BoundsRows {
+ public:
+  /// No pairs.
+  BoundsRows() = default;
+  /// Pairs (a[k], b[k]) with padding[k] metres, a[k] != b[k], every index in [0, link_count): any order.
+  /// Throws std::invalid_argument otherwise.
+  BoundsRows(const std::vector<std::int64_t>& a, const std::vector<std::int64_t>& b, const std::vector<double>& padding,
+             int link_count);
+  /// Entries past the last link, past the last padding, and past the last verdict that a step of lanes may
+  /// read or write: the widest.
+  static constexpr int kSpare = 8;
+  /// How many pairs.
+  int size() const noexcept { return pairs_; }
+  /// The robot's link count the pairs index.
+  int linkCount() const noexcept { return link_count_; }
+
+  /// Pairs first, ..., first + count − 1, of links (a, lo), ..., (a, lo + count − 1).
+  struct Row {
+    int a = 0;      ///< the first link of every pair of the run
+    int lo = 0;     ///< the second link of its first pair
+    int first = 0;  ///< its first pair's index
+    int count = 0;  ///< how many pairs
+  };
+  /// The runs, for the lanes, in order of their first pair.
+  const std::vector<Row>& rows() const noexcept { return rows_; }
+  /// Per pair its padding, then kSpare zeros.
+  const std::vector<double>& padding() const noexcept { return padding_; }
+
+ private:
+  std::vector<Row> rows_;
+  std::vector<double> padding_;
+  int pairs_ = 0;
+  int link_count_ = 0;
+};
+
 /// The enclosing balls of a robot's links at one configuration. Made per thread; place() allocates nothing.
 class EnclosingBalls {
  public:
@@ -34,11 +73,12 @@ class EnclosingBalls {
   /// boxes apart on a face axis. Both hold the hulls, so the answer holds in every geometry mode. False
   /// proves nothing; a non-finite pose, or a link without geometry, is never apart.
   bool apart(int a, int b, double padding, const Tolerances& tol) const noexcept;
-  /// For k < n: out[k] = 1 when links a[k] and b[k], as last placed, have bounding balls more than
-  /// padding[k] apart beyond the band (apart()'s first test, for many pairs at once in SIMD lanes, the target
-  /// chosen at run time as KinematicLanes' is), else 0, which proves nothing.
-  void boundsApart(const std::int64_t* a, const std::int64_t* b, const double* padding, int n, const Tolerances& tol,
-                   std::uint8_t* out) const noexcept;
+  /// For each pair k of `pairs` (made for this robot's link count): out[k] = 1 when its links, as last placed,
+  /// have bounding balls more than its padding apart beyond the band (apart()'s first test, by the same
+  /// formula, for many pairs at once in SIMD lanes, the target chosen at run time as KinematicLanes' is), else
+  /// 0, which proves nothing. Pairs made for another link count are all 0. out has room for
+  /// pairs.size() + BoundsRows::kSpare bytes: the lanes write whole steps, the last past the last pair.
+  void boundsApart(const BoundsRows& pairs, const Tolerances& tol, std::uint8_t* out) const noexcept;
 
   /// A ball as placed, world frame.
   struct Placed {
@@ -77,7 +117,8 @@ class EnclosingBalls {
   std::vector<double> local_norms_;  // |centre| in the link frame
   std::vector<double> radii_;
   // Per link, its bounding ball as last placed, one array per coordinate for the lanes (a link without
-  // geometry: an infinite radius, never apart).
+  // geometry: an infinite radius, never apart), and BoundsRows::kSpare entries more, never apart, which the lanes of a
+  // row's last step read past its span.
   std::vector<double> bound_x_, bound_y_, bound_z_, bound_r_, bound_norm_;
 };
 

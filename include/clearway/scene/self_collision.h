@@ -143,7 +143,7 @@ class SelfCollision {
   std::shared_ptr<const RobotGeometry> geometry_;
   std::vector<LinkPair> pairs_;
   std::vector<double> pair_padding_;
-  std::vector<std::int64_t> pair_a_, pair_b_;  // pairs_' links, as the enclosing layer's lanes read them
+  BoundsRows bounds_rows_;                                // pairs_, as the enclosing layer's lanes read them
   std::vector<std::shared_ptr<const PairTable>> tables_;  // per pair when options_.pair_tables
   std::vector<int> with_table_;                           // the pairs whose table may prove a collision
   std::vector<std::uint8_t> free_table_;  // per pair: its table is freeOnly(), asked only when the balls meet
