@@ -38,7 +38,7 @@ struct PairTableOptions {
   int coarse_one = 64, fine_one = 16;   ///< a pair moved by one variable
   ///@}
   ///@{
-  int coarse_two = 16, fine_two = 8;  ///< a pair moved by two
+  int coarse_two = 16, fine_two = 16;  ///< a pair moved by two
   ///@}
   /// Cell centres checked at most, per table (each a distance query at load): a level of halving that
   /// would pass it is not begun, and its cells stay Unsure.
@@ -50,7 +50,7 @@ struct PairTableOptions {
   /// of at most max_exact_triangles triangles each: past either, cells are checked on the hulls alone. A
   /// search among many triangles within a wide padding is what makes a table dear; counted, not timed, a
   /// table is the same on every machine (and so is which colliding pair a check reports).
-  long max_exact_checks = 2000;
+  long max_exact_checks = 8000;
   int max_exact_triangles = 4096;
   ///@}
   /// No cell is checked after this moment (the cells left stay Unsure). None by default: a deadline makes
