@@ -89,7 +89,7 @@ BoundsRows::BoundsRows(const std::vector<std::int64_t>& a, const std::vector<std
 }
 
 void EnclosingBalls::boundsApart(const BoundsRows& pairs, const Tolerances& tol, std::uint8_t* out) const noexcept {
-  static_assert(HWY_MAX_BYTES / sizeof(double) <= BoundsRows::kSpare, "a step of lanes reads past its span");
+  static_assert(HWY_MAX_BYTES / sizeof(double) <= BoundsRows::kSpare, "a step of lanes reads past its run");
   const int n = pairs.size();
   if (n == 0) return;
   if (!poses_ || !geometry_ || pairs.linkCount() != static_cast<int>(links_.size())) {  // nothing proved
