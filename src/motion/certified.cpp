@@ -648,8 +648,8 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
     r.report.kind = CollisionReport::Kind::Invalid;
     return r;
   }
-  if (sc.staticCollision().kind != CollisionReport::Kind::None || rigid_collision_.kind != CollisionReport::Kind::None) {
-    r.report = sc.staticCollision().kind != CollisionReport::Kind::None ? sc.staticCollision() : rigid_collision_;
+  if (sc.staticCollision().kind != CollisionReport::Kind::None) {
+    r.report = sc.staticCollision();
     return r;
   }
   for (int i = 0; i < sc.dimension(); ++i) ctx.dq[i] = q1[i] - q0[i];

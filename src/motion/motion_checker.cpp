@@ -194,19 +194,8 @@ void MotionChecker::buildItems() {
   if (sc.effects().self) {
     const SelfCollision& self = sc.selfCollision();
     std::vector<std::pair<std::pair<int, int>, int>> keyed;  // (anchors, index in single)
-    const std::vector<Pose>& at = bodies_.reference;
     for (int k = 0; k < static_cast<int>(self.pairs().size()); ++k) {
-      const LinkPair& p = self.pairs()[k];
-      if (anchor[p.a] == anchor[p.b]) {  // one rigid body: as at every state
-        if (rigid_collision_.kind == CollisionReport::Kind::None &&
-            meshesIntersect(*sc.geometry().link(p.a), at[p.a], *sc.geometry().link(p.b), at[p.b],
-                            sc.options().tolerances, sc.options().mode, self.pairPadding(k))) {
-          rigid_collision_.kind = CollisionReport::Kind::Self;
-          rigid_collision_.link = p.a;
-          rigid_collision_.other_link = p.b;
-        }
-        continue;
-      }
+      const LinkPair& p = self.pairs()[k];  // (never two links of one rigid body: the scene checks those once)
       Item item;
       item.a = item.frame_a = p.a;
       item.b = item.frame_b = p.b;

@@ -259,11 +259,13 @@ void Scene::init() {
   link_padding_.assign(model.linkCount(), description_.padding);
   CollisionFilter moving_filter = filter_;
   std::vector<std::pair<int, int>> static_pairs;
-  for (const auto& [a, b] : filter_.enabledPairs())
-    if (!moves[a] && !moves[b]) {
+  for (const auto& [a, b] : filter_.enabledPairs()) {
+    const bool still = !moves[a] && !moves[b];
+    if (still || rigid_anchor_[a] == rigid_anchor_[b]) {  // (a gripper's links on its flange move as one)
       static_pairs.emplace_back(a, b);
-      moving_filter.disable(a, b, "never moves");
+      moving_filter.disable(a, b, still ? "never moves" : "one rigid body");
     }
+  }
   SelfCollisionOptions so;
   so.mode = options_.mode;
   so.tolerances = options_.tolerances;

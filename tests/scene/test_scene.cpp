@@ -1015,5 +1015,56 @@ TEST(Scene, LinksMoveRigidlyWithTheirAnchors) {
   }
 }
 
+TEST(Scene, PairsWithinOneRigidBodyAreCheckedOnce) {
+  // Two links joined by fixed joints never move relative to each other: the scene decides their pair once,
+  // at load. Where they overlap, every state collides and names them (the motion checker's segments too);
+  // where they do not, the pair is not among those checked per state.
+  const auto urdf = [](double finger_x) {
+    const auto box = [](const char* size) {
+      return std::string("<collision><geometry><box size=\"") + size + "\"/></geometry></collision>";
+    };
+    return std::string("<robot name=\"rigid\">") + "<link name=\"base\">" + box("0.2 0.2 0.2") + "</link>" +
+           "<link name=\"arm\">" + box("0.6 0.1 0.1") + "</link>" + "<link name=\"mount\">" + box("0.02 0.02 0.02") +
+           "</link>" + "<link name=\"finger\">" + box("0.1 0.1 0.1") + "</link>" +
+           "<joint name=\"turn\" type=\"revolute\"><parent link=\"base\"/><child link=\"arm\"/>"
+           "<origin xyz=\"0 0 0.5\"/><axis xyz=\"0 0 1\"/><limit lower=\"-3\" upper=\"3\" effort=\"1\" "
+           "velocity=\"1\"/></joint>"
+           "<joint name=\"to_mount\" type=\"fixed\"><parent link=\"arm\"/><child link=\"mount\"/>"
+           "<origin xyz=\"0.5 0 0.3\"/></joint>"
+           "<joint name=\"to_finger\" type=\"fixed\"><parent link=\"mount\"/><child link=\"finger\"/>"
+           "<origin xyz=\"" +
+           std::to_string(finger_x - 0.5) + " 0 -0.3\"/></joint></robot>";
+  };
+  TempDir dir;
+  for (const double finger_x : {0.2, 0.5 + 0.3}) {  // overlapping the arm (x in [-0.3, 0.3]), and clear of it
+    const bool overlap = finger_x < 0.3;
+    const std::string robot = dir.write(overlap ? "over.urdf" : "clear.urdf", urdf(finger_x));
+    const std::shared_ptr<const Scene> loaded =
+        Scene::load(dir.write(overlap ? "over.yaml" : "clear.yaml", "format: 1\nname: rigid\nrobot:\n  urdf: " + robot +
+                                                                        "\n  group: [turn]\nchecks: [self]\n"));
+    const Scene& scene = *loaded;
+    const RobotModel& model = scene.robot();
+    const int arm = model.linkIndex("arm"), finger = model.linkIndex("finger");
+    ASSERT_EQ(scene.rigidAnchors()[finger], arm);
+    for (const LinkPair& p : scene.selfCollision().pairs())
+      EXPECT_NE(scene.rigidAnchors()[p.a], scene.rigidAnchors()[p.b])
+          << model.link(p.a).name << ", " << model.link(p.b).name << " are one rigid body";
+    SceneContext ctx = scene.makeContext();
+    MotionChecker motion(loaded);
+    MotionContext mctx = motion.makeContext();
+    for (const double turn : {-2.0, 0.0, 1.0}) {
+      CollisionReport report;
+      EXPECT_EQ(scene.isFree(&turn, ctx, &report), !overlap) << turn;
+      const double next = turn + 0.5;
+      const MotionResult m = motion.check(&turn, &next, mctx, false);
+      EXPECT_EQ(m.free, !overlap) << turn;
+      if (!overlap) continue;
+      EXPECT_EQ(report.kind, CollisionReport::Kind::Self);
+      EXPECT_EQ(std::minmax(report.link, report.other_link), std::minmax(arm, finger));
+      EXPECT_EQ(m.report.kind, CollisionReport::Kind::Self);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace clearway

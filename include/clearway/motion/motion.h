@@ -338,7 +338,6 @@ class MotionChecker {
   int env_begin_ = 0;        // the first environment item
   // Names this checker's contexts (a copy shares its items, so its serial too).
   std::uint64_t serial_ = detail::nextSerial();
-  CollisionReport rigid_collision_;  // a self pair within one rigid body that collides (then every state does)
   double obstacle_speed_ = 0.0;   // the fastest obstacle's speed (m/s)
   std::vector<int> quaternions_;  // state entries where a floating joint's quaternion starts (qx)
   // Per self item (group or pair): its pairs' tables (scene/pair_table.h) built with the padding plus twice

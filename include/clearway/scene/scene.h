@@ -182,8 +182,8 @@ class Scene {
   const std::vector<int>& rigidAnchors() const noexcept { return rigid_anchor_; }
   /// Metres of padding around link i.
   double linkPadding(int i) const noexcept { return link_padding_[i]; }
-  /// A collision no state can undo (between links that never move, or a static link and a static
-  /// obstacle), found at construction; kind None when there is none.
+  /// A collision no state can undo (between links that never move or move as one rigid body, or a static
+  /// link and a static obstacle), found at construction; kind None when there is none.
   const CollisionReport& staticCollision() const noexcept { return static_collision_; }
 
   /// A context for this scene (allocates: make one per thread and reuse it).
@@ -289,7 +289,8 @@ class Scene {
   std::vector<EnvBody> env_bodies_;
   std::vector<int> env_order_;
   std::vector<double> link_padding_;
-  CollisionReport static_collision_;  // a collision no state can undo (static links), found at construction
+  CollisionReport
+      static_collision_;  // a collision no state can undo (static links, rigid bodies), found at construction
   CollisionReport self_static_collision_;  // the part of it among the robot's own links
   double static_clearance_ = std::numeric_limits<double>::infinity();  // static links to static obstacles
   double static_clearance_lower_ = std::numeric_limits<double>::infinity();
