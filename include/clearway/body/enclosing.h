@@ -117,8 +117,8 @@ class EnclosingBalls {
   std::vector<double> local_norms_;  // |centre| in the link frame
   std::vector<double> radii_;
   // Per link, its bounding ball as last placed, one array per coordinate for the lanes (a link without
-  // geometry: an infinite radius, never apart), and BoundsRows::kSpare entries more, never apart, which the lanes of a
-  // row's last step read past its span.
+  // geometry: an infinite radius, never apart), and BoundsRows::kSpare entries more, never apart, which the
+  // lanes of a run's last step read past it.
   std::vector<double> bound_x_, bound_y_, bound_z_, bound_r_, bound_norm_;
 };
 

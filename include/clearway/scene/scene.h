@@ -289,8 +289,7 @@ class Scene {
   std::vector<EnvBody> env_bodies_;
   std::vector<int> env_order_;
   std::vector<double> link_padding_;
-  CollisionReport
-      static_collision_;  // a collision no state can undo (static links, rigid bodies), found at construction
+  CollisionReport static_collision_;  // a collision no state can undo, found at construction
   CollisionReport self_static_collision_;  // the part of it among the robot's own links
   double static_clearance_ = std::numeric_limits<double>::infinity();  // static links to static obstacles
   double static_clearance_lower_ = std::numeric_limits<double>::infinity();
