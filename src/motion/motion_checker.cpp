@@ -97,19 +97,28 @@ void MotionChecker::buildItemTables() {
   const SelfCollisionOptions& so = sc.selfCollision().options();
   const PairTableOptions table = so.table_options.within(so.table_seconds);
   const double margin = 2.0 * options_.contact_distance;
+  // Every self item's table (a group's: each member's), built at once; an item whose every pair has one
+  // keeps them.
+  std::vector<PairTable::Request> requests;
+  for (int m = 0; m < env_begin_; ++m)
+    if (items_[m].last <= items_[m].first) requests.push_back({items_[m].a, items_[m].b, items_[m].padding + margin});
+  const std::vector<std::shared_ptr<const PairTable>> tables =
+      PairTable::sharedMany(sc.geometryPtr(), requests, sc.options().mode, sc.options().tolerances, so.held, table);
+  std::vector<int> request_of(env_begin_, -1);
+  for (int m = 0, r = 0; m < env_begin_; ++m)
+    if (items_[m].last <= items_[m].first) request_of[m] = r++;
   for (int k = 0; k < env_begin_; ++k) {
     const Item& item = items_[k];
     if (item.group >= 0) continue;  // (a member: its group's list holds its table)
     std::vector<std::shared_ptr<const PairTable>> list;
     const int first = item.first < item.last ? item.first : k, last = item.first < item.last ? item.last : k + 1;
     for (int m = first; m < last; ++m) {
-      auto t = PairTable::shared(sc.geometryPtr(), items_[m].a, items_[m].b, items_[m].padding + margin,
-                                 sc.options().mode, sc.options().tolerances, so.held, table);
+      const std::shared_ptr<const PairTable>& t = tables[request_of[m]];
       if (!t) {
         list.clear();
         break;
       }
-      list.push_back(std::move(t));
+      list.push_back(t);
     }
     item_tables_[k] = std::move(list);
   }

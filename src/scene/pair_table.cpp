@@ -2,6 +2,7 @@
 
 #include <clearway/body/proximity.h>
 #include <clearway/detail/margins.h>
+#include <clearway/detail/parallel_for.h>
 #include <clearway/shape/convex_hull.h>
 
 #include <algorithm>
@@ -425,6 +426,17 @@ std::shared_ptr<const PairTable> PairTable::shared(const std::shared_ptr<const R
     cache.sweep_at = std::max<std::size_t>(64, 2 * cache.tables.size());
   }
   return t;
+}
+
+std::vector<std::shared_ptr<const PairTable>> PairTable::sharedMany(
+    const std::shared_ptr<const RobotGeometry>& geometry, const std::vector<Request>& requests, GeometryMode mode,
+    const Tolerances& tol, const std::vector<double>& held, const PairTableOptions& options) {
+  std::vector<std::shared_ptr<const PairTable>> out(requests.size());
+  detail::parallelFor(requests.size(), detail::loadThreads(options.threads), [&](std::size_t i) {
+    const Request& r = requests[i];
+    out[i] = shared(geometry, r.a, r.b, r.padding, mode, tol, held, options);
+  });
+  return out;
 }
 
 PairTable::CacheStats PairTable::cacheStats() {

@@ -95,9 +95,9 @@ SelfCollision::SelfCollision(std::shared_ptr<const RobotGeometry> geometry, cons
   bounds_rows_ = BoundsRows(pair_a, pair_b, pair_padding_, n);
   if (options_.pair_tables) {
     const PairTableOptions table = options_.table_options.within(options_.table_seconds);
-    for (std::size_t k = 0; k < pairs_.size(); ++k)
-      tables_.push_back(PairTable::shared(geometry_, pairs_[k].a, pairs_[k].b, pair_padding_[k], options_.mode,
-                                          options_.tolerances, options_.held, table));
+    std::vector<PairTable::Request> requests;
+    for (std::size_t k = 0; k < pairs_.size(); ++k) requests.push_back({pairs_[k].a, pairs_[k].b, pair_padding_[k]});
+    tables_ = PairTable::sharedMany(geometry_, requests, options_.mode, options_.tolerances, options_.held, table);
   }
   free_table_.assign(pairs_.size(), 0);
   for (std::size_t k = 0; k < tables_.size(); ++k) {

@@ -155,6 +155,58 @@ TEST(PairTable, Ur5CellsHold) {
   EXPECT_GT(t.free, 0);
 }
 
+// The tables a load builds on several threads at once (sharedMany) are the tables built one at a time:
+// two loads of the UR5 (so that neither finds the other's tables in the cache), one on the calling thread
+// and one on four threads, give every pair the same variables, cells checked and certified share, and the
+// same verdict and witness at random configurations, and both equal build()'s own.
+TEST(PairTable, TablesBuiltAtOnceAreTheTablesBuiltOneAtATime) {
+  CLEARWAY_SHARED_ROBOT_OR_SKIP(urdf, "ur5/ur5.urdf");
+  const auto load = [&] {
+    auto model = std::make_shared<const RobotModel>(loadRobot(urdf, ""));
+    return std::make_shared<const RobotGeometry>(model);
+  };
+  const auto g1 = load(), g4 = load();
+  const RobotModel& model = g1->model();
+  const CollisionFilter filter(model);
+  std::vector<PairTable::Request> requests;
+  for (const auto& [a, b] : filter.enabledPairs()) requests.push_back({a, b, 0.002});
+  PairTableOptions one, four;
+  one.threads = 1;
+  four.threads = 4;
+  const Tolerances tol;
+  const auto t1 = PairTable::sharedMany(g1, requests, GeometryMode::Mesh, tol, {}, one);
+  const auto t4 = PairTable::sharedMany(g4, requests, GeometryMode::Mesh, tol, {}, four);
+  ASSERT_EQ(t1.size(), requests.size());
+  ASSERT_EQ(t4.size(), requests.size());
+  std::mt19937_64 rng(29);
+  int tabled = 0;
+  for (std::size_t k = 0; k < requests.size(); ++k) {
+    const std::string where = model.link(requests[k].a).name + "/" + model.link(requests[k].b).name;
+    ASSERT_EQ(t1[k] == nullptr, t4[k] == nullptr) << where;
+    if (!t1[k]) continue;
+    ++tabled;
+    EXPECT_NE(t1[k], t4[k]) << where << ": shared from the cache, not built";
+    const auto alone = PairTable::build(model, requests[k].a, *g1->link(requests[k].a), requests[k].b,
+                                        *g1->link(requests[k].b), requests[k].padding, GeometryMode::Mesh, tol);
+    ASSERT_TRUE(alone) << where;
+    for (const PairTable* t : {t4[k].get(), alone.get()}) {
+      EXPECT_EQ(t->variables(), t1[k]->variables()) << where;
+      EXPECT_EQ(t->freeOnly(), t1[k]->freeOnly()) << where;
+      EXPECT_EQ(t->cellsChecked(), t1[k]->cellsChecked()) << where;
+      EXPECT_EQ(t->certifiedShare(), t1[k]->certifiedShare()) << where;
+    }
+    for (int s = 0; s < 300; ++s) {
+      const std::vector<double> q = randomConfiguration(model, rng);
+      TrianglePair w1, w4;
+      const PairTable::Verdict v1 = t1[k]->lookup(q.data(), &w1), v4 = t4[k]->lookup(q.data(), &w4);
+      ASSERT_EQ(v4, v1) << where << " at state " << s;
+      ASSERT_EQ(alone->lookup(q.data()), v1) << where << " at state " << s;
+      EXPECT_TRUE(w4.a == w1.a && w4.b == w1.b) << where << " at state " << s;
+    }
+  }
+  EXPECT_GT(tabled, 10) << "too few tabled pairs to say anything";
+}
+
 // A cell whose bodies a rung proves at least the needed margin apart is Free: the rungs answer exactly
 // `enough` once they prove it (the parts do when every part is that far), and a table that asked for more
 // than that left such cells Unsure. On the UR5's forearm and wrist_2 (a table of two joints, its links

@@ -56,6 +56,10 @@ struct PairTableOptions {
   /// No cell is checked after this moment (the cells left stay Unsure). None by default: a deadline makes
   /// the tables, though never the verdicts, depend on the machine's speed.
   std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+  /// Tables a robot's load builds at once (sharedMany): 0 for as many as the machine runs at once
+  /// (detail::loadThreads: at most 16), 1 for the calling thread alone. The tables are the same whatever
+  /// this is.
+  int threads = 0;
   /// These options with the deadline brought forward to `seconds` from now, if that is sooner (a
   /// budget beyond 10⁶ s counts as 10⁶ s; a negative or NaN one as 0).
   PairTableOptions within(double seconds) const;
@@ -85,6 +89,20 @@ class PairTable {
                                                  double padding, GeometryMode mode, const Tolerances& tol,
                                                  const std::vector<double>& held = {},
                                                  const PairTableOptions& options = {});
+  /// One table sharedMany() asks for: links a and b, checked with `padding`.
+  struct Request {
+    int a = -1;            ///< one link
+    int b = -1;            ///< the other
+    double padding = 0.0;  ///< metres
+  };
+  /// shared() for each request, in order, on up to options.threads threads at once: the same tables as
+  /// one shared() after another (each is built whole on one thread). An exception of a build is rethrown
+  /// here, once every thread has stopped.
+  static std::vector<std::shared_ptr<const PairTable>> sharedMany(const std::shared_ptr<const RobotGeometry>& geometry,
+                                                                  const std::vector<Request>& requests,
+                                                                  GeometryMode mode, const Tolerances& tol,
+                                                                  const std::vector<double>& held = {},
+                                                                  const PairTableOptions& options = {});
   /// The work of shared()'s cache since the program started, for tests: what it shares and what keeping it
   /// costs are counts, not times.
   struct CacheStats {
