@@ -100,13 +100,14 @@ void MotionChecker::buildItemTables() {
   // Every self item's table (a group's: each member's), built at once; an item whose every pair has one
   // keeps them.
   std::vector<PairTable::Request> requests;
-  for (int m = 0; m < env_begin_; ++m)
-    if (items_[m].last <= items_[m].first) requests.push_back({items_[m].a, items_[m].b, items_[m].padding + margin});
+  std::vector<int> request_of(env_begin_, -1);  // per item that is not a group's head: its request
+  for (int m = 0; m < env_begin_; ++m) {
+    if (items_[m].last > items_[m].first) continue;
+    request_of[m] = static_cast<int>(requests.size());
+    requests.push_back({items_[m].a, items_[m].b, items_[m].padding + margin});
+  }
   const std::vector<std::shared_ptr<const PairTable>> tables =
       PairTable::sharedMany(sc.geometryPtr(), requests, sc.options().mode, sc.options().tolerances, so.held, table);
-  std::vector<int> request_of(env_begin_, -1);
-  for (int m = 0, r = 0; m < env_begin_; ++m)
-    if (items_[m].last <= items_[m].first) request_of[m] = r++;
   for (int k = 0; k < env_begin_; ++k) {
     const Item& item = items_[k];
     if (item.group >= 0) continue;  // (a member: its group's list holds its table)

@@ -47,7 +47,7 @@ void parallelFor(std::size_t n, unsigned threads, Fn&& fn) {
     }
   };
   std::vector<std::thread> pool;
-  const std::size_t helpers = std::min<std::size_t>(threads, n) > 1 ? std::min<std::size_t>(threads, n) - 1 : 0;
+  const std::size_t helpers = std::max<std::size_t>(std::min<std::size_t>(threads, n), 1) - 1;
   try {
     pool.reserve(helpers);
     for (std::size_t t = 0; t < helpers; ++t) pool.emplace_back(work);
