@@ -88,18 +88,23 @@ BoundsRows::BoundsRows(const std::vector<std::int64_t>& a, const std::vector<std
   padding_.resize(n + kSpare, 0.0);
 }
 
+void BoundsRows::apart(const double* x, const double* y, const double* z, const double* r, const double* norm,
+                       double band, std::uint8_t* out) const noexcept {
+  static_assert(HWY_MAX_BYTES / sizeof(double) <= kSpare, "a step of lanes reads past its run");
+  if (pairs_ == 0) return;
+  HWY_DYNAMIC_DISPATCH(RowsApart)
+  (x, y, z, r, norm, rows_.data(), static_cast<int>(rows_.size()), padding_.data(), band, out);
+}
+
 void EnclosingBalls::boundsApart(const BoundsRows& pairs, const Tolerances& tol, std::uint8_t* out) const noexcept {
-  static_assert(HWY_MAX_BYTES / sizeof(double) <= BoundsRows::kSpare, "a step of lanes reads past its run");
   const int n = pairs.size();
   if (n == 0) return;
   if (!poses_ || !geometry_ || pairs.linkCount() != static_cast<int>(links_.size())) {  // nothing proved
     std::fill(out, out + n, std::uint8_t{0});
     return;
   }
-  const double band = margins::narrowBand(tol.gjk_absolute);
-  HWY_DYNAMIC_DISPATCH(RowsApart)
-  (bound_x_.data(), bound_y_.data(), bound_z_.data(), bound_r_.data(), bound_norm_.data(), pairs.rows().data(),
-   static_cast<int>(pairs.rows().size()), pairs.padding().data(), band, out);
+  pairs.apart(bound_x_.data(), bound_y_.data(), bound_z_.data(), bound_r_.data(), bound_norm_.data(),
+              margins::narrowBand(tol.gjk_absolute), out);
 }
 
 }  // namespace clearway

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <tuple>
 
 #include "motion_detail.h"
 
@@ -78,6 +79,7 @@ MotionChecker::MotionChecker(std::shared_ptr<const Scene> scene, MotionOptions o
   }
   buildItems();
   buildItemTables();
+  buildRakeRows();
   const std::vector<int>& begin = bodies_.parts_begin;
   for (int k = 0; k < env_begin_; ++k) {
     const Item& it = items_[k];
@@ -88,6 +90,29 @@ MotionChecker::MotionChecker(std::shared_ptr<const Scene> scene, MotionOptions o
     for (int j = 0; j < nb; ++j) split.push_back(bound_.path(it.a, begin[it.b] + j));
     split_paths_.push_back(std::move(split));
   }
+}
+
+void MotionChecker::buildRakeRows() {
+  std::vector<std::int64_t> a, b;
+  std::vector<double> padding;
+  rake_pair_.assign(items_.size(), -1);
+  rake_bodies_.clear();
+  rake_body_count_ = 0;
+  for (const Item& it : items_) rake_body_count_ = std::max({rake_body_count_, it.a + 1, it.b + 1});
+  std::vector<char> named(rake_body_count_, 0);
+  for (int k = 0; k < env_begin_; ++k) {
+    const Item& it = items_[k];
+    if (it.group >= 0 || it.b < 0) continue;
+    rake_pair_[k] = static_cast<int>(a.size());
+    a.push_back(it.a), b.push_back(it.b);
+    padding.push_back(it.padding + options_.contact_distance);
+    for (const auto& [body, frame, g] : {std::tuple{it.a, it.frame_a, it.ga}, std::tuple{it.b, it.frame_b, it.gb}})
+      if (!named[body]) {
+        named[body] = 1;
+        rake_bodies_.push_back({body, frame, g});
+      }
+  }
+  rake_rows_ = BoundsRows(a, b, padding, rake_body_count_);
 }
 
 void MotionChecker::buildItemTables() {
@@ -292,6 +317,9 @@ MotionContext MotionChecker::makeContext() const {
   int bodies = 0;
   for (const Item& it : items_) bodies = std::max({bodies, it.a + 1, it.b + 1});
   c.rake_balls.assign(bodies, {});
+  for (std::vector<double>* v : {&c.rake_x, &c.rake_y, &c.rake_z, &c.rake_r, &c.rake_norm})
+    v->assign(static_cast<std::size_t>(rake_body_count_ + BoundsRows::kSpare), 0.0);
+  c.rake_apart.assign(static_cast<std::size_t>(rake_rows_.size() + BoundsRows::kSpare), 0);
   c.body_bound.assign(bodies, 0.0);
   c.contact.assign(items_.size(), {options_.contact_distance, options_.contact_distance});
   c.contact_stamp.assign(items_.size(), 0);

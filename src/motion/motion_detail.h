@@ -50,6 +50,10 @@ struct Scratch {
     const LinkGeometry* geometry = nullptr;  // the body's geometry it was placed for
   };
   std::vector<RakeBall> rake_balls;
+  // The rake's test in lanes (certified.cpp: Sweep::rakeInLanes): per body its ball grown by its motion over
+  // the piece, an array per coordinate (MotionChecker::rake_rows_'s layout), and per pair of the rows 1 when apart.
+  std::vector<double> rake_x, rake_y, rake_z, rake_r, rake_norm;
+  std::vector<std::uint8_t> rake_apart;
   std::uint64_t rake_piece = 0;  // the rake's pieces so far (names each)
   // Per item: its contact distance at either end of this segment, set when it first comes within
   // contact_distance (contact_stamp[k] == segment): half an end's clearance where that is below

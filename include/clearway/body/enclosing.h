@@ -46,6 +46,13 @@ class BoundsRows {
   const std::vector<Row>& rows() const noexcept { return rows_; }
   /// Per pair its padding, then kSpare zeros.
   const std::vector<double>& padding() const noexcept { return padding_; }
+  /// For each pair k, out[k] = 1 when its balls are more than its padding apart beyond the band: |c_a − c_b|²
+  /// > limit², limit = reach + band·(|c_a| + |c_b| + reach), reach = r_a + r_b + padding[k]; else 0, which
+  /// proves nothing (a NaN or infinite radius is never apart). The balls by index, an array per coordinate
+  /// (centre x, y, z, radius r, |centre| norm), each with kSpare entries past linkCount() (read, never
+  /// used); out has room for size() + kSpare bytes. In SIMD lanes, the target chosen at run time.
+  void apart(const double* x, const double* y, const double* z, const double* r, const double* norm, double band,
+             std::uint8_t* out) const noexcept;
 
  private:
   std::vector<Row> rows_;

@@ -32,6 +32,7 @@
 // measured farther than touching: its margin (MotionResult::margin), which makes the segments that lie within
 // it free too (MotionChecker::within). Every ball is at least contact_distance / B wide, so the loops end;
 // a cap on the number of distance queries ends them too (reported as a collision).
+#include <clearway/body/enclosing.h>
 #include <clearway/serial.h>
 #include <clearway/scene/scene.h>
 
@@ -345,6 +346,18 @@ class MotionChecker {
   // segment is not swept.
   std::vector<std::vector<std::shared_ptr<const PairTable>>> item_tables_;
   void buildItemTables();
+  // The rake's first test of many self items at once (certified.cpp: Sweep::rakeInLanes): the self items
+  // that are not a group's members as pairs of bodies, padded by the contact distance; per item its pair
+  // there (−1: none); and the bodies they name, each with the link that places it and its geometry.
+  BoundsRows rake_rows_;
+  std::vector<int> rake_pair_;
+  struct RakeBody {
+    int body = 0, frame = 0;
+    const LinkGeometry* geometry = nullptr;
+  };
+  std::vector<RakeBody> rake_bodies_;
+  int rake_body_count_ = 0;  // bodies the rows index: every item's, merged ones included
+  void buildRakeRows();
 };
 
 }  // namespace clearway
