@@ -136,6 +136,7 @@ LinkGeometry::LinkGeometry(std::vector<Triangle> triangles, std::vector<Primitiv
   for (const Vec3& v : hull_.vertices()) sphere_radius_ = std::max(sphere_radius_, (v - sphere_center_).norm());
   // Rounding of the norms (relative) and of the centre (relative to the coordinates).
   sphere_radius_ = margins::roundedUp(sphere_radius_, bounding_radius_);
+  sole_primitive_ = triangles_.empty() && primitives_.size() == 1;
   buildParts();
   findSolids();
   findCores();

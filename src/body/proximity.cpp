@@ -286,6 +286,14 @@ bool partsScreen(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& 
       a, pose_a, b, pose_b, tol, [need](int) { return need; }, first);
 }
 
+// Two primitives placed in their links (b's link placed in a's frame by b_in_a): whether they lie within
+// `padding`, as exactIntersect tests them. (Out of line, as primitivesBound: the rungs that links of meshes
+// climb, which never come here, stay as compact as they were.)
+[[gnu::noinline]] bool primitivesIntersect(const LinkGeometry::Primitive& a, const LinkGeometry::Primitive& b,
+                                           const Pose& b_in_a, const Tolerances& tol, double padding) noexcept {
+  return shapesIntersect(a.shape, a.pose, b.shape, b_in_a * b.pose, tol, padding);
+}
+
 // screenMeshes, the convex parts' rung only when `parts`.
 Screen screenRungs(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
                    const Tolerances& tol, GeometryMode mode, double padding, SimplexCache* hull_cache,
@@ -303,6 +311,11 @@ Screen screenRungs(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry
   // into another), and before the triangle search; so does a core of one link inside a primitive of the
   // other (a solid, whose own distance is exact). A pair they leave pays about 1,100 more.
   if (coresOverlap(a, b, b_in_a) || coreInPrimitive(a, b, b_in_a)) return Screen::Touching;
+  // Two links of one primitive each are those primitives (convex solids): their own GJK decides, as the
+  // exact test would, where the hulls' (circumscribed polytopes: 82 vertices for a capsule) only screens.
+  const LinkGeometry::Primitive* sole_a = mode == GeometryMode::Mesh ? a.solePrimitive() : nullptr;
+  const LinkGeometry::Primitive* sole_b = sole_a ? b.solePrimitive() : nullptr;
+  if (sole_b) return primitivesIntersect(*sole_a, *sole_b, b_in_a, tol, padding) ? Screen::Touching : Screen::Apart;
   SimplexCache scratch;
   SimplexCache& cache = hull_cache ? *hull_cache : scratch;
   const IntersectResult hulls = gjkIntersect(Margin<ConvexHull>{a.hull(), padding}, pose_a, b.hull(), pose_b, tol, cache);
@@ -540,6 +553,13 @@ DistanceResult shapeLinkDistance(const Shape& shape, const Pose& pose_shape, con
 
 namespace {
 
+// gjkLowerBound of two primitives placed in their links (placed by pose_a and pose_b).
+[[gnu::noinline]] double primitivesBound(const LinkGeometry::Primitive& a, const Pose& pose_a,
+                                         const LinkGeometry::Primitive& b, const Pose& pose_b, const Tolerances& tol,
+                                         SimplexCache& cache, double enough, double relative) noexcept {
+  return gjkLowerBound(a.shape, pose_a * a.pose, b.shape, pose_b * b.pose, tol, cache, enough, relative);
+}
+
 // A lower bound on the distance from the link's bounding ball (placed by pose_a) to the convex shape: the
 // ball against the shape's own ball and against its box (in its frame), a dozen operations where GJK costs
 // hundreds. The ball is grown by the rounding of placing its centre, both gaps shrunk by that of measuring them.
@@ -597,6 +617,7 @@ DistanceResult swapped(DistanceResult r) noexcept {
 
 void BodyPair::forget() noexcept {
   hullCache() = SimplexCache{};
+  sole_ = SimplexCache{};
   parts_first_ = -1;
   parts_stale_ = true;
 }
@@ -620,7 +641,7 @@ bool BodyPair::intersectsExactly(const Pose& pose_a, const Pose& pose_b, const T
 }
 
 double BodyPair::convexBound(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, double enough,
-                             double relative, double climb, GeometryMode mode) noexcept {
+                             double relative, double climb, GeometryMode mode, bool primitives) noexcept {
   const LinkGeometry& a = *a_;
   // (In every max() below the bound so far comes second: a NaN rung leaves it, and a NaN first bound
   // gives way to the rung's number.) A dearer rung only while the bound is at most climb and short of enough.
@@ -629,6 +650,19 @@ double BodyPair::convexBound(const Pose& pose_a, const Pose& pose_b, const Toler
   double lower = shape_ ? ballShapeGap(a, pose_a, *shape_, pose_b)
                         : (pose_a * a.sphereCenter() - pose_b * b_->sphereCenter()).norm() - a.sphereRadius() -
                               b_->sphereRadius();
+  // Two links of one primitive each, in Mesh mode: the primitives' own bound is the exact rung (nothing
+  // dearer is left to climb to), a few iterations of analytic supports where the hulls' would search
+  // polytopes of up to 82 vertices and stay short of the true distance by their facets.
+  const LinkGeometry::Primitive* sole_a =
+      primitives && mode == GeometryMode::Mesh && !shape_ ? a.solePrimitive() : nullptr;
+  const LinkGeometry::Primitive* sole_b = sole_a ? b_->solePrimitive() : nullptr;
+  if (sole_b && !(lower >= enough)) {
+    rung_ = Rung::Exact;
+    SimplexCache cold;  // (a pair whose hull warm start the caller keeps keeps none of its own)
+    lower =
+        std::max(primitivesBound(*sole_a, pose_a, *sole_b, pose_b, tol, warm_ ? cold : sole_, enough, relative), lower);
+    return lower >= 0.0 ? lower : 0.0;
+  }
   if (!(lower >= enough)) {
     rung_ = Rung::Hulls;
     SimplexCache& cache = hullCache();
@@ -656,7 +690,14 @@ double BodyPair::lowerBound(const Pose& pose_a, const Pose& pose_b, const Tolera
   if (!pose_a.isFinite() || !pose_b.isFinite()) return 0.0;
   const double climb = q.climb >= 0.0 ? q.climb : q.enough;
   const GeometryMode mode = q.top <= Rung::Hulls ? GeometryMode::Hull : q.mode;
-  const double lower = convexBound(pose_a, pose_b, tol, q.enough, q.relative, climb, mode);
+  const double lower = convexBound(pose_a, pose_b, tol, q.enough, q.relative, climb, mode, q.top >= Rung::Exact);
+  // Two links of one primitive each, which convexBound measured: `within` decided as the exact rung decides it.
+  if (rung_ == Rung::Exact) {
+    if (!(q.within >= 0.0) || lower > q.within) return lower;
+    return primitivesIntersect(*a_->solePrimitive(), *b_->solePrimitive(), relativePose(pose_a, pose_b), tol, q.within)
+               ? 0.0
+               : std::max(lower, q.within * margins::kBeyond);
+  }
   if (rung_ != Rung::Parts || !(lower <= climb) || !(lower < q.enough) || q.top < Rung::Exact) return lower;
   rung_ = Rung::Exact;
   const LinkGeometry& a = *a_;

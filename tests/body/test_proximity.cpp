@@ -310,6 +310,83 @@ TEST(BodyPair, ConvexSideAnswersAsTheShapeQueries) {
   EXPECT_TRUE(inside.intersects(bad, Pose(), tol, {}));
 }
 
+// Links of one primitive each (a URDF of boxes, spheres, cylinders and capsules) are their primitives: the
+// ladder measures them by their own GJK, exact where the hulls (circumscribed polytopes) stop short, and the
+// screen decides them. Every answer is the exact one: the screen's verdict is the triangles' rung's, the bound
+// never exceeds the distance (meshDistance, the primitives' GJK) and is within the relative error of it (skins
+// included: two capsules' cores far apart under thick skins),
+// `within` decides as the exact rung does, and Hull mode still answers for the hulls. Seen failing with the
+// second primitive left unplaced by its link's pose.
+TEST(BodyPair, LinksOfOnePrimitiveAreMeasuredAsThePrimitives) {
+  const std::vector<std::pair<std::string, Shape>> shapes = {{"box", Box(Vec3(0.05, 0.02, 0.08))},
+                                                             {"sphere", Sphere(0.03)},
+                                                             {"capsule", Capsule(0.02, 0.05)},
+                                                             {"cylinder", Cylinder(0.04, 0.03)}};
+  std::mt19937_64 rng(31);
+  std::vector<LinkGeometry> g;
+  for (const auto& [name, shape] : shapes) {
+    CollisionElement e;
+    e.primitive = shape;
+    e.origin = randomPose(rng, 0.05);  // (an element off the link's origin, as URDF <origin> places it)
+    g.emplace_back(std::vector<CollisionElement>{e}, std::vector<TriangleMesh>{});
+    ASSERT_NE(g.back().solePrimitive(), nullptr) << name;
+  }
+  EXPECT_EQ(LinkGeometry(tree_ref::uvSphere(0.1, 6, 8)).solePrimitive(), nullptr);
+  const Tolerances tol;
+  int cases = 0, touching = 0, within_hits = 0, within_clear = 0, tighter = 0;
+  for (std::size_t i = 0; i < g.size(); ++i)
+    for (std::size_t j = 0; j < g.size(); ++j) {
+      BodyPair pair(g[i], g[j]);  // warm starts carried from case to case, as along a segment
+      for (int c = 0; c < 40; ++c, ++cases) {
+        const Pose pa = randomPose(rng, 0.5);
+        Pose pb = randomPose(rng, 0.15);
+        pb.t += pa.t;
+        const std::string what = shapes[i].first + " vs " + shapes[j].first + " case " + std::to_string(c);
+        const DistanceResult truth = meshDistance(g[i], pa, g[j], pb, tol, 0.0, INFINITY);
+        ASSERT_FALSE(isFailure(truth.status)) << what;
+        const double ref = truth.distance;
+        const IntersectQuery iq{c % 3 == 0 ? 0.01 : 0.0, GeometryMode::Mesh};
+        const bool exact = meshesIntersectExactly(g[i], pa, g[j], pb, tol, iq.padding);
+        const Screen s = pair.screen(pa, pb, tol, iq);
+        EXPECT_NE(s, Screen::Unsure) << what;
+        EXPECT_EQ(s == Screen::Touching, exact) << what;
+        touching += exact;
+        BoundQuery q;
+        q.relative = 0.1;
+        const double bound = pair.lowerBound(pa, pb, tol, q);
+        EXPECT_EQ(pair.lastRung(), Rung::Exact) << what;  // (nothing is enough: past the balls)
+        EXPECT_LE(bound, ref + kBand) << what;
+        EXPECT_GE(bound, ref * (1.0 - q.relative) - kBand) << what;
+        BoundQuery hulls;
+        hulls.mode = GeometryMode::Hull;
+        const double hull = pair.lowerBound(pa, pb, tol, hulls);
+        EXPECT_LE(hull, ref + kBand) << what;
+        BoundQuery exact_q;
+        const double full = pair.lowerBound(pa, pb, tol, exact_q);
+        if (full > hull + 1e-6) ++tighter;
+        BoundQuery near;
+        near.relative = 0.1;
+        near.within = 0.01;
+        near.climb = 0.01;
+        const double w = pair.lowerBound(pa, pb, tol, near);
+        if (ref < near.within - kBand) {
+          EXPECT_EQ(w, 0.0) << what;
+          ++within_hits;
+        } else if (ref > near.within + kBand) {
+          EXPECT_GT(w, near.within) << what << ": beyond `within` must compare beyond it";
+          EXPECT_LE(w, ref + kBand) << what;
+          ++within_clear;
+        }
+      }
+    }
+  std::printf("  %d cases: %d touching, %d within 1 cm, %d beyond; tighter than the hulls in %d\n", cases, touching,
+              within_hits, within_clear, tighter);
+  EXPECT_GT(touching, cases / 10);
+  EXPECT_GT(within_hits, cases / 10);
+  EXPECT_GT(within_clear, cases / 10);
+  EXPECT_GT(tighter, cases / 10);
+}
+
 // A cast: the link's hull, grown by a margin, translating against a convex shape or another link held still.
 // Where it reports no contact before s, the grown hulls are apart at every sampled s' < s (a certified lower
 // bound on the first contact); where it reports a hit within reach, they touch there (within the band);

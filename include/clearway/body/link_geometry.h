@@ -64,6 +64,9 @@ class LinkGeometry {
   const AabbTree& tree() const noexcept { return tree_; }
   /// The primitive elements (empty for a mesh-only link).
   const std::vector<Primitive>& primitives() const noexcept { return primitives_; }
+  /// The link's one element when it is a single primitive without triangles (else null): then the
+  /// primitive is the link, and its own GJK is exact where the hull, a circumscribed polytope, is not.
+  const Primitive* solePrimitive() const noexcept { return sole_primitive_ ? primitives_.data() : nullptr; }
   /// A convex hull containing every triangle and primitive (curved primitives enter as circumscribed
   /// polytopes, so the hull is slightly larger than their hull).
   const ConvexHull& hull() const noexcept { return hull_; }
@@ -164,6 +167,7 @@ class LinkGeometry {
   std::vector<Part> parts_;
   Aabb bounds_;
   double bounding_radius_ = 0.0;
+  bool sole_primitive_ = false;  // one primitive, no triangles (solePrimitive)
   Vec3 sphere_center_ = Vec3::Zero();
   double sphere_radius_ = 0.0;
   std::vector<std::int32_t> solid_of_;  // per triangle: its closed piece, −1 for an open one

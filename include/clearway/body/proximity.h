@@ -228,8 +228,10 @@ class BodyPair {
 
  private:
   // The balls, the hulls, then (in Mesh mode, while the bound is at most `climb`) the convex parts; sets rung_.
+  // Two links of one primitive each, in Mesh mode and unless `primitives` is false: the balls, then the
+  // primitives themselves (rung_ Exact).
   double convexBound(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, double enough, double relative,
-                     double climb, GeometryMode mode) noexcept;
+                     double climb, GeometryMode mode, bool primitives = true) noexcept;
   SimplexCache& hullCache() noexcept { return warm_ ? *warm_ : hull_; }
 
   const LinkGeometry* a_;
@@ -237,6 +239,7 @@ class BodyPair {
   const Shape* shape_ = nullptr;
   SimplexCache* warm_ = nullptr;
   SimplexCache hull_;
+  SimplexCache sole_;                // two links of one primitive each: the primitives' GJK axis
   std::vector<SimplexCache> parts_;  // a's part i against b's part j at i·nb + j
   bool parts_stale_ = false;
   int parts_first_ = -1;  // the part pair intersectsExactly() tries first: the one too near last time

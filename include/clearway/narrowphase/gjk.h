@@ -306,7 +306,11 @@ double gjkLowerBound(const A& a, const Pose& pose_a, const B& b, const Pose& pos
     if (vw > 0.0) lower = std::max(lower, vw / std::sqrt(vv));
     if (!(lower - rsum < enough)) break;
     // Until the simplex holds a point, v is only a direction: the relative test needs v in the difference.
-    if (s.n > 0 && (vv - vw <= relative * vv || inSimplex(s, p.w))) break;
+    // Relative to the distance of the shapes, skins included (‖v‖ − rsum bounds it from above): cores far
+    // apart under thick skins (two capsules) would otherwise stop with a bound far short of it. Skins that
+    // overlap (‖v‖ ≤ rsum): the distance is 0, which the bound already is.
+    const double skin = rsum > 0.0 ? rsum * std::sqrt(vv) : 0.0;  // rsum·‖v‖
+    if (s.n > 0 && (vv - vw <= relative * (vv - skin) || skin >= vv || inSimplex(s, p.w))) break;
     s.p[s.n++] = p;
     const Vec3 v_next = reduceSimplex(s);
     const double vv_next = v_next.squaredNorm();
@@ -330,6 +334,10 @@ double gjkLowerBound(const A& a, const Pose& pose_a, const B& b, const Pose& pos
 /// A non-finite pose yields Status::InvalidInput.
 DistanceResult gjkDistance(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b,
                            const Tolerances& tol = {}) noexcept;
+
+/// gjkLowerBound of two posed shapes (the template above, for each pair of shape types).
+double gjkLowerBound(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b, const Tolerances& tol,
+                     SimplexCache& cache, double enough, double relative) noexcept;
 
 /// Intersection of two posed shapes with separating-axis caching (see the template above).
 IntersectResult gjkIntersect(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b,
