@@ -44,6 +44,31 @@ std::vector<Named> meshes() {
                                         Vec3(0.2, 0.05, 0.0))}};
 }
 
+// A measurement `within` a contact distance (1 cm), as the motion checker asks it.
+BoundQuery nearQuery() {
+  BoundQuery near;
+  near.relative = 0.1;
+  near.within = 0.01;
+  near.climb = 0.01;
+  return near;
+}
+
+// `within` a contact distance: the bound is 0 exactly when the reference distance is that near (outside the
+// band), and beyond it, compared with ≤, otherwise; counts which it was.
+void expectWithin(BodyPair& pair, const Pose& pa, const Pose& pb, const Tolerances& tol, double ref,
+                  const std::string& what, int& hits, int& clear) {
+  const BoundQuery near = nearQuery();
+  const double w = pair.lowerBound(pa, pb, tol, near);
+  if (ref < near.within - kBand) {
+    EXPECT_EQ(w, 0.0) << what;
+    ++hits;
+  } else if (ref > near.within + kBand) {
+    EXPECT_GT(w, near.within) << what << ": beyond `within` must compare beyond it";
+    EXPECT_LE(w, ref + kBand) << what;
+    ++clear;
+  }
+}
+
 TEST(BodyPair, LadderBoundsTheBruteForceDistance) {
   const std::vector<Named> m = meshes();
   std::vector<LinkGeometry> g;
@@ -78,23 +103,11 @@ TEST(BodyPair, LadderBoundsTheBruteForceDistance) {
         hull.enough = std::numeric_limits<double>::infinity();
         EXPECT_LE(pair.lowerBound(pa, pb, tol, hull), ref + kBand) << what;
         // `within` a contact distance: 0 exactly when the reference is that near (outside the band).
-        BoundQuery near;
-        near.relative = 0.1;
-        near.within = 0.01;
-        near.climb = 0.01;
-        const double w = pair.lowerBound(pa, pb, tol, near);
-        if (ref < near.within - kBand) {
-          EXPECT_EQ(w, 0.0) << what;
-          ++within_hits;
-        } else if (ref > near.within + kBand) {
-          EXPECT_GT(w, near.within) << what << ": beyond `within` must compare beyond it";
-          EXPECT_LE(w, ref + kBand) << what;
-          ++within_clear;
-        }
+        expectWithin(pair, pa, pb, tol, ref, what, within_hits, within_clear);
         // The warm starts only speed it up: forgotten, the answers are a fresh pair's, bit for bit.
         pair.forget();
         BodyPair fresh(g[i], g[j]);
-        EXPECT_EQ(pair.lowerBound(pa, pb, tol, near), fresh.lowerBound(pa, pb, tol, near)) << what;
+        EXPECT_EQ(pair.lowerBound(pa, pb, tol, nearQuery()), fresh.lowerBound(pa, pb, tol, nearQuery())) << what;
         EXPECT_EQ(pair.intersects(pa, pb, tol, {0.01, GeometryMode::Mesh}),
                   meshesIntersect(g[i], pa, g[j], pb, tol, GeometryMode::Mesh, 0.01))
             << what;
@@ -256,22 +269,10 @@ TEST(BodyPair, ConvexSideAnswersAsTheShapeQueries) {
           EXPECT_LE(pair.lowerBound(pa, pb, tol, rungs), ref + kBand) << what;
           EXPECT_LE(pair.lastRung(), top) << what;
         }
-        BoundQuery near;
-        near.relative = 0.1;
-        near.within = 0.01;
-        near.climb = 0.01;
-        const double w = pair.lowerBound(pa, pb, tol, near);
-        if (ref < near.within - kBand) {
-          EXPECT_EQ(w, 0.0) << what;
-          ++within_hits;
-        } else if (ref > near.within + kBand) {
-          EXPECT_GT(w, near.within) << what << ": beyond `within` must compare beyond it";
-          EXPECT_LE(w, ref + kBand) << what;
-          ++within_clear;
-        }
+        expectWithin(pair, pa, pb, tol, ref, what, within_hits, within_clear);
         pair.forget();
         BodyPair fresh(g[i], shape);
-        EXPECT_EQ(pair.lowerBound(pa, pb, tol, near), fresh.lowerBound(pa, pb, tol, near)) << what;
+        EXPECT_EQ(pair.lowerBound(pa, pb, tol, nearQuery()), fresh.lowerBound(pa, pb, tol, nearQuery())) << what;
         const DistanceResult d = pair.distance(pa, pb, tol, {});
         EXPECT_EQ(d.distance, ref) << what;
         EXPECT_EQ(d.point_a, truth.point_b) << what << ": A is the link";
@@ -364,19 +365,7 @@ TEST(BodyPair, LinksOfOnePrimitiveAreMeasuredAsThePrimitives) {
         BoundQuery exact_q;
         const double full = pair.lowerBound(pa, pb, tol, exact_q);
         if (full > hull + 1e-6) ++tighter;
-        BoundQuery near;
-        near.relative = 0.1;
-        near.within = 0.01;
-        near.climb = 0.01;
-        const double w = pair.lowerBound(pa, pb, tol, near);
-        if (ref < near.within - kBand) {
-          EXPECT_EQ(w, 0.0) << what;
-          ++within_hits;
-        } else if (ref > near.within + kBand) {
-          EXPECT_GT(w, near.within) << what << ": beyond `within` must compare beyond it";
-          EXPECT_LE(w, ref + kBand) << what;
-          ++within_clear;
-        }
+        expectWithin(pair, pa, pb, tol, ref, what, within_hits, within_clear);
       }
     }
   std::printf("  %d cases: %d touching, %d within 1 cm, %d beyond; tighter than the hulls in %d\n", cases, touching,
