@@ -314,13 +314,11 @@ MotionContext MotionChecker::makeContext() const {
   c.settled.assign(items_.size(), 0);
   c.rake_now.assign(items_.size(), 0);
   c.rake_next.assign(items_.size(), 0);
-  int bodies = 0;
-  for (const Item& it : items_) bodies = std::max({bodies, it.a + 1, it.b + 1});
-  c.rake_balls.assign(bodies, {});
+  c.rake_balls.assign(rake_body_count_, {});
   for (std::vector<double>* v : {&c.rake_x, &c.rake_y, &c.rake_z, &c.rake_r, &c.rake_norm})
     v->assign(static_cast<std::size_t>(rake_body_count_ + BoundsRows::kSpare), 0.0);
   c.rake_apart.assign(static_cast<std::size_t>(rake_rows_.size() + BoundsRows::kSpare), 0);
-  c.body_bound.assign(bodies, 0.0);
+  c.body_bound.assign(rake_body_count_, 0.0);
   c.contact.assign(items_.size(), {options_.contact_distance, options_.contact_distance});
   c.contact_stamp.assign(items_.size(), 0);
   c.split_slot.assign(env_begin_, 0);

@@ -356,7 +356,7 @@ class MotionChecker {
     const LinkGeometry* geometry = nullptr;
   };
   std::vector<RakeBody> rake_bodies_;
-  int rake_body_count_ = 0;  // bodies the rows index: every item's, merged ones included
+  int rake_body_count_ = 0;  // bodies the items name (merged ones included): the rows', a context's per body
   void buildRakeRows();
 };
 
