@@ -197,8 +197,13 @@ void ComputeLinks(D d, const RobotModel& model, const double* q, Pose* poses, co
       // The parent's columns: where this pass computed it, from `cols`; else from its pose (the load of t
       // reads the next pose's first double into the spare lane: parent < i, so that pose exists).
       const double* from = nullptr;
-      for (int j = k - 1; j >= begin && !from; --j)
-        if (link(j) == st.parent) from = cols[j - begin];
+      if (!links) {  // (a range: the parent's place in it is known)
+        const int j = st.parent - first;
+        if (j >= begin) from = cols[j - begin];
+      } else {
+        for (int j = k - 1; j >= begin && !from; --j)
+          if (links[j] == st.parent) from = cols[j - begin];
+      }
       V P0, P1, P2, Pt;
       if (from) {
         P0 = hn::Load(d, from), P1 = hn::Load(d, from + 4), P2 = hn::Load(d, from + 8), Pt = hn::Load(d, from + 12);
