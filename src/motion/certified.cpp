@@ -2,6 +2,7 @@
 // mode's shape casts ahead of it.
 #include <clearway/motion/motion.h>
 
+#include <clearway/body/proximity.h>
 #include <clearway/detail/margins.h>
 #include <clearway/kinematics/forward_kinematics.h>
 #include <clearway/narrowphase/gjk.h>
@@ -508,7 +509,8 @@ struct MotionChecker::Sweep {
   // stays beyond contact_distance, the largest contactOf can be. Pieces split from the whole segment to
   // eighths, and only while the balls at the middle clear the contact distance: an item whose balls meet
   // there is near, and is left to the distances (one test spent). A piece costs one subtraction and a
-  // squared norm where a measurement costs a ladder of GJKs, and one pose per piece serves every item.
+  // squared norm where a measurement costs a ladder of GJKs, and one pose per piece serves every item. A
+  // slender self pair's balls leave it, its hulls' boxes apart by the same reach settle it too.
   static constexpr int kRakeLevels = 4;
   static constexpr int kRakePieces = 1 << (kRakeLevels - 1);  // the finest pieces: bits of ctx.settled[k]
   static constexpr std::uint8_t kRakeAll = (1u << kRakePieces) - 1u;
@@ -529,6 +531,14 @@ struct MotionChecker::Sweep {
       b.geometry = &g;
     }
     return b;
+  }
+  // Whether self item `it`'s hulls' boxes, as oriented boxes, are farther apart than `reach` (beyond their own
+  // band) at s: tighter than the balls for slender links (a forearm beside the base). (Out of line: the rake's
+  // test stays as compact for the items that never ask it.)
+  [[gnu::noinline]] bool boxesApartAt(const Item& it, double s, double reach) {
+    const Pose pa = pose(s, it.frame_a);
+    const Pose b_in_a = relativePose(pa, pose(s, it.frame_b));
+    return b_in_a.isFinite() && boxesApart(*it.ga, *it.gb, b_in_a, mc.scene_->options().tolerances, reach);
   }
   // Whether item k's bounding balls at s settle the piece s ± half: apart (for the environment: clear of the
   // obstacles' boxes) by more than padding + contact + B·half; else, unless `last` (no halves follow), whether
@@ -559,7 +569,9 @@ struct MotionChecker::Sweep {
         if (loose < INFINITY && test(loose) == Raked::Settled) return Raked::Settled;
       }
       const double motion = boundOf(k) * half;
-      return motion < INFINITY ? test(motion) : Raked::Near;  // (∞ or NaN: nothing is settled)
+      if (!(motion < INFINITY)) return Raked::Near;  // (∞ or NaN: nothing is settled)
+      const Raked t = test(motion);
+      return t == Raked::Settled || !it.boxes || !boxesApartAt(it, s, contact + motion) ? t : Raked::Settled;
     }
     const double motion = boundOf(k) * half;
     if (!(motion < INFINITY)) return Raked::Near;

@@ -319,6 +319,7 @@ class MotionChecker {
     double padding = 0.0;
     int first = 0, last = 0;  // a group: its members, items [first, last)
     int group = -1;           // a member: its group
+    bool boxes = false;       // a self pair the rake also tests by the hulls' boxes
   };
   // Fills items_: groups where two bodies' every link pair (or a body's every link) is checked.
   void buildItems();
