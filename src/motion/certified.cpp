@@ -509,8 +509,8 @@ struct MotionChecker::Sweep {
   // stays beyond contact_distance, the largest contactOf can be. Pieces split from the whole segment to
   // eighths, and only while the balls at the middle clear the contact distance: an item whose balls meet
   // there is near, and is left to the distances (one test spent). A piece costs one subtraction and a
-  // squared norm where a measurement costs a ladder of GJKs, and one pose per piece serves every item. A
-  // slender self pair's balls leave it, its hulls' boxes apart by the same reach settle it too.
+  // squared norm where a measurement costs a ladder of GJKs, and one pose per piece serves every item. Where
+  // a slender self pair's balls leave a piece, its hulls' boxes, apart by the same reach, may settle it.
   static constexpr int kRakeLevels = 4;
   static constexpr int kRakePieces = 1 << (kRakeLevels - 1);  // the finest pieces: bits of ctx.settled[k]
   static constexpr std::uint8_t kRakeAll = (1u << kRakePieces) - 1u;
