@@ -293,7 +293,7 @@ void MotionChecker::buildItems() {
   // Panda's free segments took 0.3 to 0.7% more instructions).
   constexpr double kSlender = 2.5;
   const auto slender = [](const LinkGeometry& g) {
-    const Vec3 h = 0.5 * (g.bounds().max - g.bounds().min);
+    const Vec3 h = g.bounds().halfExtents();
     return g.sphereRadius() >= kSlender * (h.sum() - h.maxCoeff() - h.minCoeff());
   };
   for (Item& it : items_) it.boxes = it.b >= 0 && (slender(*it.ga) || slender(*it.gb));
