@@ -3,6 +3,7 @@
 // tree of their own, the names, and the clearance grid built once enough queries asked. The link queries
 // against it are in environment_queries.cpp.
 #include <clearway/environment/environment.h>
+#include <clearway/environment/voxel_blocks.h>
 #include <clearway/load/input_limits.h>
 
 #include "environment_boxes.h"
@@ -78,9 +79,12 @@ Environment Environment::withMap(std::shared_ptr<const OccupancyMap> map) const 
   Environment e = *this;
   e.map_ = std::move(map);
   e.voxel_tree_.reset();
+  e.blocks_.reset();
   // Voxels lie on a grid: the median split is as good as the SAH there and builds several times faster.
-  if (e.map_ && !e.map_->occupied.empty())
+  if (e.map_ && !e.map_->occupied.empty()) {
     e.voxel_tree_ = std::make_shared<const AabbTree>(e.map_->occupied, TreeBuildOptions{TreeSplit::Median, 2});
+    e.blocks_ = std::make_shared<const VoxelBlocks>(*e.map_, !e.without_blocks_);
+  }
   e.rescale();
   return e;
 }
@@ -131,6 +135,12 @@ Environment Environment::withoutClearanceGrid() const {
   Environment e = *this;
   e.clearance_.reset();
   return e;
+}
+
+Environment Environment::withoutVoxelBlocks() const {
+  Environment e = *this;
+  e.without_blocks_ = true;
+  return e.withMap(map_);
 }
 
 Environment Environment::withoutObstacleBoxes() const {

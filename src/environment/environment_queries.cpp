@@ -1,17 +1,23 @@
 // Environment's link queries: a link against the obstacles and voxels near it (the store is environment.cpp).
 //
+// The map's voxels are met as their blocks (voxel_blocks.h): boxes of exactly their union, a few hundred
+// where a scanned shelf has ten thousand voxels. Every query walks the blocks, so that they all see the
+// same geometry (a free state stays leavable by a motion); only a report goes back to the voxels, to name
+// one the link touches.
+//
 // A link is first reduced to its world box (the box of its hull's box placed by the pose), which picks
-// the candidates from each tree. Candidates then meet tests from cheapest to dearest: for voxels the
+// the candidates from each tree. Candidates then meet tests from cheapest to dearest: for blocks the
 // link's box as an oriented box (6 face axes), then GJK against the link's hull (one warm-started
-// cache for all voxels of a query: every voxel is axis-aligned, so the last separating axis is a good
-// start for the next), and only in Mesh mode, when the hull touches voxels, the triangles. When more
-// than a few voxels pass the hull, the voxel tree and the link's triangle tree are descended together
-// (world frame against link frame), which tests each voxel only against the triangles near it.
+// cache for all blocks of a query: every block is axis-aligned, so the last separating axis is a good
+// start for the next), and only in Mesh mode, when the hull touches blocks, the triangles. When more
+// than a few blocks pass the hull, the block tree and the link's triangle tree are descended together
+// (world frame against link frame), which tests each block only against the triangles near it.
 //
 // Slack: boxes are grown by padding + band, band = 4·max(gjk_absolute, 64 ulps)·scale with scale
 // bounding every coordinate of the query, so box culling never drops a pair that GJK (whose own band
 // is gjk_absolute times the pair's size) would call touching.
 #include <clearway/environment/environment.h>
+#include <clearway/environment/voxel_blocks.h>
 
 #include <clearway/detail/margins.h>
 #include <clearway/narrowphase/epa.h>
@@ -47,9 +53,23 @@ double ballReach(const LinkGeometry& link, const Pose& pose) noexcept {
   return link.sphereRadius() * (1.0 + margins::kRounding) + margins::placedRounding(link.sphereCenter().norm(), pose.t.norm());
 }
 
-// Voxels passing the hull test that the Mesh mode checks one by one (each against the triangles near
+// True when voxel v and block b share more than a face (a coarse voxel's cells may lie in several blocks).
+bool shares(const Aabb& block, const Aabb& voxel) noexcept {
+  return (block.min.cwiseMax(voxel.min).array() < block.max.cwiseMin(voxel.max).array()).all();
+}
+
+// What a hit on the map's voxel v reports.
+EnvironmentHit voxelHit(const std::vector<Aabb>& voxels, int v) noexcept {
+  EnvironmentHit h;
+  h.kind = EnvironmentHit::Kind::Voxel;
+  h.index = v;
+  h.voxel = voxels[static_cast<std::size_t>(v)];
+  return h;
+}
+
+// Blocks passing the hull test that the Mesh mode checks one by one (each against the triangles near
 // it); beyond this many, descending the two trees together is cheaper than a triangle-tree query each.
-constexpr int kFewVoxels = 4;
+constexpr int kFewBlocks = 4;
 
 // The running minimum of Environment::linkDistance, with the link as A.
 struct NearestSearch {
@@ -107,13 +127,14 @@ struct Environment::Reach {
 };
 
 // One item near the link: an obstacle where it is at the query's time, a voxel made by withPoints (as a box
-// obstacle), or a voxel of the map.
+// obstacle), or a block of the map's voxels (voxel_blocks.h: every query sees the map as its blocks, the
+// same union, so that they agree with each other; only a report names a voxel).
 struct Environment::Item {
   EnvironmentHit::Kind kind;
-  int index;                   // a map voxel's index, else −1
-  const Obstacle* obstacle;    // null for a map voxel
-  const Aabb* voxel;           // a map voxel, else null
-  Pose pose;                   // the obstacle's at the query's time, or the voxel's centre
+  int block;                   // a map block's index, else −1
+  const Obstacle* obstacle;    // null for a voxel or block
+  const Aabb* voxel;           // a point voxel's cell or a block, else null
+  Pose pose;                   // the obstacle's at the query's time, or the box's centre
   int warm;                    // a static obstacle's warm-start slot, else −1
 
   Aabb box() const noexcept { return obstacle ? obstacleBox(*obstacle, pose) : *voxel; }
@@ -126,11 +147,10 @@ struct Environment::Item {
     const Shape box = Box(voxel->halfExtents());
     return f(BodyPair(link, box, warm));
   }
-  // What a hit on it reports.
+  // What a hit on it reports (a block's: Environment::blockHit).
   EnvironmentHit hit() const noexcept {
     EnvironmentHit h;
     h.kind = kind;
-    h.index = index;
     if (kind == EnvironmentHit::Kind::Obstacle) h.obstacle = obstacle;
     else h.voxel = box();
     return h;
@@ -155,13 +175,14 @@ Environment::Walk Environment::forEachItem(const Reach& reach, double t, F&& vis
     if (reach.box ? !overlaps(box, *reach.box) : !(boxDistance(box, link_box) <= *reach.limit)) continue;
     if (visit(item)) return Walk::Stopped;
   }
-  if (!voxel_tree_) return Walk::Done;
-  const std::vector<Aabb>& voxels = map_->occupied;
-  const auto on_voxel = [&](std::int32_t v) {
-    return visit(Item{EnvironmentHit::Kind::Voxel, v, nullptr, &voxels[v], Pose::translation(voxels[v].center()), -1});
+  if (!blocks_) return Walk::Done;
+  const std::vector<Aabb>& boxes = blocks_->boxes();
+  const auto on_block = [&](std::int32_t b) {
+    return visit(Item{EnvironmentHit::Kind::Voxel, b, nullptr, &boxes[b], Pose::translation(boxes[b].center()), -1});
   };
-  return (reach.box ? voxel_tree_->query(*reach.box, on_voxel)
-                    : voxel_tree_->forEachWithin(*reach.local, *reach.pose, *reach.limit, on_voxel))
+  const AabbTree& tree = blocks_->tree();
+  return (reach.box ? tree.query(*reach.box, on_block)
+                    : tree.forEachWithin(*reach.local, *reach.pose, *reach.limit, on_block))
              ? Walk::Stopped
              : Walk::Done;
 }
@@ -189,14 +210,6 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
     if (hit) *hit = h;
     return true;
   };
-  const std::vector<Aabb>* map_voxels = map_ ? &map_->occupied : nullptr;
-  const auto voxelHit = [&](int v) {
-    EnvironmentHit h;
-    h.kind = EnvironmentHit::Kind::Voxel;
-    h.index = v;
-    h.voxel = (*map_voxels)[v];
-    return report(h);
-  };
   // The box of the link's bounding ball: a dozen operations where placing its box costs ten times more,
   // and as tight for most links (R·c + t rounds by a few ulps of |c| + |t|).
   const Vec3 centre = pose * link.sphereCenter();
@@ -211,21 +224,36 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
   if (moving_.empty()) {
     countQuery();  // (Scene::isFree reads the grid, once built, before it calls here)
     const auto any = [](const auto&...) { return true; };
-    if (!static_.query(query, any) && !(voxel_tree_ && voxel_tree_->query(query, any))) return false;
+    if (!static_.query(query, any) && !(blocks_ && blocks_->tree().query(query, any))) return false;
   }
+  // A block touched: the report names the first of its voxels the same test finds touching (only when asked).
+  const auto blockHit = [&](int b) {
+    if (!hit) return true;
+    const Aabb& box = blocks_->boxes()[static_cast<std::size_t>(b)];
+    int found = blocks_->voxelOf(b);
+    voxel_tree_->query(query, [&](std::int32_t v) {
+      const Aabb& c = map_->occupied[static_cast<std::size_t>(v)];
+      if (!shares(box, c) ||
+          !shapeIntersectsLink(Box(c.halfExtents()), Pose::translation(c.center()), link, pose, tol, mode, padding))
+        return false;
+      found = v;
+      return true;
+    });
+    return report(voxelHit(map_->occupied, found));
+  };
 
-  // The link's box as an oriented box in the world (A = world, B = the link frame): the voxels' first cull,
-  // set up at the first voxel (most links near obstacles meet none).
+  // The link's box as an oriented box in the world (A = world, B = the link frame): the blocks' first cull,
+  // set up at the first block (most links near obstacles meet none).
   std::optional<detail::OrientedBoxTest> obb;
   detail::OrientedBoxTest::PlacedB placed_link;
-  SimplexCache cache;  // one for all voxels: they are axis-aligned, so the last separating axis starts the next well
-  int passed[kFewVoxels];
+  SimplexCache cache;  // one for all blocks: they are axis-aligned, so the last separating axis starts the next well
+  int passed[kFewBlocks];
   int n_passed = 0;
   bool many = false;
   int found = -1;
   EnvironmentHit found_obstacle;  // an obstacle (or a point voxel) touched
   const Walk walk = forEachItem(Reach::overlapping(query), t, [&](const Item& item) {
-    if (item.index < 0) {  // an obstacle, or a voxel made by withPoints: on its own
+    if (item.block < 0) {  // an obstacle, or a voxel made by withPoints: on its own
       if (counters) ++counters->obstacle_tests;
       if (!item.pairWith(link, nullptr, [&](BodyPair pair) { return pair.intersects(pose, item.pose, tol, q); }))
         return false;
@@ -243,42 +271,42 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
     if (!shapeIntersectsLink(Box(Vec3(h[0], h[1], h[2])), Pose::translation(Vec3(c[0], c[1], c[2])), link, pose, tol,
                              GeometryMode::Hull, padding, &cache))
       return false;
-    if (mode == GeometryMode::Hull || n_passed == kFewVoxels) {
-      found = item.index;
+    if (mode == GeometryMode::Hull || n_passed == kFewBlocks) {
+      found = item.block;
       many = mode == GeometryMode::Mesh;
       return true;
     }
-    passed[n_passed++] = item.index;
+    passed[n_passed++] = item.block;
     return false;
   });
   if (walk == Walk::Invalid) return report(invalidMovingHit(t));  // out of reach of the doubles: touching
   if (found_obstacle.kind != EnvironmentHit::Kind::None) return report(found_obstacle);
-  if (!voxel_tree_) return false;
-  const AabbTree& voxel_tree = *voxel_tree_;
-  const std::vector<Aabb>& voxels = map_->occupied;
-  if (mode == GeometryMode::Hull) return found >= 0 ? voxelHit(found) : false;
+  if (!blocks_) return false;
+  const AabbTree& block_tree = blocks_->tree();
+  const std::vector<Aabb>& blocks = blocks_->boxes();
+  if (mode == GeometryMode::Hull) return found >= 0 ? blockHit(found) : false;
 
   if (!many) {
     for (int k = 0; k < n_passed; ++k) {
-      const Aabb& b = voxels[passed[k]];
+      const Aabb& b = blocks[passed[k]];
       if (counters) ++counters->voxel_tests;
       if (shapeIntersectsLink(Box(b.halfExtents()), Pose::translation(b.center()), link, pose, tol, GeometryMode::Mesh,
                               padding, &cache))
-        return voxelHit(passed[k]);
+        return blockHit(passed[k]);
     }
     return false;
   }
 
-  // Many voxels inside the hull: voxel tree (world) against triangle tree (link frame), then box–triangle
-  // GJK; then the link's primitives against the voxels near them.
+  // Many blocks inside the hull: block tree (world) against triangle tree (link frame), then box–triangle
+  // GJK; then the link's primitives against the blocks near them.
   found = -1;
-  // A core of the link meeting an occupied voxel settles it without the triangle search.
+  // A core of the link meeting a block settles it without the triangle search.
   const double core_margin = margins::kSlack * (1.0 + scale_ + extent);
-  // (A voxel within r of c, found in the voxel tree.)
-  const auto voxelWithin = [&](const Vec3& c, double r) {
+  // (A block within r of c.)
+  const auto blockWithin = [&](const Vec3& c, double r) {
     int at = -1;
-    voxel_tree.query(Aabb::fromCenterHalf(c, Vec3::Constant(r)), [&](std::int32_t v) {
-      const Aabb& b = voxels[v];
+    block_tree.query(Aabb::fromCenterHalf(c, Vec3::Constant(r)), [&](std::int32_t v) {
+      const Aabb& b = blocks[v];
       if (!(((c - b.center()).cwiseAbs() - b.halfExtents()).cwiseMax(0.0).norm() < r)) return false;
       at = v;
       return true;
@@ -286,21 +314,21 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
     return at;
   };
   for (const LinkGeometry::CoreGroup& g : link.coreGroups()) {
-    if (voxelWithin(pose * g.center, g.radius) < 0) continue;  // (a filter: no voxel near any of its cores)
+    if (blockWithin(pose * g.center, g.radius) < 0) continue;  // (a filter: no block near any of its cores)
     for (int k = g.first; k < g.first + g.count; ++k) {
       const LinkGeometry::Ball& core = link.cores()[k];
       const double r = core.radius - core_margin;
       if (!(r > 0.0)) continue;
-      found = voxelWithin(pose * core.center, r);
-      if (found >= 0) return voxelHit(found);
+      found = blockWithin(pose * core.center, r);
+      if (found >= 0) return blockHit(found);
     }
   }
   const std::vector<Triangle>& tris = link.triangles();
   forEachOverlap(
-      voxel_tree, link.tree(), pose,
+      block_tree, link.tree(), pose,
       [&](std::int32_t v, std::int32_t j) {
         if (counters) ++counters->voxel_tests;
-        const Aabb& b = voxels[v];
+        const Aabb& b = blocks[v];
         const Box box(b.halfExtents());
         SimplexCache pair_cache;
         if (!gjkIntersect(Margin<Box>{box, padding}, Pose::translation(b.center()), tris[j], pose, tol, pair_cache)
@@ -310,12 +338,12 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
         return true;
       },
       slack);
-  if (found >= 0) return voxelHit(found);
+  if (found >= 0) return blockHit(found);
   for (const LinkGeometry::Primitive& p : link.primitives()) {
     const Pose pose_p = pose * p.pose;
-    voxel_tree.query(shapeWorldBox(p.shape, pose_p).inflated(slack), [&](std::int32_t v) {
+    block_tree.query(shapeWorldBox(p.shape, pose_p).inflated(slack), [&](std::int32_t v) {
       if (counters) ++counters->voxel_tests;
-      const Aabb& b = voxels[v];
+      const Aabb& b = blocks[v];
       const Box box(b.halfExtents());
       SimplexCache pair_cache;
       const bool touching = std::visit(
@@ -327,17 +355,18 @@ bool Environment::linkIntersects(const LinkGeometry& link, const Pose& pose, con
       if (touching) found = v;
       return touching;
     });
-    if (found >= 0) return voxelHit(found);
+    if (found >= 0) return blockHit(found);
   }
-  // No surface touches a voxel: one may still lie inside a closed mesh of the link.
+  // No surface touches a block: one may still lie inside a closed mesh of the link (a block the surface does
+  // not cross lies wholly inside the solid or wholly outside it: its centre says which).
   if (link.solidCount() > 0) {
     const Pose to_link = pose.inverse();
-    voxel_tree.query(query, [&](std::int32_t v) {
-      if (!link.containsPoint(to_link * voxels[v].center())) return false;
+    block_tree.query(query, [&](std::int32_t v) {
+      if (!link.containsPoint(to_link * blocks[v].center())) return false;
       found = v;
       return true;
     });
-    if (found >= 0) return voxelHit(found);
+    if (found >= 0) return blockHit(found);
   }
   return false;
 }
@@ -405,7 +434,8 @@ double Environment::lowerBound(const LinkGeometry& link, const Pose& pose, const
     if (boxes->ballClear(centre, reach, linkSlack(q.enough, extent, tol))) return q.enough;
   }
   // One walk: each item near the link climbs its own ladder, asked only to prove the least bound so far
-  // (items certainly beyond it cannot lower it, and are not visited).
+  // (items certainly beyond it cannot lower it, and are not visited). The map's voxels are walked as their
+  // blocks: the same union (voxel_blocks.h), so the same bound, from a few boxes instead of many voxels.
   double lower = q.enough;
   BoundQuery item_q = q;
   std::optional<Item> nearest;
@@ -427,8 +457,34 @@ double Environment::lowerBound(const LinkGeometry& link, const Pose& pose, const
     if (hit) *hit = invalidMovingHit(t);
     return 0.0;
   }
-  if (hit && nearest) *hit = nearest->hit();
+  if (hit && nearest)
+    *hit = nearest->block < 0 ? nearest->hit() : nearestVoxel(link, pose, tol, q, nearest->block, lower);
   return lower >= 0.0 ? lower : 0.0;  // (NaN: 0)
+}
+
+EnvironmentHit Environment::nearestVoxel(const LinkGeometry& link, const Pose& pose, const Tolerances& tol,
+                                         const BoundQuery& q, int block, double bound) const noexcept {
+  const std::vector<Aabb>& voxels = map_->occupied;
+  const Aabb& box = blocks_->boxes()[static_cast<std::size_t>(block)];
+  int found = blocks_->voxelOf(block);
+  // Only a bound within the climbing distance is a contact a caller reports: there the block's voxels
+  // near the link (few, that near) are measured and the nearest named. Elsewhere any voxel of it will do.
+  if (q.climb < 0.0 ? bound < q.enough : bound <= q.climb) {
+    double best = q.enough;
+    BoundQuery voxel_q = q;
+    voxel_tree_->forEachWithin(link.bounds(), pose, best, [&](std::int32_t v) {
+      const Aabb& b = voxels[v];
+      if (!shares(box, b)) return false;
+      voxel_q.enough = best;
+      const Shape cell = Box(b.halfExtents());
+      const double d = BodyPair(link, cell).lowerBound(pose, Pose::translation(b.center()), tol, voxel_q);
+      if (!(d < best)) return false;
+      best = d;
+      found = v;
+      return !(best > 0.0);
+    });
+  }
+  return voxelHit(voxels, found);
 }
 
 double Environment::linkCast(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, const CastQuery& q,

@@ -758,8 +758,9 @@ TEST(Scene, TheLinkThatHitLastGoesFirstAndNoVerdictChanges) {
   std::printf("the lead changed the reported link on %d colliding states\n", changed);
 }
 
-// Which shortcut of the environment a verdict test compares: the clearance grid, or the obstacles' boxes.
-enum class Shortcut { Grid, Boxes };
+// Which shortcut of the environment a verdict test compares: the clearance grid, the obstacles' boxes, or
+// the map's voxels merged into blocks.
+enum class Shortcut { Grid, Boxes, Blocks };
 
 // The same states with one shortcut of the environment and without it: every verdict, and what each report
 // names, equal; one at a time and batched. Half the states are random, half walk near obstacles. The grid
@@ -771,8 +772,10 @@ void expectShortcutKeepsVerdicts(Shortcut shortcut, const std::shared_ptr<const 
   const auto with = shortcut == Shortcut::Grid
                         ? loaded->withEnvironment(std::make_shared<Environment>(env.withoutObstacleBoxes()))
                         : loaded;
-  const auto without = with->withEnvironment(std::make_shared<Environment>(
-      shortcut == Shortcut::Grid ? with->environment().withoutClearanceGrid() : env.withoutObstacleBoxes()));
+  const auto without = with->withEnvironment(
+      std::make_shared<Environment>(shortcut == Shortcut::Grid    ? with->environment().withoutClearanceGrid()
+                                    : shortcut == Shortcut::Boxes ? env.withoutObstacleBoxes()
+                                                                  : env.withoutVoxelBlocks()));
   with->environment().prepareClearanceGrid();
   without->environment().prepareClearanceGrid();
   if (shortcut == Shortcut::Grid) ASSERT_NE(with->environment().clearanceGrid(), nullptr) << what;
@@ -810,10 +813,13 @@ void expectShortcutKeepsVerdicts(Shortcut shortcut, const std::shared_ptr<const 
       EXPECT_EQ(b.counters().environment.grid_clears, 0) << where;
       EXPECT_GT(a.counters().environment.grid_clears, 0) << where << ": the grid cleared no link";
       clears += a.counters().environment.grid_clears;
-    } else {
+    } else if (shortcut == Shortcut::Boxes) {
       EXPECT_EQ(b.counters().environment.box_clears, 0) << where;
       if (has_boxes) EXPECT_GT(a.counters().environment.box_clears, 0) << where << ": the boxes cleared no link";
       clears += a.counters().environment.box_clears;
+    } else {  // (the tests the blocks saved: never more than the voxels need)
+      EXPECT_LE(a.counters().environment.voxel_tests, b.counters().environment.voxel_tests) << where;
+      clears += b.counters().environment.voxel_tests - a.counters().environment.voxel_tests;
     }
   }
 }
@@ -898,7 +904,8 @@ TEST(Scene, HullModeSelfPairsAreDecidedByTheHulls) {
 
 // A shortcut on arm6_wall and every shared family, in Mesh and Hull mode (where a link's hull, which its
 // parts' balls need not hold, decides). The grid in both forms; the boxes in the primitive form (a map's
-// voxels have none), on every SIMD target of the lanes in Mesh mode. Returns the links it cleared.
+// voxels have none), on every SIMD target of the lanes in Mesh mode; the blocks in the map's form (the
+// primitive one has no map), both modes. Returns the links it cleared (the blocks: the voxel tests saved).
 long long expectShortcutKeepsVerdicts(Shortcut shortcut, unsigned seed) {
   std::mt19937 rng(seed);
   long long clears = 0;
@@ -919,8 +926,12 @@ long long expectShortcutKeepsVerdicts(Shortcut shortcut, unsigned seed) {
         EXPECT_EQ(test::loadScene(stem + form)->environment().obstacleBoxes(), nullptr) << stem + form;
         continue;
       }
+      if (shortcut == Shortcut::Blocks && form == ".yaml") {
+        EXPECT_EQ(test::loadScene(stem + form)->environment().voxelBlocks(), nullptr) << stem + form;
+        continue;
+      }
       expectShortcutKeepsVerdicts(shortcut, test::loadScene(stem + form), stem + form, rng, clears, targets);
-      if (form == ".yaml")
+      if (form == ".yaml" || shortcut == Shortcut::Blocks)
         expectShortcutKeepsVerdicts(shortcut, test::loadScene(stem + form, hull), stem + form + " (hull)", rng, clears,
                                     {});
     }
@@ -938,6 +949,14 @@ TEST(Scene, TheObstacleBoxesChangeNoVerdict) {
   const long long clears = expectShortcutKeepsVerdicts(Shortcut::Boxes, 31);
   CLEARWAY_SHARED_SCENES_OR_SKIP();
   std::printf("the obstacles' boxes cleared %lld links\n", clears);
+}
+
+// (Our own maps are compared with their voxels in tests/environment/test_voxel_blocks.cpp.)
+TEST(Scene, TheVoxelBlocksChangeNoVerdict) {
+  CLEARWAY_SHARED_SCENES_OR_SKIP();
+  const long long saved = expectShortcutKeepsVerdicts(Shortcut::Blocks, 37);
+  EXPECT_GT(saved, 0) << "the blocks saved no voxel test: are they walked at all?";
+  std::printf("the voxel blocks saved %lld voxel tests\n", saved);
 }
 
 // Found by fuzz_scene_edits: a floating joint's quaternion of zeros passed validState (the tool's check

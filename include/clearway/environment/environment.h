@@ -29,6 +29,8 @@
 
 namespace clearway {
 
+class VoxelBlocks;
+
 /// How OctoMap cells that were never observed count.
 enum class UnknownSpace {
   Free,      ///< only occupied leaves are obstacles
@@ -110,6 +112,8 @@ class Environment {
   const std::vector<std::shared_ptr<const Obstacle>>& movingObstacles() const noexcept { return moving_; }
   /// The occupancy map, or null when there is none (valid while this environment or a copy lives).
   const OccupancyMap* map() const noexcept { return map_.get(); }
+  /// The map's voxels merged into blocks, as every query here walks them (voxel_blocks.h); null without voxels.
+  const VoxelBlocks* voxelBlocks() const noexcept { return blocks_.get(); }
   /// Voxels made occupied by withPoints (beyond the map's own).
   int pointVoxelCount() const noexcept { return point_voxels_; }
   /// True when nothing can be hit: no obstacle, no voxel of the map or of withPoints.
@@ -148,6 +152,9 @@ class Environment {
   /// This world, never with the obstacles' boxes, nor any world edited from it (for comparing verdicts and
   /// cost).
   Environment withoutObstacleBoxes() const;
+  /// This world with its map's voxels never merged into blocks (each voxel a block of its own: voxel_blocks.h),
+  /// nor in any world edited from it (for comparing verdicts and cost).
+  Environment withoutVoxelBlocks() const;
 
   /// This world with one obstacle more: O(log n). Throws std::invalid_argument for an empty name or one
   /// in use, or a non-finite pose or velocity.
@@ -189,8 +196,10 @@ class Environment {
   /// each item within reach of the link's oriented box climbing BodyPair::lowerBound's ladder (the balls,
   /// the hulls, the link's convex parts, the exact geometry; q as there), asked to prove only the least
   /// bound so far. at.warm, if given, holds staticCount() hull warm starts for this link, one per static
-  /// obstacle. at.hit (optional) names the item the bound came from when one came below q.enough. 0 for
-  /// non-finite input or a failed query.
+  /// obstacle. The map's voxels are walked merged into blocks (voxel_blocks.h: the same union). at.hit
+  /// (optional) names the item the bound came from when one came below q.enough; for the map, the block's
+  /// voxel nearest the link where the bound is within q.climb (q.climb < 0: below q.enough), elsewhere a
+  /// voxel of that block. 0 for non-finite input or a failed query.
   double lowerBound(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, const BoundQuery& q,
                     const EnvironmentQuery& at = {}) const noexcept;
   /// How many warm starts lowerBound takes: one slot per static obstacle (slots of removed obstacles
@@ -222,6 +231,10 @@ class Environment {
   Walk forEachItem(const Reach& reach, double t, F&& visit) const;
   // What a walk stopped by a moving obstacle out of reach of the doubles at time t reports: that obstacle.
   EnvironmentHit invalidMovingHit(double t) const noexcept;
+  // What lowerBound reports for a bound `bound` from map block `block`: the block's voxel nearest the link
+  // where the bound is within q.climb (a contact), else one of its voxels.
+  EnvironmentHit nearestVoxel(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, const BoundQuery& q,
+                              int block, double bound) const noexcept;
 
   // A static obstacle in the tree, with its warm-start slot; or a voxel made by withPoints: no obstacle,
   // slot −1, the item's box its cell (a cloud's million voxels, each a small node and nothing more).
@@ -255,6 +268,7 @@ class Environment {
   detail::PersistentMap<std::string, Named> names_;
   std::vector<std::shared_ptr<const Obstacle>> moving_;  // checked one by one: few by nature
   std::shared_ptr<const AabbTree> voxel_tree_;  // map_->occupied (null without voxels)
+  std::shared_ptr<const VoxelBlocks> blocks_;   // map_->occupied merged: every query walks these (null without voxels)
   std::shared_ptr<const FreeSlot> free_slots_;
   int slot_count_ = 0;
   std::size_t named_count_ = 0;
@@ -263,6 +277,7 @@ class Environment {
   double scale_ = 0.0;            // the largest |coordinate| of the trees' bounds (sizes the rounding band)
   std::shared_ptr<const ObstacleBoxes> boxes_;  // of this version's static items (null: too many, or none)
   bool without_boxes_ = false;                  // withoutObstacleBoxes, in edits too
+  bool without_blocks_ = false;                 // withoutVoxelBlocks, in edits too
 };
 
 }  // namespace clearway
