@@ -597,8 +597,7 @@ std::vector<SuiteCase> enumerateCases(const SuiteConfig& config) {
     if (!std::filesystem::is_directory(scenes)) throw std::runtime_error(need + ", and " + scenes + " is not a folder");
     for (const std::string& family : sceneFamilies(scenes))
       for (int k = 1; k <= config.problems; ++k)
-        for (const bool octomap : {false, true}) {  // (the verdicts suite takes both forms of a problem)
-          if (octomap && suite != "verdicts") continue;
+        for (const bool octomap : {false, true}) {  // (both forms of a problem: primitives, and the map)
           const std::string file = problemFile(scenes, family, k, octomap);
           if (!file.empty()) cases.push_back({suite, std::filesystem::path(file).stem().string(), file});
         }

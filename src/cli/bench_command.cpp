@@ -36,12 +36,13 @@ namespace fs = std::filesystem;
 const char* const kBenchHelp =
     "SUITE: narrowphase (GJK distance by tolerance, Clearway and FCL's two solvers), states (one state:\n"
     "exact meshes, convex hulls, FCL OBBRSS; mesh-batch: 64 states per call), verdicts (the same states through\n"
-    "every path to a verdict, both forms of each problem: one per call with and without the clearance grid,\n"
+    "every path to a verdict: one per call with and without the clearance grid,\n"
     "64 per call with the lanes forced to each SIMD target, judged against FCL; a state where they differ fails\n"
     "the case), motions (certified by contact distance, OMPL's sampling by\n"
     "resolution over Clearway and over FCL, against a dense reference), plan (RRTConnect with each\n"
     "checker: one OMPL benchmark log per problem in DIR/plan, the checkers as planners side by side for\n"
-    "Planner Arena), or all. Default: narrowphase states motions.\n"
+    "Planner Arena), or all. Default: narrowphase states motions. The scene suites take both forms of each\n"
+    "problem: its primitives (NAME_0001) and its OctoMap (NAME_0001.octomap, a family of its own: NAME.octomap).\n"
     "Writes DIR/results.csv; unsharded runs and merges also DIR/summary.csv, DIR/table.txt (printed; it\n"
     "ends with each problem family's state, motion and planning figures beside issue 20's targets),\n"
     "DIR/plots.gp and its PNG plots (when gnuplot is installed). --shard I/N runs the cases with index I\n"
@@ -139,8 +140,11 @@ std::string targets(const std::vector<BenchRow>& rows) {
   std::vector<std::pair<std::string, Family>> families;
   for (const BenchRow& r : rows) {
     if (r.suite != "states" && r.suite != "motions" && r.suite != "plan") continue;
+    // (bookshelf_small_panda_0001 and bookshelf_small_panda_0001.octomap: two families, by form.)
     const std::size_t cut = r.subject.find_last_of('_');
-    const std::string name = cut == std::string::npos ? r.subject : r.subject.substr(0, cut);
+    const bool map = r.subject.size() > 8 && r.subject.compare(r.subject.size() - 8, 8, ".octomap") == 0;
+    const std::string name =
+        (cut == std::string::npos ? r.subject : r.subject.substr(0, cut)) + (map ? ".octomap" : "");
     auto it = std::find_if(families.begin(), families.end(), [&](const auto& f) { return f.first == name; });
     if (it == families.end()) it = families.insert(families.end(), {name, Family{}});
     Family& f = it->second;
@@ -162,20 +166,22 @@ std::string targets(const std::vector<BenchRow>& rows) {
   const auto ratio = [](double theirs, double ours) { return theirs > 0 && ours > 0 ? fmt("%.1f", theirs / ours) : "-"; };
   std::ostringstream t;
   char line[256];
-  std::snprintf(line, sizeof line, "%-22s %10s %10s %8s %10s %10s %8s %8s\n", "family", "state ns", "batch ns", "FCL/x",
+  std::snprintf(line, sizeof line, "%-28s %10s %10s %8s %10s %10s %8s %8s\n", "family", "state ns", "batch ns", "FCL/x",
                 "motion us", "OMPL-FCL/x", "plan/x", "e2e/x");
   t << line;
   for (const auto& [name, f] : families) {
-    std::snprintf(line, sizeof line, "%-22s %10s %10s %8s %10s %10s %8s %8s\n", name.c_str(), per(f.one, f.one_n, 1).c_str(),
-                  per(f.batch, f.batch_n, 1).c_str(),
-                  ratio(f.fcl_state_n > 0 ? f.fcl_state / f.fcl_state_n : 0, f.one_n > 0 ? f.one / f.one_n : 0).c_str(),
-                  per(f.motion, f.motion_n, 1e3).c_str(),
-                  ratio(f.fcl_motion_n > 0 ? f.fcl_motion / f.fcl_motion_n : 0, f.motion_n > 0 ? f.motion / f.motion_n : 0).c_str(),
-                  ratio(f.fcl_plan, f.plan).c_str(), ratio(f.fcl_e2e, f.e2e).c_str());
+    std::snprintf(
+        line, sizeof line, "%-28s %10s %10s %8s %10s %10s %8s %8s\n", name.c_str(), per(f.one, f.one_n, 1).c_str(),
+        per(f.batch, f.batch_n, 1).c_str(),
+        ratio(f.fcl_state_n > 0 ? f.fcl_state / f.fcl_state_n : 0, f.one_n > 0 ? f.one / f.one_n : 0).c_str(),
+        per(f.motion, f.motion_n, 1e3).c_str(),
+        ratio(f.fcl_motion_n > 0 ? f.fcl_motion / f.fcl_motion_n : 0, f.motion_n > 0 ? f.motion / f.motion_n : 0)
+            .c_str(),
+        ratio(f.fcl_plan, f.plan).c_str(), ratio(f.fcl_e2e, f.e2e).c_str());
     t << line;
   }
-  std::snprintf(line, sizeof line, "%-22s %10s %10s %8s %10s %10s %8s %8s\n", "target (issue 20)", "500", "100", "30", "4",
-                "80", "10", "10");
+  std::snprintf(line, sizeof line, "%-28s %10s %10s %8s %10s %10s %8s %8s\n", "target (issue 20)", "500", "100", "30",
+                "4", "80", "10", "10");
   t << line;
   t << "state ns: the exact check, one state per call; batch ns: 64 per call; FCL/x: FCL OBBRSS's time per state over\n"
        "the one-per-call check's. motion us: certified at a 1 mm contact distance; OMPL-FCL/x: OMPL's 1% sampling\n"

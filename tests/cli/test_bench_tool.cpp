@@ -208,13 +208,13 @@ TEST(BenchTool, PlanningWritesOneOmplExperimentPerProblem) {
   const std::string dir = tempDir("plan");
   const ToolRun r = runTool("bench plan --subjects box_panda --plan-runs 2 --plan-time=20" + sharedArg() + " --out '" + dir + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  int logs = 0;
+  std::set<std::string> logs;  // one per form of the problem: its primitives and its OctoMap
   for (const auto& entry : fs::directory_iterator(dir + "/plan")) {
-    ++logs;
-    EXPECT_EQ(entry.path().filename().string(), "box_panda_0001.log");
+    const std::string name = entry.path().filename().string();
+    logs.insert(name);
     OmplLog log;
     ASSERT_NO_THROW(log = readOmplLog(entry.path().string()));
-    EXPECT_EQ(log.experiment["problem STRING"], "box_panda_0001");
+    EXPECT_EQ(log.experiment["problem STRING"] + ".log", name);
     // The checkers are the planners of the one experiment: Planner Arena plots them side by side.
     ASSERT_EQ(log.planners.size(), 3u);
     EXPECT_EQ(log.planners[0].name, "geometric_RRTConnect[certified]");  // (OMPL adds "geometric_")
@@ -235,25 +235,28 @@ TEST(BenchTool, PlanningWritesOneOmplExperimentPerProblem) {
       }
     }
   }
-  EXPECT_EQ(logs, 1);
+  EXPECT_EQ(logs, (std::set<std::string>{"box_panda_0001.log", "box_panda_0001.octomap.log"}));
   // The certified checker's paths re-check as free under the dense reference.
   std::ifstream in(dir + "/results.csv");
   int plan_rows = 0;
-  std::map<std::string, double> ns;  // engine/mode -> median ns
+  std::map<std::string, double> ns;  // subject/engine/mode -> median ns
   for (std::string line; std::getline(in, line);) {
     const std::vector<std::string> f = fields(line);
     if (f.size() != 14 || f[0] != "plan") continue;
     ++plan_rows;
     if (f[4] == "certified" || f[4] == "certified+simplify") {
-      EXPECT_EQ(f[9], "2") << "both runs solve box_panda within 20 s";
+      EXPECT_EQ(f[9], "2") << "both runs solve " << f[2] << " within 20 s";
       EXPECT_EQ(f[10], "0") << "a certified path collides";
     }
-    ns[f[3] + "/" + f[4]] = std::stod(f[7]);
+    ns[f[2] + "/" + f[3] + "/" + f[4]] = std::stod(f[7]);
   }
-  EXPECT_EQ(plan_rows, 6) << "per checker, the solve and the solve with simplifySolution";
+  EXPECT_EQ(plan_rows, 12) << "per form and checker, the solve and the solve with simplifySolution";
   // End to end takes the simplification too: longer than the solve alone, for every checker.
-  for (const char* k : {"clearway/certified", "clearway/sampled", "fcl/sampled"})
-    if (ns.count(k)) EXPECT_GT(ns[std::string(k) + "+simplify"], ns[k]) << k;
+  for (const char* subject : {"box_panda_0001/", "box_panda_0001.octomap/"})
+    for (const char* checker : {"clearway/certified", "clearway/sampled", "fcl/sampled"}) {
+      const std::string k = std::string(subject) + checker;
+      if (ns.count(k)) EXPECT_GT(ns[k + "+simplify"], ns[k]) << k;
+    }
   fs::remove_all(dir);
 }
 
@@ -295,11 +298,12 @@ TEST(BenchTool, TableShowsEachFamilyAgainstTheTargets) {
   const ToolRun r = runTool("bench states motions plan --subjects box_panda --count 10 --plan-runs 2 --plan-time=20" +
                             sharedArg() + " --out '" + dir + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  std::map<std::string, double> ns;  // suite/engine/mode/tolerance -> ns per item (one problem)
+  std::map<std::string, double> ns;  // subject/suite/engine/mode/tolerance -> ns per item
   std::ifstream in(dir + "/results.csv");
   for (std::string line; std::getline(in, line);) {
     const std::vector<std::string> f = fields(line);
-    if (f.size() == 14 && f[0] != "suite") ns[f[0] + "/" + f[3] + "/" + f[4] + "/" + f[5]] = std::stod(f[7]);
+    if (f.size() == 14 && f[0] != "suite")
+      ns[f[2] + "/" + f[0] + "/" + f[3] + "/" + f[4] + "/" + f[5]] = std::stod(f[7]);
     // Each certified motion's work is counted (steps), not answered from the validator's memory.
     if (f.size() == 14 && f[0] == "motions" && f[4] == "certified") EXPECT_GT(std::stod(f[8]), 0.0) << line;
   }
@@ -308,32 +312,40 @@ TEST(BenchTool, TableShowsEachFamilyAgainstTheTargets) {
     std::snprintf(b, sizeof b, format, x);
     return std::string(b);
   };
-  std::vector<std::string> expected = {
-      "box_panda",
-      fixed("%.0f", ns.at("states/clearway/mesh/0")),
-      fixed("%.0f", ns.at("states/clearway/mesh-batch/0")),
-      fixed("%.1f", ns.at("states/fcl/obbrss/0") / ns.at("states/clearway/mesh/0")),
-      fixed("%.0f", ns.at("motions/clearway/certified/0.001") / 1e3),
-      fixed("%.1f", ns.at("motions/fcl/sampled/0.01") / ns.at("motions/clearway/certified/0.001")),
-      fixed("%.1f", ns.at("plan/fcl/sampled/0.01") / ns.at("plan/clearway/certified/0.001")),
-      fixed("%.1f", ns.at("plan/fcl/sampled+simplify/0.01") / ns.at("plan/clearway/certified+simplify/0.001"))};
+  // (Both forms of the problem: box_panda's primitives and box_panda.octomap, a family of its own.)
+  std::map<std::string, std::vector<std::string>> expected;
+  for (const std::string family : {"box_panda", "box_panda.octomap"}) {
+    const std::string subject = family == "box_panda" ? "box_panda_0001/" : "box_panda_0001.octomap/";
+    const auto at = [&](const std::string& key) { return ns.at(subject + key); };
+    expected[family] = {
+        family,
+        fixed("%.0f", at("states/clearway/mesh/0")),
+        fixed("%.0f", at("states/clearway/mesh-batch/0")),
+        fixed("%.1f", at("states/fcl/obbrss/0") / at("states/clearway/mesh/0")),
+        fixed("%.0f", at("motions/clearway/certified/0.001") / 1e3),
+        fixed("%.1f", at("motions/fcl/sampled/0.01") / at("motions/clearway/certified/0.001")),
+        fixed("%.1f", at("plan/fcl/sampled/0.01") / at("plan/clearway/certified/0.001")),
+        fixed("%.1f", at("plan/fcl/sampled+simplify/0.01") / at("plan/clearway/certified+simplify/0.001"))};
+  }
   std::ifstream table(dir + "/table.txt");
-  bool header = false, family = false, target = false;
+  bool header = false, target = false;
+  std::set<std::string> families;
   for (std::string line; std::getline(table, line);) {
     std::istringstream words(line);
     std::vector<std::string> w;
     for (std::string x; words >> x;) w.push_back(x);
     if (line.rfind("family ", 0) == 0) header = true;
-    if (header && !w.empty() && w[0] == "box_panda") {
-      family = true;
-      EXPECT_EQ(w, expected) << line;
+    if (header && !w.empty() && expected.count(w[0])) {
+      families.insert(w[0]);
+      EXPECT_EQ(w, expected[w[0]]) << line;
     }
     if (header && line.rfind("target (issue 20)", 0) == 0) {
       target = true;
       EXPECT_EQ(w, (std::vector<std::string>{"target", "(issue", "20)", "500", "100", "30", "4", "80", "10", "10"}));
     }
   }
-  EXPECT_TRUE(header && family && target) << "table.txt lacks the targets block";
+  EXPECT_EQ(families.size(), 2u) << "a row per form of the problem";
+  EXPECT_TRUE(header && target) << "table.txt lacks the targets block";
   EXPECT_MENTIONS(r.out, "target (issue 20)");
   fs::remove_all(dir);
 }

@@ -41,7 +41,7 @@ TEST(BenchWithoutFcl, StatesVerdictsAndMotionsMeasureClearwayAlone) {
   config.subjects = {"box_panda"};
   config.count = 10;
   const std::vector<bench::SuiteCase> cases = bench::enumerateCases(config);
-  ASSERT_EQ(cases.size(), 4u);  // (verdicts: both forms of the problem)
+  ASSERT_EQ(cases.size(), 6u);  // (each suite: both forms of the problem)
   for (const bench::SuiteCase& c : cases) {
     std::vector<bench::SuiteRow> rows;
     bench::runCase(c, config, rows);
