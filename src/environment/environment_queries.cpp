@@ -187,6 +187,24 @@ Environment::Walk Environment::forEachItem(const Reach& reach, double t, F&& vis
              : Walk::Done;
 }
 
+bool Environment::ballClear(const Vec3& center, double radius, double slack) const noexcept {
+  if (!moving_.empty()) return false;
+  if (const ObstacleBoxes* boxes = obstacleBoxes()) return boxes->ballClear(center, radius, slack);
+  const double reach = (radius + slack) * (1.0 + margins::kRounding);
+  if (!center.allFinite() || !(reach >= 0.0) || !(reach < INFINITY)) return false;
+  // A box within reach: the squared distance from the centre to it (each axis's gap, rounded by a few ulps
+  // of the coordinates, which the band in `slack` exceeds many times over) at most reach².
+  const auto near = [&](const Aabb& b) {
+    const Vec3 gap = (b.min - center).cwiseMax(center - b.max).cwiseMax(0.0);
+    return !(gap.squaredNorm() > reach * reach);
+  };
+  const Aabb box = Aabb::fromCenterHalf(center, Vec3::Constant(reach));
+  if (static_.query(box, [&](const Static&, const Aabb& b) { return near(b); })) return false;
+  if (!blocks_) return true;
+  const std::vector<Aabb>& blocks = blocks_->boxes();
+  return !blocks_->tree().query(box, [&](std::int32_t b) { return near(blocks[static_cast<std::size_t>(b)]); });
+}
+
 EnvironmentHit Environment::invalidMovingHit(double t) const noexcept {
   EnvironmentHit h;
   h.kind = EnvironmentHit::Kind::Obstacle;
@@ -426,7 +444,8 @@ double Environment::lowerBound(const LinkGeometry& link, const Pose& pose, const
   // (No clearance grid here: it exists only once enough queries were asked, and a bound it settled could
   // differ from the GJKs' within their relative error, so a segment's verdict would depend on history.)
   // The obstacles' boxes exist from the start: a link whose bounding ball they clear by q.enough (and the
-  // band) is that far from every item, which is all that is asked; no walk, no GJK.
+  // band) is that far from every item, which is all that is asked; no walk, no GJK. (Not ballClear's walk
+  // where there are none: the walk below starts the same way.)
   if (const ObstacleBoxes* boxes = obstacleBoxes(); boxes && std::isfinite(q.enough)) {
     const Vec3 centre = pose * link.sphereCenter();
     const double reach = ballReach(link, pose);
@@ -470,7 +489,9 @@ EnvironmentHit Environment::nearestVoxel(const LinkGeometry& link, const Pose& p
   // Only a bound within the climbing distance is a contact a caller reports: there the block's voxels
   // near the link (few, that near) are measured and the nearest named. Elsewhere any voxel of it will do.
   if (q.climb < 0.0 ? bound < q.enough : bound <= q.climb) {
-    double best = q.enough;
+    // (The block's nearest voxel is as near as the block: within its bound's relative error, which the
+    // doubling holds with room to spare; the walk then meets only the voxels that near.)
+    double best = std::min(q.enough, 2.0 * bound * (1.0 + q.relative) + margins::kRounding * (1.0 + scale_));
     BoundQuery voxel_q = q;
     voxel_tree_->forEachWithin(link.bounds(), pose, best, [&](std::int32_t v) {
       const Aabb& b = voxels[v];

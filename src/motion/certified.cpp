@@ -541,7 +541,8 @@ struct MotionChecker::Sweep {
     return b_in_a.isFinite() && boxesApart(*it.ga, *it.gb, b_in_a, mc.scene_->options().tolerances, reach);
   }
   // Whether item k's bounding balls at s settle the piece s ± half: apart (for the environment: clear of the
-  // obstacles' boxes) by more than padding + contact + B·half; else, unless `last` (no halves follow), whether
+  // obstacles' and the map's boxes, Environment::ballClear) by more than padding + contact + B·half; else,
+  // unless `last` (no halves follow), whether
   // they are by more than padding + contact (the piece's halves may be), or near.
   Raked rakeTest(int k, double s, double half, bool last, bool loose_tried = false) {
     const Item& it = mc.items_[k];
@@ -575,12 +576,12 @@ struct MotionChecker::Sweep {
     }
     const double motion = boundOf(k) * half;
     if (!(motion < INFINITY)) return Raked::Near;
-    const ObstacleBoxes* boxes = sc.environment().obstacleBoxes();
-    if (!boxes || ctx.obstacle_motion > 0.0) return Raked::Near;
+    const Environment& env = sc.environment();
+    if (ctx.obstacle_motion > 0.0) return Raked::Near;
     const double grown = (a.radius + motion) * margins::kBeyond;
-    const double slack = sc.environment().linkSlack(contact, a.center.cwiseAbs().maxCoeff() + grown, tol);
-    if (boxes->ballClear(a.center, grown, slack)) return Raked::Settled;
-    return !last && boxes->ballClear(a.center, a.radius, slack) ? Raked::Halve : Raked::Near;
+    const double slack = env.linkSlack(contact, a.center.cwiseAbs().maxCoeff() + grown, tol);
+    if (env.ballClear(a.center, grown, slack)) return Raked::Settled;
+    return !last && env.ballClear(a.center, a.radius, slack) ? Raked::Halve : Raked::Near;
   }
 
   // rakeTest's first test, by the bodies' own motions, of every self item at once in SIMD lanes, at the piece

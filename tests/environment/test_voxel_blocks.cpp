@@ -306,5 +306,53 @@ TEST(VoxelBlocks, QueriesAgreeWithEveryVoxel) {
   std::printf("%d hits, %d misses, %d bounds within contact\n", hits, misses, near);
 }
 
+// Environment::ballClear where there are no obstacle boxes (a map; more obstacles than ObstacleBoxes keeps)
+// walks the trees: a ball it calls clear is farther than the slack from everything, by the exact distance
+// (Environment::linkDistance of a sphere link); and it clears balls in the open, not near the walls. Seen
+// failing with the blocks' gap taken from their centres.
+TEST(VoxelBlocks, BallClearWalksTheTreesAndIsCertified) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * unit(rng); };
+  const double res = 0.05;
+  std::vector<Obstacle> obstacles;
+  for (int i = 0; i < ObstacleBoxes::kMaxBoxes + 16; ++i) {
+    Obstacle o;
+    o.name = "o" + std::to_string(i);
+    if (i % 2)
+      o.shape = Sphere(uniform(0.01, 0.05));
+    else
+      o.shape = Box(Vec3(uniform(0.01, 0.05), uniform(0.01, 0.05), uniform(0.01, 0.05)));
+    o.pose.R = Eigen::Quaterniond(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1), uniform(-1, 1))
+                   .normalized()
+                   .toRotationMatrix();
+    o.pose.t = Vec3(uniform(-1.6, 1.6), uniform(-1.6, 1.6), uniform(-1.6, 1.6));
+    obstacles.push_back(o);
+  }
+  const Environment env(obstacles, mapOf(octreeLikeVoxels(rng, res, {-24, -24, -24}), res));
+  ASSERT_EQ(env.obstacleBoxes(), nullptr);
+  int clear = 0, not_clear = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const Vec3 c(uniform(-1.8, 1.8), uniform(-1.8, 1.8), uniform(-1.8, 1.8));
+    const double r = uniform(0.0, 0.3), slack = trial % 3 == 0 ? 0.0 : uniform(0.0, 0.05);
+    if (!env.ballClear(c, r, slack)) {
+      ++not_clear;
+      continue;
+    }
+    ++clear;
+    CollisionElement e;
+    e.primitive = Sphere(r);
+    const LinkGeometry ball(std::vector<CollisionElement>{e}, std::vector<TriangleMesh>{});
+    const DistanceResult d = env.linkDistance(ball, Pose::translation(c), kTol);
+    ASSERT_GT(d.distance, slack) << "trial " << trial << ": a ball called clear is within the slack";
+  }
+  EXPECT_GT(clear, 500);
+  EXPECT_GT(not_clear, 500);
+  EXPECT_FALSE(env.ballClear(Vec3(NAN, 0, 0), 0.1, 0.0));
+  EXPECT_FALSE(env.ballClear(Vec3(9, 9, 9), INFINITY, 0.0));
+  EXPECT_FALSE(env.ballClear(Vec3(9, 9, 9), 0.1, NAN));
+  EXPECT_TRUE(env.ballClear(Vec3(9, 9, 9), 0.1, 0.0));
+}
+
 }  // namespace
 }  // namespace clearway

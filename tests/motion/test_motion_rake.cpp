@@ -111,7 +111,8 @@ TEST(MotionRake, KeepsEveryVerdictInCastMode) {
 TEST(MotionRake, KeepsEveryVerdictOnTheSharedRobots) {
   CLEARWAY_SHARED_OR_SKIP(shared, "scenes");
   for (const char* name : {"box_panda/box_panda_0001.yaml", "bookshelf_small_panda/bookshelf_small_panda_0001.yaml",
-                           "cage_ur5/cage_ur5_0001.yaml", "box_ur5/box_ur5_0001.octomap.yaml"}) {
+                           "cage_ur5/cage_ur5_0001.yaml", "box_ur5/box_ur5_0001.octomap.yaml",
+                           "bookshelf_small_panda/bookshelf_small_panda_0001.octomap.yaml"}) {
     SCOPED_TRACE(name);
     const RakeRun run = compareRake(test::loadScene(shared + "/" + name), 37, 300);
     std::printf("%s: %d segments, %d collide; distances measured %ld with the rake, %ld without\n", name, run.segments,

@@ -152,6 +152,11 @@ class Environment {
   /// This world, never with the obstacles' boxes, nor any world edited from it (for comparing verdicts and
   /// cost).
   Environment withoutObstacleBoxes() const;
+  /// True when the ball (world frame) is more than `slack` (beyond rounding) from every obstacle and voxel,
+  /// by their boxes: the obstacleBoxes() when there are, else the trees' boxes near the ball (an obstacle's
+  /// world box, the map's blocks). False proves nothing; so for a NaN or infinite input, and while an
+  /// obstacle moves. As for linkIntersects' culls, `slack` should hold the narrow phase's band (linkSlack).
+  bool ballClear(const Vec3& center, double radius, double slack) const noexcept;
   /// This world with its map's voxels never merged into blocks (each voxel a block of its own: voxel_blocks.h),
   /// nor in any world edited from it (for comparing verdicts and cost).
   Environment withoutVoxelBlocks() const;
