@@ -187,9 +187,8 @@ Environment::Walk Environment::forEachItem(const Reach& reach, double t, F&& vis
              : Walk::Done;
 }
 
-bool Environment::ballClear(const Vec3& center, double radius, double slack) const noexcept {
+bool Environment::ballClearByTrees(const Vec3& center, double radius, double slack) const noexcept {
   if (!moving_.empty()) return false;
-  if (const ObstacleBoxes* boxes = obstacleBoxes()) return boxes->ballClear(center, radius, slack);
   const double reach = (radius + slack) * (1.0 + margins::kRounding);
   if (!center.allFinite() || !(reach >= 0.0) || !(reach < INFINITY)) return false;
   // A box within reach: the squared distance from the centre to it (each axis's gap, rounded by a few ulps

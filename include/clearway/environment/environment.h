@@ -156,7 +156,10 @@ class Environment {
   /// by their boxes: the obstacleBoxes() when there are, else the trees' boxes near the ball (an obstacle's
   /// world box, the map's blocks). False proves nothing; so for a NaN or infinite input, and while an
   /// obstacle moves. As for linkIntersects' culls, `slack` should hold the narrow phase's band (linkSlack).
-  bool ballClear(const Vec3& center, double radius, double slack) const noexcept;
+  bool ballClear(const Vec3& center, double radius, double slack) const noexcept {
+    if (const ObstacleBoxes* boxes = obstacleBoxes()) return boxes->ballClear(center, radius, slack);
+    return ballClearByTrees(center, radius, slack);
+  }
   /// This world with its map's voxels never merged into blocks (each voxel a block of its own: voxel_blocks.h),
   /// nor in any world edited from it (for comparing verdicts and cost).
   Environment withoutVoxelBlocks() const;
@@ -236,6 +239,8 @@ class Environment {
   Walk forEachItem(const Reach& reach, double t, F&& visit) const;
   // What a walk stopped by a moving obstacle out of reach of the doubles at time t reports: that obstacle.
   EnvironmentHit invalidMovingHit(double t) const noexcept;
+  // ballClear without the obstacles' boxes (out of line: the boxes' callers pay nothing for it).
+  bool ballClearByTrees(const Vec3& center, double radius, double slack) const noexcept;
   // What lowerBound reports for a bound `bound` from map block `block`: the block's voxel nearest the link
   // where the bound is within q.climb (a contact), else one of its voxels.
   EnvironmentHit nearestVoxel(const LinkGeometry& link, const Pose& pose, const Tolerances& tol, const BoundQuery& q,
