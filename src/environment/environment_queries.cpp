@@ -147,7 +147,7 @@ struct Environment::Item {
     const Shape box = Box(voxel->halfExtents());
     return f(BodyPair(link, box, warm));
   }
-  // What a hit on it reports (a block's: Environment::blockHit).
+  // What a hit on it reports (a block names none of its voxels: the query that found it looks one up).
   EnvironmentHit hit() const noexcept {
     EnvironmentHit h;
     h.kind = kind;
