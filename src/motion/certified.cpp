@@ -542,8 +542,8 @@ struct MotionChecker::Sweep {
   }
   // Whether item k's bounding balls at s settle the piece s ± half: apart (for the environment: clear of the
   // obstacles' and the map's boxes, Environment::ballClear) by more than padding + contact + B·half; else,
-  // unless `last` (no halves follow), whether
-  // they are by more than padding + contact (the piece's halves may be), or near.
+  // unless `last` (no halves follow), whether they are by more than padding + contact (the piece's halves
+  // may be), or near.
   Raked rakeTest(int k, double s, double half, bool last, bool loose_tried = false) {
     const Item& it = mc.items_[k];
     const Scene& sc = *mc.scene_;
