@@ -1,7 +1,10 @@
 // Outer balls (outer_balls.h), built on a grid in the link frame:
 //  1. cells: every triangle is cut into pieces no longer than a step, and the cells of their corners
 //     and centres are the surface; the cells no path of unmarked cells joins to the grid's rim are the
-//     inside (a closed mesh's solid);
+//     inside (a closed mesh's solid). The cover is first sought for the surface's items alone (balls deep
+//     enough to reach the surface from within mostly hold the inside too, which the proof of step 4
+//     checks), and only where that proof fails for the inside's cubes as well (which cost the Panda's links
+//     more than half their build time);
 //  2. a distance transform gives each cell its depth (to the nearest unmarked cell);
 //  3. greedy set cover: a candidate ball at a cell reaches its depth plus half a step; the items it holds
 //     whole (a piece's three corners, an inside cube's eight, a surface cell's corner inside the solid)
@@ -117,9 +120,9 @@ void groupBalls(std::vector<LinkGeometry::Ball>& balls, std::vector<OuterBalls::
   balls = std::move(sorted);
 }
 
-}  // namespace
-
-OuterBalls buildOuterBalls(const LinkGeometry& link, const OuterBallOptions& options) {
+// The balls of buildOuterBalls, covering the items of the surface and, when `inside_items`, of the inside
+// cells too; empty when the inside is not proven held.
+OuterBalls coverLink(const LinkGeometry& link, const OuterBallOptions& options, bool inside_items) {
   OuterBalls out;
   const std::vector<Triangle>& triangles = link.triangles();
   if (triangles.empty() || !link.primitives().empty() || !(options.step > 0.0) || options.max_cells < 27) return out;
@@ -212,6 +215,7 @@ OuterBalls buildOuterBalls(const LinkGeometry& link, const OuterBallOptions& opt
           const int c = grid.index(x, y, z);
           if (mark[c] == kEmpty && outside[c]) continue;
           if (mark[c] == kEmpty) mark[c] = kInside;
+          if (mark[c] == kInside && !inside_items) continue;  // (it still counts for the depth)
           if (mark[c] == kInside) items.push_back({c, static_cast<int>(points.size())});
           for (int k = 0; k < 8; ++k) {
             const int X = x + (k & 1), Y = y + ((k >> 1) & 1), Z = z + ((k >> 2) & 1);
@@ -223,7 +227,7 @@ OuterBalls buildOuterBalls(const LinkGeometry& link, const OuterBallOptions& opt
   }
   const int item_count = static_cast<int>(items.size());
   items.push_back({-1, static_cast<int>(points.size())});  // (the end of the last item)
-  // The items of cell c: order[first[c]], ..., order[first[c + 1] − 1].
+  // The items of cell c: order[first[c]], ..., order[first[c + 1] − 1] (then renumbered first[c], ...).
   std::vector<int> first(n + 1, 0), order(item_count);
   for (int i = 0; i < item_count; ++i) ++first[items[i].first + 1];
   std::partial_sum(first.begin(), first.end(), first.begin());
@@ -231,8 +235,24 @@ OuterBalls buildOuterBalls(const LinkGeometry& link, const OuterBallOptions& opt
     std::vector<int> at(first.begin(), first.end() - 1);
     for (int i = 0; i < item_count; ++i) order[at[items[i].first]++] = i;
   }
+  {  // Items and their points renumbered in cell order: a cell's items lie together in memory.
+    std::vector<std::pair<int, int>> by_cell;
+    std::vector<std::pair<int, Vec3>> cell_points;
+    by_cell.reserve(items.size());
+    cell_points.reserve(points.size());
+    for (int k = 0; k < item_count; ++k) {
+      const int i = order[k];
+      by_cell.push_back({items[i].first, static_cast<int>(cell_points.size())});
+      cell_points.insert(cell_points.end(), points.begin() + items[i].second, points.begin() + items[i + 1].second);
+    }
+    by_cell.push_back({-1, static_cast<int>(cell_points.size())});
+    items.swap(by_cell);
+    points.swap(cell_points);
+  }
   std::vector<double> reach(n, 0.0);  // how far a cell's points lie from its centre
   for (const auto& [c, p] : points) reach[c] = std::max(reach[c], (p - grid.center(c)).norm());
+  // (A cell whose centre lies farther than a ball's radius and this from its centre holds none of its items.)
+  const double max_reach = *std::max_element(reach.begin(), reach.end());
 
   // 2. Depth: the squared distance, in steps, from each marked cell to the nearest unmarked one.
   std::vector<double> depth(n);
@@ -274,62 +294,73 @@ OuterBalls buildOuterBalls(const LinkGeometry& link, const OuterBallOptions& opt
       }
   std::vector<std::uint8_t> held(item_count, 0);  // per item: a chosen ball holds it
   std::vector<int> open(n);                       // per cell: how many of its items no ball holds yet
-  for (int c = 0; c < n; ++c) open[c] = first[c + 1] - first[c];
+  std::vector<int> row_open(static_cast<std::size_t>(grid.ny) * grid.nz, 0);  // per row of cells along x
+  for (int c = 0; c < n; ++c) {
+    open[c] = first[c + 1] - first[c];
+    row_open[c / grid.nx] += open[c];
+  }
   const double slack = 0.5 * step;
   const auto radiusAt = [&](int c) { return std::sqrt(depth[c]) * step + slack; };
+  // Calls f(y, z, xa, xb) for each row of cells whose centres [xa, xb] may lie within `within` (metres) of
+  // cell c's centre: the ball's cube cut to its rows' chords (in cells, rounded outwards).
+  const auto forRows = [&](int c, double within, auto&& f) {
+    const auto [x0, y0, z0] = grid.coordinates(c);
+    const double w = within / step;
+    const int span = static_cast<int>(std::ceil(w)) + 1;
+    for (int z = std::max(0, z0 - span); z <= std::min(grid.nz - 1, z0 + span); ++z)
+      for (int y = std::max(0, y0 - span); y <= std::min(grid.ny - 1, y0 + span); ++y) {
+        const double dy = y - y0, dz = z - z0, chord = w * w - dy * dy - dz * dz;
+        if (chord < 0.0) continue;
+        const int half = static_cast<int>(std::sqrt(chord)) + 1;
+        f(y, z, std::max(0, x0 - half), std::min(grid.nx - 1, x0 + half));
+      }
+  };
   // The items a candidate would newly hold (into `take` when given): whole cells where the cell's reach
   // settles it, else item by item.
   const auto gain = [&](int c, std::vector<int>* take) {
     const Vec3 o = grid.center(c);
     const double r = radiusAt(c);
-    const int span = static_cast<int>(std::ceil(r / step)) + 1;
-    const auto [x0, y0, z0] = grid.coordinates(c);
     int count = 0;
-    for (int z = std::max(0, z0 - span); z <= std::min(grid.nz - 1, z0 + span); ++z)
-      for (int y = std::max(0, y0 - span); y <= std::min(grid.ny - 1, y0 + span); ++y)
-        for (int x = std::max(0, x0 - span); x <= std::min(grid.nx - 1, x0 + span); ++x) {
-          const int e = grid.index(x, y, z);
-          if (open[e] == 0) continue;
-          const double d = (grid.center(e) - o).norm();
-          if (d - reach[e] > r) continue;
-          const bool whole = d + reach[e] <= r;
-          for (int k = first[e]; k < first[e + 1]; ++k) {
-            const int i = order[k];
-            if (held[i]) continue;
-            bool in = whole;
-            if (!in) {
-              in = true;
-              for (int p = items[i].second; p < items[i + 1].second && in; ++p)
-                in = (points[p].second - o).squaredNorm() <= r * r;
-            }
-            if (!in) continue;
-            ++count;
-            if (take) take->push_back(i);
+    forRows(c, r + max_reach, [&](int y, int z, int xa, int xb) {
+      if (row_open[z * grid.ny + y] == 0) return;
+      for (int x = xa; x <= xb; ++x) {
+        const int e = grid.index(x, y, z);
+        if (open[e] == 0) continue;
+        const double d = (grid.center(e) - o).norm();
+        if (d - reach[e] > r) continue;
+        const bool whole = d + reach[e] <= r;
+        for (int i = first[e]; i < first[e + 1]; ++i) {  // (items are numbered in cell order)
+          if (held[i]) continue;
+          bool in = whole;
+          if (!in) {
+            in = true;
+            for (int p = items[i].second; p < items[i + 1].second && in; ++p)
+              in = (points[p].second - o).squaredNorm() <= r * r;
           }
+          if (!in) continue;
+          ++count;
+          if (take) take->push_back(i);
         }
+      }
+    });
     return count;
   };
-  // Lazy greedy: a candidate's key bounds its gain from above, at first the items in its cube of cells
-  // (a summed-volume table), later its gain when last counted (gains only fall as items are held).
-  const int sx = grid.nx + 1, sy = grid.ny + 1;
-  std::vector<int> sum(static_cast<std::size_t>(sx) * sy * (grid.nz + 1), 0);
-  const auto at = [&](int x, int y, int z) -> int& { return sum[(static_cast<std::size_t>(z) * sy + y) * sx + x]; };
-  for (int z = 0; z < grid.nz; ++z)
-    for (int y = 0; y < grid.ny; ++y)
-      for (int x = 0; x < grid.nx; ++x) {
-        const int c = grid.index(x, y, z);
-        at(x + 1, y + 1, z + 1) = first[c + 1] - first[c] + at(x, y + 1, z + 1) + at(x + 1, y, z + 1) +
-                                  at(x + 1, y + 1, z) - at(x, y, z + 1) - at(x, y + 1, z) - at(x + 1, y, z) +
-                                  at(x, y, z);
-      }
+  // Lazy greedy: a candidate's key bounds its gain from above, at first the items of the cells its ball
+  // may reach (prefix sums along each row), later its gain when last counted (gains only fall as items are
+  // held).
+  const std::size_t row_length = static_cast<std::size_t>(grid.nx) + 1;
+  std::vector<int> row_sum(row_length * grid.ny * grid.nz, 0);  // items of a row's first x cells
+  for (int c = 0; c < n; ++c) {
+    const std::size_t at = static_cast<std::size_t>(c / grid.nx) * row_length + c % grid.nx;
+    row_sum[at + 1] = row_sum[at] + first[c + 1] - first[c];
+  }
   const auto bound = [&](int c) {
-    const int span = static_cast<int>(std::ceil(radiusAt(c) / step)) + 1;
-    const auto [x0, y0, z0] = grid.coordinates(c);
-    const int xa = std::max(0, x0 - span), xb = std::min(grid.nx, x0 + span + 1);
-    const int ya = std::max(0, y0 - span), yb = std::min(grid.ny, y0 + span + 1);
-    const int za = std::max(0, z0 - span), zb = std::min(grid.nz, z0 + span + 1);
-    return at(xb, yb, zb) - at(xa, yb, zb) - at(xb, ya, zb) - at(xb, yb, za) + at(xa, ya, zb) + at(xa, yb, za) +
-           at(xb, ya, za) - at(xa, ya, za);
+    int total = 0;
+    forRows(c, radiusAt(c) + max_reach, [&](int y, int z, int xa, int xb) {
+      const std::size_t row = static_cast<std::size_t>(z * grid.ny + y) * row_length;
+      total += row_sum[row + xb + 1] - row_sum[row + xa];
+    });
+    return total;
   };
   std::priority_queue<std::pair<int, int>> queue;  // (key, cell)
   for (int c : candidates) queue.push({bound(c), c});
@@ -373,6 +404,7 @@ OuterBalls buildOuterBalls(const LinkGeometry& link, const OuterBallOptions& opt
     for (int i : taken) {
       held[i] = 1;
       --open[items[i].first];
+      --row_open[items[i].first / grid.nx];
     }
     chosen.push_back({grid.center(c), taken});
   }
@@ -393,13 +425,24 @@ OuterBalls buildOuterBalls(const LinkGeometry& link, const OuterBallOptions& opt
   const double margin = kMarginFraction * link.sphereRadius();
   for (int grown = 0;; ++grown) {
     if (link.ballsHoldSolids(out.balls, margin)) break;
-    if (grown == 4) return OuterBalls{};
+    // (A cover of the surface alone grows none: the cover with the inside is tighter than one grown.)
+    if (grown == (inside_items ? 4 : 0)) return OuterBalls{};
     for (LinkGeometry::Ball& b : out.balls) b.radius += 0.25 * step;
   }
   for (LinkGeometry::Ball& b : out.balls) b.radius += margin;
   out.cell = step;
   groupBalls(out.balls, out.groups, size);
   return out;
+}
+
+}  // namespace
+
+OuterBalls buildOuterBalls(const LinkGeometry& link, const OuterBallOptions& options) {
+  if (link.solidCount() > 0) {
+    OuterBalls surface = coverLink(link, options, false);
+    if (surface.proven()) return surface;
+  }
+  return coverLink(link, options, true);
 }
 
 }  // namespace clearway
