@@ -499,9 +499,10 @@ DistanceResult meshDistance(const LinkGeometry& a, const Pose& pose_a, const Lin
   bool stop = false;
   if (!ta.empty() && !tb.empty()) {
     // Box gaps are loose for distance (a triangle's box, turned, reaches far beyond it), so a triangle
-    // pair passing them is first projected on two axes, each gap a lower bound on its distance: the
-    // line through the centroids (tight for small triangles far apart) and the normal of the best pair
-    // so far (tight for surfaces facing each other). GJK runs only when neither reaches the cutoff.
+    // pair passing them is first projected on four axes, each gap a lower bound on its distance: the
+    // line through the centroids (tight for small triangles far apart), the normal of the best pair
+    // so far (tight for surfaces facing each other) and each triangle's own normal (tight for a corner
+    // over a face: fine meshes near a surface). GJK runs only when none reaches the cutoff.
     const double rounding = margins::kRounding * (a.boundingRadius() + b.boundingRadius() + b_in_a.t.norm());
     stop = forEachPairWithin(a.tree(), b.tree(), b_in_a, m.cutoff, [&](std::int32_t i, std::int32_t j) {
       if (m.cutoff < std::numeric_limits<double>::infinity()) {
@@ -511,6 +512,10 @@ DistanceResult meshDistance(const LinkGeometry& a, const Pose& pose_a, const Lin
         const double len = u.norm();
         if (len > 0.0 && projectedGap(va, vb, u / len) - rounding >= m.cutoff) return false;
         if (projectedGap(va, vb, m.best.normal) - rounding >= m.cutoff) return false;
+        for (const Vec3& n : {(va[1] - va[0]).cross(va[2] - va[0]), (vb[1] - vb[0]).cross(vb[2] - vb[0])}) {
+          const double nn = n.norm();
+          if (nn > 0.0 && projectedGap(va, vb, n / nn) - rounding >= m.cutoff) return false;
+        }
       }
       return m.add(gjkDistance(ta[i], Pose::identity(), tb[j], b_in_a, tol));
     });
