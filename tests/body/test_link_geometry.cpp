@@ -551,5 +551,49 @@ TEST(LinkGeometry, DistanceMatchesBruteForce) {
   EXPECT_GT(positive, 20);
 }
 
+// A fine mesh within millimetres of a coarse one (large triangles askew, whose boxes hold many of the fine
+// mesh's), where the search prunes by triangles' planes as well as boxes: with a relative error and a
+// cutoff, never above the brute-force distance for its bound, never more than the relative error above it
+// for its distance, in both orders (each side's leaves bound the other's boxes).
+TEST(LinkGeometry, DistanceNearFineMeshesMatchesBruteForce) {
+  const TriangleMesh fine = tree_ref::uvSphere(0.05, 40, 80);                      // 6,320 triangles
+  const TriangleMesh plate = tree_ref::gridBox(Vec3(0.2, 0.12, 0.03), 1);          // 12 large ones
+  const TriangleMesh ring = tree_ref::torus(0.09, 0.025, 24, 12);
+  const std::vector<std::pair<std::string, TriangleMesh>> meshes{{"plate", plate}, {"fine", fine}, {"ring", ring}};
+  std::mt19937_64 rng(41);
+  const Tolerances tol;
+  constexpr double kRelative = 0.1, kCutoff = 0.003;
+  int near = 0, cases = 0;
+  for (const auto& [i, j] : std::vector<std::pair<int, int>>{{0, 1}, {1, 0}, {2, 1}, {1, 2}}) {
+    const LinkGeometry ga(meshes[i].second), gb(meshes[j].second);
+    const double reach = 1.2 * (tree_ref::meshRadius(meshes[i].second) + tree_ref::meshRadius(meshes[j].second));
+    for (int c = 0; c < 14; ++c) {
+      const Pose pa = randomPoseNear(rng, 0.2);
+      Pose pb = randomPoseNear(rng, reach);
+      pb.t += pa.t;
+      // Moved along the normal of closest approach to 0 … 2.5 mm (the reference judges where it lands).
+      const DistanceResult first = meshDistance(ga, pa, gb, pb, tol, 0.2);
+      if (!(first.distance > 0.0)) continue;
+      pb.t -= (first.distance - std::uniform_real_distribution<double>(0.0, 0.0025)(rng)) * first.normal;
+      const double ref = tree_ref::meshDistance(tree_ref::place(meshes[i].second, pa), tree_ref::place(meshes[j].second, pb));
+      const DistanceResult d = meshDistance(ga, pa, gb, pb, tol, kRelative, kCutoff);
+      const std::string what = meshes[i].first + " vs " + meshes[j].first + " case " + std::to_string(c) +
+                               ": reference " + std::to_string(ref);
+      ++cases;
+      ASSERT_FALSE(isFailure(d.status)) << what;
+      EXPECT_LE(d.lower_bound, ref + kBand) << what;
+      if (ref < kCutoff) {
+        ++near;
+        EXPECT_GE(d.distance, ref - kBand) << what;
+        EXPECT_LE(d.distance, (1.0 + kRelative) * ref + kBand) << what;
+      } else {
+        EXPECT_GE(d.distance, kCutoff - kBand) << what;
+      }
+    }
+  }
+  EXPECT_GE(cases, 40);
+  EXPECT_GE(near, 30) << cases;
+}
+
 }  // namespace
 }  // namespace clearway
