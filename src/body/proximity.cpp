@@ -465,88 +465,36 @@ double projectedGap(const Vec3 a[3], const Vec3 b[3], const Vec3& u) noexcept {
   return std::max(std::min({b0, b1, b2}) - std::max({a0, a1, a2}), std::min({a0, a1, a2}) - std::max({b0, b1, b2}));
 }
 
-// forEachPairWithin (tree/aabb_tree.h) over two meshes' triangles, with one more bound on a pair of nodes
-// one of which is a leaf: the distance from its triangles' planes to the other's box. A large triangle's box,
-// askew, holds many boxes of a fine mesh that its plane keeps beyond the cutoff. `slack` covers the rounding
-// of a plane's gap (as of meshDistance's projected gaps). Stops, returning true, when on_pair(i, j) does.
-template <class F>
-bool trianglePairsWithin(const LinkGeometry& a, const LinkGeometry& b, const Pose& b_in_a, double slack, double& cutoff,
-                         F&& on_pair) {
-  using Node = AabbTree::Node;
-  using detail::OrientedBoxTest;
-  const AabbTree& ta = a.tree();
-  const AabbTree& tb = b.tree();
-  if (ta.empty() || tb.empty()) return false;
-  const OrientedBoxTest test(b_in_a, 0.0, detail::treePairScale(ta.bounds(), tb.bounds(), b_in_a));
-  const std::vector<Node>& na = ta.nodes();
-  const std::vector<Node>& nb = tb.nodes();
-  // The least distance from the planes of a leaf's triangles (in A's frame) to a box given as centre c and
-  // half widths h along axes `axes` (A's frame; columns); -∞ when a triangle is degenerate. It stops once
-  // at most `floor` (a bound already known).
-  const auto planesGap = [&](const Node& leaf, const AabbTree& tree, const std::vector<Triangle>& tris,
-                             const Pose& to_a, const Vec3& c, const Vec3& h, const Mat3& axes, double floor) {
+// A lower bound on the distance between the triangles below node ia of A's tree and node ib of B's, at
+// least `gap` (their boxes'): where one is a leaf, the least distance from its triangles' planes to the
+// other's box. A large triangle's box, askew, holds many boxes of a fine mesh that its plane keeps away.
+// `slack` covers the rounding of a plane's gap (as of meshDistance's projected gaps).
+double leafPlanesGap(const LinkGeometry& a, const LinkGeometry& b, const Pose& b_in_a, double slack, std::int32_t ia,
+                     std::int32_t ib, double gap) noexcept {
+  const AabbTree::Node& x = a.tree().nodes()[ia];
+  const AabbTree::Node& y = b.tree().nodes()[ib];
+  // The least distance from the planes of a leaf's triangles (placed in A's frame by to_a) to a box of
+  // centre c and half widths h along the columns of `axes` (A's frame); it stops once at most `gap`, and
+  // a degenerate triangle gives no bound.
+  const auto planes = [&](const AabbTree::Node& leaf, const LinkGeometry& g, const Pose& to_a, const Vec3& c,
+                          const Vec3& h, const Mat3& axes) {
     double least = std::numeric_limits<double>::infinity();
-    for (std::int32_t s = leaf.first; s < leaf.first + leaf.count && least > floor; ++s) {
-      const Triangle& t = tris[tree.items()[s]];
-      const Vec3 p0 = to_a * t.v[0];
+    for (std::int32_t s = leaf.first; s < leaf.first + leaf.count && least > gap; ++s) {
+      const Triangle& t = g.triangles()[g.tree().items()[s]];
       const Vec3 n = to_a.R * (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]);
       const double len = n.norm();
-      if (!(len > 0.0) || !std::isfinite(len)) return -std::numeric_limits<double>::infinity();
+      if (!(len > 0.0) || !std::isfinite(len)) return gap;
       const Vec3 u = n / len;
-      least = std::min(least, std::abs(u.dot(c - p0)) - (axes.transpose() * u).cwiseAbs().dot(h) - slack);
+      least = std::min(least, std::abs(u.dot(c - to_a * t.v[0])) - (axes.transpose() * u).cwiseAbs().dot(h) - slack);
     }
-    return least;
+    return std::max(gap, least);
   };
-  const Mat3 identity = Mat3::Identity();
-  // A pair's gap: the boxes', then, where it is within the cutoff and a node is a leaf, its planes'.
-  const auto gap = [&](std::int32_t ia, std::int32_t ib) {
-    const Node& x = na[ia];
-    const Node& y = nb[ib];
-    double g = test.gap(x.box, y.box);
-    if (!(g <= cutoff) || (!x.isLeaf() && !y.isLeaf())) return g;
-    if (x.isLeaf()) {  // B's box in A's frame
-      const Vec3 c = b_in_a * (0.5 * (y.box.min + y.box.max));
-      g = std::max(g, planesGap(x, ta, a.triangles(), Pose::identity(), c, 0.5 * (y.box.max - y.box.min), b_in_a.R, g));
-    }
-    if (y.isLeaf() && g <= cutoff)
-      g = std::max(g, planesGap(y, tb, b.triangles(), b_in_a, 0.5 * (x.box.min + x.box.max),
-                                0.5 * (x.box.max - x.box.min), identity, g));
-    return g;
-  };
-  struct Entry {
-    std::int32_t a, b;
-    double gap;
-  };
-  Entry stack[2 * AabbTree::kMaxDepth + 1];
-  int top = 0;
-  stack[top++] = {0, 0, gap(0, 0)};
-  while (top > 0) {
-    const Entry e = stack[--top];
-    if (!(e.gap <= cutoff)) continue;
-    const Node& x = na[e.a];
-    const Node& y = nb[e.b];
-    if (x.isLeaf() && y.isLeaf()) {  // (each pair's own projected gaps follow in on_pair)
-      for (std::int32_t sa = x.first; sa < x.first + x.count; ++sa)
-        for (std::int32_t sb = y.first; sb < y.first + y.count; ++sb)
-          if ((x.count * y.count == 1 || test.gap(ta.slotBoxes()[sa], tb.slotBoxes()[sb]) <= cutoff) &&
-              detail::callbackStops(on_pair, ta.items()[sa], tb.items()[sb]))
-            return true;
-      continue;
-    }
-    const bool unfold_a = !x.isLeaf() && (y.isLeaf() || detail::boxSize(x.box) >= detail::boxSize(y.box));
-    Entry c0, c1;
-    if (unfold_a) {
-      c0 = {x.first, e.b, gap(x.first, e.b)};
-      c1 = {x.first + 1, e.b, gap(x.first + 1, e.b)};
-    } else {
-      c0 = {e.a, y.first, gap(e.a, y.first)};
-      c1 = {e.a, y.first + 1, gap(e.a, y.first + 1)};
-    }
-    if (c0.gap > c1.gap) std::swap(c0, c1);
-    stack[top++] = c1;  // the nearer pair on top
-    stack[top++] = c0;
-  }
-  return false;
+  if (x.isLeaf())  // B's box placed in A
+    gap = planes(x, a, Pose::identity(), b_in_a * (0.5 * (y.box.min + y.box.max)), 0.5 * (y.box.max - y.box.min),
+                 b_in_a.R);
+  if (y.isLeaf())
+    gap = planes(y, b, b_in_a, 0.5 * (x.box.min + x.box.max), 0.5 * (x.box.max - x.box.min), Mat3::Identity());
+  return gap;
 }
 
 template <class S>
@@ -588,7 +536,10 @@ DistanceResult meshDistance(const LinkGeometry& a, const Pose& pose_a, const Lin
     // so far (tight for surfaces facing each other) and each triangle's own normal (tight for a corner
     // over a face: fine meshes near a surface). GJK runs only when none reaches the cutoff.
     const double rounding = margins::kRounding * (a.boundingRadius() + b.boundingRadius() + b_in_a.t.norm());
-    stop = trianglePairsWithin(a, b, b_in_a, rounding, m.cutoff, [&](std::int32_t i, std::int32_t j) {
+    const auto planes = [&](std::int32_t ia, std::int32_t ib, double gap) {
+      return leafPlanesGap(a, b, b_in_a, rounding, ia, ib, gap);
+    };
+    stop = forEachPairWithinBy(a.tree(), b.tree(), b_in_a, m.cutoff, planes, [&](std::int32_t i, std::int32_t j) {
       if (m.cutoff < std::numeric_limits<double>::infinity()) {
         const Vec3* va = ta[i].v;
         const Vec3 vb[3] = {b_in_a * tb[j].v[0], b_in_a * tb[j].v[1], b_in_a * tb[j].v[2]};

@@ -498,6 +498,40 @@ TEST(AabbTree, PairsWithinACutoffAndTheNearestPair) {
         for (int i = 0; i < 100; ++i)
           for (int j = 0; j < 100; ++j)
             if (dist(i, j) <= 0.2 - kBand) ASSERT_TRUE(found.count({i, j})) << "case " << c;
+        // The caller's bound: here the exact least distance below the two nodes (points, by brute force),
+        // so that the pairs visited are exactly those within the cutoff, and none of the others' subtrees.
+        std::vector<std::vector<int>> below_a(ta.nodes().size()), below_b(tb.nodes().size());
+        const auto collect = [](const AabbTree& t, std::vector<std::vector<int>>& below) {
+          for (int n = static_cast<int>(t.nodes().size()) - 1; n >= 0; --n) {
+            const AabbTree::Node& node = t.nodes()[n];
+            if (node.isLeaf())
+              for (int s = node.first; s < node.first + node.count; ++s) below[n].push_back(t.items()[s]);
+            else
+              for (int k = 0; k < 2; ++k)
+                below[n].insert(below[n].end(), below[node.first + k].begin(), below[node.first + k].end());
+          }
+        };
+        collect(ta, below_a);
+        collect(tb, below_b);
+        int asked = 0;
+        const auto exact = [&](std::int32_t na, std::int32_t nb, double gap) {
+          ++asked;
+          double least = tree_ref::kInf;
+          for (int i : below_a[na])
+            for (int j : below_b[nb]) least = std::min(least, dist(i, j));
+          EXPECT_LE(gap, least + 1e-12) << "the boxes' gap exceeds the distance";
+          return std::max(gap, least);
+        };
+        double bounded = 0.2;
+        std::set<std::pair<int, int>> bounded_found;
+        forEachPairWithinBy(ta, tb, b_in_a, bounded, exact, [&](int i, int j) { bounded_found.insert({i, j}); });
+        if (best <= 0.2) EXPECT_GT(asked, 0) << "case " << c;
+        for (int i = 0; i < 100; ++i)
+          for (int j = 0; j < 100; ++j) {
+            if (dist(i, j) <= 0.2 - kBand) ASSERT_TRUE(bounded_found.count({i, j})) << "case " << c;
+            // (A leaf of several items is visited whole when its nearest pair is within the cutoff.)
+            if (leaf == 1 && dist(i, j) > 0.2 + kBand) ASSERT_FALSE(bounded_found.count({i, j})) << "case " << c;
+          }
       }
 }
 

@@ -352,24 +352,29 @@ bool forEachOverlapDeeperFirst(const AabbTree& a, const AabbTree& b, const Pose&
   return detail::OverlapDescent<kFullSat, F>(a, b, b_in_a, margin, on_pair).template descend<true>();
 }
 
-/// Calls on_pair(item_a, item_b) for pairs of items whose oriented boxes may be within `cutoff` metres
-/// (the largest gap along the 6 face normals, a lower bound on the box distance, is ≤ cutoff), nearer
-/// pairs of subtrees first. on_pair may lower cutoff (read again before each pair of subtrees) and may
-/// return true to stop. Every item pair whose boxes are within the final cutoff is visited.
-template <class F>
-bool forEachPairWithin(const AabbTree& a, const AabbTree& b, const Pose& b_in_a, double& cutoff, F&& on_pair) {
+/// forEachPairWithin with the caller's own lower bound on the distance of what two nodes hold:
+/// bound(node_a, node_b, gap), asked for the pairs whose boxes' gap is within the cutoff, answers at
+/// least that gap (a pair goes on while it is within the cutoff). Every item pair that neither the boxes
+/// nor the bound keep beyond the final cutoff is visited.
+template <class B, class F>
+bool forEachPairWithinBy(const AabbTree& a, const AabbTree& b, const Pose& b_in_a, double& cutoff, B&& bound,
+                         F&& on_pair) {
   using Node = AabbTree::Node;
   if (a.empty() || b.empty()) return false;
   const detail::OrientedBoxTest test(b_in_a, 0.0, detail::treePairScale(a.bounds(), b.bounds(), b_in_a));
   const std::vector<Node>& na = a.nodes();
   const std::vector<Node>& nb = b.nodes();
+  const auto gap = [&](std::int32_t ia, std::int32_t ib) {
+    const double g = test.gap(na[ia].box, nb[ib].box);
+    return g <= cutoff ? bound(ia, ib, g) : g;
+  };
   struct Entry {
     std::int32_t a, b;
     double gap;
   };
   Entry stack[2 * AabbTree::kMaxDepth + 1];
   int top = 0;
-  stack[top++] = {0, 0, test.gap(na[0].box, nb[0].box)};
+  stack[top++] = {0, 0, gap(0, 0)};
   while (top > 0) {
     const Entry e = stack[--top];
     if (!(e.gap <= cutoff)) continue;
@@ -386,17 +391,27 @@ bool forEachPairWithin(const AabbTree& a, const AabbTree& b, const Pose& b_in_a,
     const bool unfold_a = !x.isLeaf() && (y.isLeaf() || detail::boxSize(x.box) >= detail::boxSize(y.box));
     Entry c0, c1;
     if (unfold_a) {
-      c0 = {x.first, e.b, test.gap(na[x.first].box, y.box)};
-      c1 = {x.first + 1, e.b, test.gap(na[x.first + 1].box, y.box)};
+      c0 = {x.first, e.b, gap(x.first, e.b)};
+      c1 = {x.first + 1, e.b, gap(x.first + 1, e.b)};
     } else {
-      c0 = {e.a, y.first, test.gap(x.box, nb[y.first].box)};
-      c1 = {e.a, y.first + 1, test.gap(x.box, nb[y.first + 1].box)};
+      c0 = {e.a, y.first, gap(e.a, y.first)};
+      c1 = {e.a, y.first + 1, gap(e.a, y.first + 1)};
     }
     if (c0.gap > c1.gap) std::swap(c0, c1);
     stack[top++] = c1;  // the nearer pair on top
     stack[top++] = c0;
   }
   return false;
+}
+
+/// Calls on_pair(item_a, item_b) for pairs of items whose oriented boxes may be within `cutoff` metres
+/// (the largest gap along the 6 face normals, a lower bound on the box distance, is ≤ cutoff), nearer
+/// pairs of subtrees first. on_pair may lower cutoff (read again before each pair of subtrees) and may
+/// return true to stop. Every item pair whose boxes are within the final cutoff is visited.
+template <class F>
+bool forEachPairWithin(const AabbTree& a, const AabbTree& b, const Pose& b_in_a, double& cutoff, F&& on_pair) {
+  return forEachPairWithinBy(
+      a, b, b_in_a, cutoff, [](std::int32_t, std::int32_t, double gap) { return gap; }, on_pair);
 }
 
 }  // namespace clearway
