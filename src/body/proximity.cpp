@@ -294,13 +294,11 @@ bool partsScreen(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& 
   return shapesIntersect(a.shape, a.pose, b.shape, b_in_a * b.pose, tol, padding);
 }
 
-// screenMeshes, the convex parts' rung only when `parts`.
-Screen screenRungs(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
-                   const Tolerances& tol, GeometryMode mode, double padding, SimplexCache* hull_cache,
-                   bool parts) noexcept {
+// screenMeshes' cheap rungs, a few operations each: bounding spheres, the boxes of the hulls as oriented
+// boxes (6 face axes), the cores. Unsure where the hulls must decide.
+Screen cheapRungs(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                  const Tolerances& tol, double padding) noexcept {
   if (!pose_a.isFinite() || !pose_b.isFinite() || !validPadding(padding)) return Screen::Touching;
-  // Conservative filters from cheapest to dearest: bounding spheres, the boxes of the hulls as oriented
-  // boxes (6 face axes), the cores, the hulls (GJK), the convex parts.
   if (spheresApart(pose_a * a.sphereCenter(), a.sphereRadius(), pose_b * b.sphereCenter(), b.sphereRadius(), padding,
                    tol))
     return Screen::Apart;
@@ -311,11 +309,23 @@ Screen screenRungs(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry
   // into another), and before the triangle search; so does a core of one link inside a primitive of the
   // other (a solid, whose own distance is exact). A pair they leave pays about 1,100 more.
   if (coresOverlap(a, b, b_in_a) || coreInPrimitive(a, b, b_in_a)) return Screen::Touching;
+  return Screen::Unsure;
+}
+
+// The rungs after cheapRungs (for a pair it left Unsure): the primitives' or the hulls' GJK, then the convex
+// parts when `parts`.
+Screen dearRungs(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                 const Tolerances& tol, GeometryMode mode, double padding, SimplexCache* hull_cache,
+                 bool parts) noexcept {
+  if (!pose_a.isFinite() || !pose_b.isFinite() || !validPadding(padding)) return Screen::Touching;
   // Two links of one primitive each are those primitives (convex solids): their own GJK decides, as the
   // exact test would, where the hulls' (circumscribed polytopes: 82 vertices for a capsule) only screens.
   const LinkGeometry::Primitive* sole_a = mode == GeometryMode::Mesh ? a.solePrimitive() : nullptr;
   const LinkGeometry::Primitive* sole_b = sole_a ? b.solePrimitive() : nullptr;
-  if (sole_b) return primitivesIntersect(*sole_a, *sole_b, b_in_a, tol, padding) ? Screen::Touching : Screen::Apart;
+  if (sole_b) {
+    const Pose b_in_a = relativePose(pose_a, pose_b);
+    return primitivesIntersect(*sole_a, *sole_b, b_in_a, tol, padding) ? Screen::Touching : Screen::Apart;
+  }
   SimplexCache scratch;
   SimplexCache& cache = hull_cache ? *hull_cache : scratch;
   const IntersectResult hulls = gjkIntersect(Margin<ConvexHull>{a.hull(), padding}, pose_a, b.hull(), pose_b, tol, cache);
@@ -323,8 +333,17 @@ Screen screenRungs(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry
   if (mode == GeometryMode::Hull) return Screen::Touching;
   // A pair the parts clear skips the triangle search, which costs tens of thousands of operations near a
   // mesh of a thousand triangles.
-  if (parts && partsScreen(a, pose_a, b, pose_b, tol, padding, b_in_a.t.norm(), nullptr)) return Screen::Apart;
+  if (parts && partsScreen(a, pose_a, b, pose_b, tol, padding, relativePose(pose_a, pose_b).t.norm(), nullptr))
+    return Screen::Apart;
   return Screen::Unsure;
+}
+
+// screenMeshes, the convex parts' rung only when `parts`: cheapRungs, then dearRungs.
+Screen screenRungs(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
+                   const Tolerances& tol, GeometryMode mode, double padding, SimplexCache* hull_cache,
+                   bool parts) noexcept {
+  const Screen cheap = cheapRungs(a, pose_a, b, pose_b, tol, padding);
+  return cheap != Screen::Unsure ? cheap : dearRungs(a, pose_a, b, pose_b, tol, mode, padding, hull_cache, parts);
 }
 }  // namespace
 
@@ -663,12 +682,24 @@ void BodyPair::forget() noexcept {
 }
 
 Screen BodyPair::screen(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, const IntersectQuery& q) noexcept {
+  const Screen cheap = screenCheap(pose_a, pose_b, tol, q);
+  return cheap != Screen::Unsure ? cheap : screenDear(pose_a, pose_b, tol, q);
+}
+
+Screen BodyPair::screenCheap(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol,
+                             const IntersectQuery& q) noexcept {
+  if (shape_) return Screen::Unsure;  // (a shape's rungs are shapeIntersectsLink's: screenDear's)
+  return cheapRungs(*a_, pose_a, *b_, pose_b, tol, q.padding);
+}
+
+Screen BodyPair::screenDear(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol,
+                            const IntersectQuery& q) noexcept {
   if (shape_) {  // (one convex piece: the hull-mode test screens, the exact one decides)
     if (!shapeIntersectsLink(*shape_, pose_b, *a_, pose_a, tol, GeometryMode::Hull, q.padding, &hullCache()))
       return Screen::Apart;
     return q.mode == GeometryMode::Hull ? Screen::Touching : Screen::Unsure;
   }
-  return screenRungs(*a_, pose_a, *b_, pose_b, tol, q.mode, q.padding, &hullCache(), false);
+  return dearRungs(*a_, pose_a, *b_, pose_b, tol, q.mode, q.padding, &hullCache(), false);
 }
 
 bool BodyPair::intersectsExactly(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol,

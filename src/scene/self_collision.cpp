@@ -17,7 +17,8 @@ namespace scene_detail {
 struct SelfScratch {
   std::vector<BodyPair> bodies;            // per checked pair: its two links' geometry and warm starts
   EnclosingBalls balls;                    // the links' enclosing balls at the current query's poses
-  std::vector<int> unsure;                 // pairs the cheap rungs left to the triangles (scratch of one query)
+  std::vector<int> dear;                   // pairs the cheap rungs left to the hulls (scratch of one query)
+  std::vector<int> unsure;                 // pairs the hulls left to the triangles (scratch of one query)
   std::vector<std::uint8_t> table_free;    // per pair: its table called it Free at this query's q
   std::vector<std::uint8_t> bounds_apart;  // per pair: its bounding balls apart at this query's poses
   std::vector<std::pair<int, TrianglePair>> witnesses;  // pairs whose unsure cell has a witness, at this q
@@ -116,6 +117,7 @@ SelfCollisionContext SelfCollision::makeContext() const {
   c.bodies.reserve(pairs_.size());
   for (const LinkPair& p : pairs_) c.bodies.emplace_back(*geometry_->link(p.a), *geometry_->link(p.b));
   c.balls = EnclosingBalls(*geometry_);
+  c.dear.reserve(pairs_.size());
   c.unsure.reserve(pairs_.size());
   c.table_free.assign(pairs_.size(), 0);
   c.bounds_apart.assign(pairs_.size() + BoundsRows::kSpare, 0);  // (the lanes' spare bytes past the last pair)
@@ -147,14 +149,30 @@ bool SelfCollision::pairHits(int k, const Pose* poses, SelfScratch& ctx, Enclosi
 }
 
 Screen SelfCollision::pairScreen(int k, const Pose* poses, SelfScratch& ctx, EnclosingBalls* balls) const noexcept {
+  const Screen cheap = pairScreenCheap(k, poses, ctx, balls);
+  return cheap != Screen::Unsure ? cheap : pairScreenDear(k, poses, ctx);
+}
+
+Screen SelfCollision::pairScreenCheap(int k, const Pose* poses, SelfScratch& ctx,
+                                      EnclosingBalls* balls) const noexcept {
   const LinkPair& p = pairs_[k];
   ++ctx.pair_tests;
   if (balls && balls->apart(p.a, p.b, pair_padding_[k], options_.tolerances)) return Screen::Apart;
   const IntersectQuery q{pair_padding_[k], options_.mode};
   // (A context of another checker of the robot, whose pair k is another pair, asks a fresh pair.)
   if (ctx.owner == serial_ && k < static_cast<int>(ctx.bodies.size()))
-    return ctx.bodies[k].screen(poses[p.a], poses[p.b], options_.tolerances, q);
-  return BodyPair(*geometry_->link(p.a), *geometry_->link(p.b)).screen(poses[p.a], poses[p.b], options_.tolerances, q);
+    return ctx.bodies[k].screenCheap(poses[p.a], poses[p.b], options_.tolerances, q);
+  return BodyPair(*geometry_->link(p.a), *geometry_->link(p.b))
+      .screenCheap(poses[p.a], poses[p.b], options_.tolerances, q);
+}
+
+Screen SelfCollision::pairScreenDear(int k, const Pose* poses, SelfScratch& ctx) const noexcept {
+  const LinkPair& p = pairs_[k];
+  const IntersectQuery q{pair_padding_[k], options_.mode};
+  if (ctx.owner == serial_ && k < static_cast<int>(ctx.bodies.size()))  // (as in pairScreenCheap)
+    return ctx.bodies[k].screenDear(poses[p.a], poses[p.b], options_.tolerances, q);
+  return BodyPair(*geometry_->link(p.a), *geometry_->link(p.b))
+      .screenDear(poses[p.a], poses[p.b], options_.tolerances, q);
 }
 
 bool SelfCollision::pairExactly(int k, const Pose* poses, SelfScratch& ctx) const noexcept {
@@ -213,16 +231,18 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
   if (ctx.last_hit >= 0 && ctx.last_hit < n && !tableFree(ctx.last_hit) &&
       pairHits(ctx.last_hit, poses, ctx, balls))
     return &pairs_[ctx.last_hit];
-  // Two passes: the cheap rungs for every pair first, so that a collision they settle (overlapping cores)
-  // ends the query before any pair's triangle search; then the triangles of the pairs they left unsure.
-  const bool two_pass = static_cast<int>(ctx.unsure.capacity()) >= n;  // (else pushing would allocate)
-  if (two_pass) ctx.unsure.clear();
-  // Pair k after the look-ups and the balls: true when it collides (pass one: unless left unsure).
+  // Three passes, each rung for every pair before the next: the cheap rungs (overlapping cores settle most
+  // collisions), then the hulls' GJK of the pairs they left, then the triangles of the pairs the hulls left
+  // unsure. A collision an earlier pass settles costs none of the later passes' work on other pairs.
+  // (Without room for every pair, pushing would allocate: each pair in full then.)
+  const bool passes = static_cast<int>(std::min(ctx.unsure.capacity(), ctx.dear.capacity())) >= n;
+  if (passes) ctx.unsure.clear(), ctx.dear.clear();
+  // Pair k after the look-ups and the balls: true when it collides (pass one: unless left to the hulls).
   const auto screened = [&](int k) {
     if (free_table_[k] && tableFree(k)) return false;
-    if (!two_pass) return pairHits(k, poses, ctx, balls);
-    const Screen s = pairScreen(k, poses, ctx, balls);
-    if (s == Screen::Unsure) ctx.unsure.push_back(k);
+    if (!passes) return pairHits(k, poses, ctx, balls);
+    const Screen s = pairScreenCheap(k, poses, ctx, balls);
+    if (s == Screen::Unsure) ctx.dear.push_back(k);
     return s == Screen::Touching;
   };
   bool visited = false;
@@ -268,9 +288,15 @@ const LinkPair* SelfCollision::firstCollision(const Pose* poses, SelfCollisionCo
     }
     if (screened(k)) return hit(k, ctx);
   }
-  if (two_pass)
+  if (passes) {
+    for (int k : ctx.dear) {
+      const Screen s = pairScreenDear(k, poses, ctx);
+      if (s == Screen::Touching) return hit(k, ctx);
+      if (s == Screen::Unsure) ctx.unsure.push_back(k);
+    }
     for (int k : ctx.unsure)
       if (pairExactly(k, poses, ctx)) return hit(k, ctx);
+  }
   ctx.last_hit = -1;
   return nullptr;
 }

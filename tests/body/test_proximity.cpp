@@ -147,16 +147,18 @@ TEST(BodyPair, LadderBoundsTheBruteForceDistance) {
 
 // The screen and the exact rung together answer as intersects() does, in both modes and with padding; the
 // screen settles some pairs each way and leaves some to the triangles (else the split would test nothing).
+// The screen's two halves answer as the screen: the cheap rungs settle some pairs each way (the cores prove
+// contacts) and leave some to the hulls, whose half settles some each way.
 TEST(BodyPair, ScreenThenTrianglesAnswerAsIntersects) {
   const std::vector<Named> m = meshes();
   std::vector<LinkGeometry> g;
   for (const Named& n : m) g.emplace_back(n.mesh);
   const Tolerances tol;
   std::mt19937_64 rng(17);
-  int counts[3] = {0, 0, 0};
+  int counts[3] = {0, 0, 0}, cheap_counts[3] = {0, 0, 0}, dear_counts[3] = {0, 0, 0};
   for (std::size_t i = 0; i < m.size(); ++i)
     for (std::size_t j = i; j < m.size(); ++j) {
-      BodyPair split(g[i], g[j]), whole(g[i], g[j]);
+      BodyPair split(g[i], g[j]), whole(g[i], g[j]), halves(g[i], g[j]);
       const double reach = 0.9 * (tree_ref::meshRadius(m[i].mesh) + tree_ref::meshRadius(m[j].mesh));
       for (int c = 0; c < 60; ++c) {
         const Pose pa = randomPose(rng, 0.1);
@@ -166,6 +168,13 @@ TEST(BodyPair, ScreenThenTrianglesAnswerAsIntersects) {
           const IntersectQuery q{c % 4 == 0 ? 0.01 : 0.0, mode};
           const Screen s = split.screen(pa, pb, tol, q);
           if (mode == GeometryMode::Mesh) ++counts[static_cast<int>(s)];
+          const Screen cheap = halves.screenCheap(pa, pb, tol, q);
+          const Screen dear = cheap == Screen::Unsure ? halves.screenDear(pa, pb, tol, q) : cheap;
+          EXPECT_EQ(dear, s) << m[i].name << " vs " << m[j].name << " case " << c;
+          if (mode == GeometryMode::Mesh) {
+            ++cheap_counts[static_cast<int>(cheap)];
+            if (cheap == Screen::Unsure) ++dear_counts[static_cast<int>(dear)];
+          }
           if (mode == GeometryMode::Hull) EXPECT_NE(s, Screen::Unsure);
           const bool answer = s == Screen::Unsure ? split.intersectsExactly(pa, pb, tol, q.padding) : s == Screen::Touching;
           EXPECT_EQ(answer, whole.intersects(pa, pb, tol, q)) << m[i].name << " vs " << m[j].name << " case " << c;
@@ -173,9 +182,13 @@ TEST(BodyPair, ScreenThenTrianglesAnswerAsIntersects) {
       }
     }
   std::printf("  Mesh mode: %d apart, %d touching, %d left to the triangles by the screen\n", counts[0], counts[1], counts[2]);
+  std::printf("  its cheap half: %d apart, %d touching, %d left to the hulls; the hulls' half: %d apart, %d touching\n",
+              cheap_counts[0], cheap_counts[1], cheap_counts[2], dear_counts[0], dear_counts[1]);
   EXPECT_GT(counts[0], 0);
   EXPECT_GT(counts[1], 0);
   EXPECT_GT(counts[2], 0);
+  for (int k = 0; k < 3; ++k) EXPECT_GT(cheap_counts[k], 0) << "the cheap half, verdict " << k;
+  EXPECT_GT(dear_counts[0], 0);
 }
 
 // A fine mesh (past 4096 triangles) whose hull and cores leave a pair unsettled is screened by its convex

@@ -196,6 +196,14 @@ class BodyPair {
   /// intersects() split in two: its cheap rungs (screenMeshes' short of the convex parts, warm), then, for
   /// an Unsure pair, intersectsExactly(). Together they answer as intersects() does.
   Screen screen(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, const IntersectQuery& q) noexcept;
+  ///@{
+  /// screen() in two halves, for a caller that screens many pairs and stops at the first contact: the rungs
+  /// of a few operations each (bounding spheres, the hulls' boxes, the cores), then, for a pair they leave
+  /// Unsure, the hulls' (or the primitives') GJK. A contact the cores prove in any pair then costs no GJK of
+  /// the pairs before it. Together they answer as screen() does.
+  Screen screenCheap(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, const IntersectQuery& q) noexcept;
+  Screen screenDear(const Pose& pose_a, const Pose& pose_b, const Tolerances& tol, const IntersectQuery& q) noexcept;
+  ///@}
   /// The dear rungs: the convex parts (warm: the part pair too near last time is tried first), then the
   /// triangles (meshesIntersectExactly). Left for the pairs screen() leaves Unsure, so that a query that
   /// ends on another pair's contact never pays them.

@@ -129,6 +129,11 @@ class SelfCollision {
   // pairHits in two halves: the enclosing balls and the pair's cheap rungs, then (for Unsure) the convex parts
   // and the triangles (BodyPair::intersectsExactly).
   Screen pairScreen(int k, const Pose* link_poses, scene_detail::SelfScratch& s, EnclosingBalls* balls) const noexcept;
+  // pairScreen in two halves: the enclosing balls and the pair's rungs of a few operations, then (for Unsure)
+  // the hulls' GJK (BodyPair::screenCheap, screenDear).
+  Screen pairScreenCheap(int k, const Pose* link_poses, scene_detail::SelfScratch& s,
+                         EnclosingBalls* balls) const noexcept;
+  Screen pairScreenDear(int k, const Pose* link_poses, scene_detail::SelfScratch& s) const noexcept;
   bool pairExactly(int k, const Pose* link_poses, scene_detail::SelfScratch& s) const noexcept;
   // Pair k's table verdict at q (Unsure without a table or q).
   PairTable::Verdict tabled(int k, const double* q) const noexcept {
