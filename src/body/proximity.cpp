@@ -295,14 +295,16 @@ bool partsScreen(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& 
 }
 
 // screenMeshes' cheap rungs, a few operations each: bounding spheres, the boxes of the hulls as oriented
-// boxes (6 face axes), the cores. Unsure where the hulls must decide.
+// boxes (6 face axes), the cores. Unsure where the hulls must decide; then `placed`, when given, holds b's
+// pose in a's frame for dearRungs.
 Screen cheapRungs(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
-                  const Tolerances& tol, double padding) noexcept {
+                  const Tolerances& tol, double padding, Pose* placed = nullptr) noexcept {
   if (!pose_a.isFinite() || !pose_b.isFinite() || !validPadding(padding)) return Screen::Touching;
   if (spheresApart(pose_a * a.sphereCenter(), a.sphereRadius(), pose_b * b.sphereCenter(), b.sphereRadius(), padding,
                    tol))
     return Screen::Apart;
   const Pose b_in_a = relativePose(pose_a, pose_b);
+  if (placed) *placed = b_in_a;
   if (boxesApart(a, b, b_in_a, tol, padding)) return Screen::Apart;
   // Overlapping cores settle a contact (in any mode: the cores lie in the hulls) before the hulls' GJK, which
   // costs most exactly there, enclosing the origin (about 5,000 instructions for a UR5 arm link dipping
@@ -313,19 +315,17 @@ Screen cheapRungs(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry&
 }
 
 // The rungs after cheapRungs (for a pair it left Unsure): the primitives' or the hulls' GJK, then the convex
-// parts when `parts`.
+// parts when `parts`. `placed`: b's pose in a's frame where cheapRungs gave it (else computed if needed).
 Screen dearRungs(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
-                 const Tolerances& tol, GeometryMode mode, double padding, SimplexCache* hull_cache,
-                 bool parts) noexcept {
+                 const Tolerances& tol, GeometryMode mode, double padding, SimplexCache* hull_cache, bool parts,
+                 const Pose* placed = nullptr) noexcept {
   if (!pose_a.isFinite() || !pose_b.isFinite() || !validPadding(padding)) return Screen::Touching;
+  const auto bInA = [&] { return placed ? *placed : relativePose(pose_a, pose_b); };
   // Two links of one primitive each are those primitives (convex solids): their own GJK decides, as the
   // exact test would, where the hulls' (circumscribed polytopes: 82 vertices for a capsule) only screens.
   const LinkGeometry::Primitive* sole_a = mode == GeometryMode::Mesh ? a.solePrimitive() : nullptr;
   const LinkGeometry::Primitive* sole_b = sole_a ? b.solePrimitive() : nullptr;
-  if (sole_b) {
-    const Pose b_in_a = relativePose(pose_a, pose_b);
-    return primitivesIntersect(*sole_a, *sole_b, b_in_a, tol, padding) ? Screen::Touching : Screen::Apart;
-  }
+  if (sole_b) return primitivesIntersect(*sole_a, *sole_b, bInA(), tol, padding) ? Screen::Touching : Screen::Apart;
   SimplexCache scratch;
   SimplexCache& cache = hull_cache ? *hull_cache : scratch;
   const IntersectResult hulls = gjkIntersect(Margin<ConvexHull>{a.hull(), padding}, pose_a, b.hull(), pose_b, tol, cache);
@@ -333,8 +333,7 @@ Screen dearRungs(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& 
   if (mode == GeometryMode::Hull) return Screen::Touching;
   // A pair the parts clear skips the triangle search, which costs tens of thousands of operations near a
   // mesh of a thousand triangles.
-  if (parts && partsScreen(a, pose_a, b, pose_b, tol, padding, relativePose(pose_a, pose_b).t.norm(), nullptr))
-    return Screen::Apart;
+  if (parts && partsScreen(a, pose_a, b, pose_b, tol, padding, bInA().t.norm(), nullptr)) return Screen::Apart;
   return Screen::Unsure;
 }
 
@@ -342,8 +341,10 @@ Screen dearRungs(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& 
 Screen screenRungs(const LinkGeometry& a, const Pose& pose_a, const LinkGeometry& b, const Pose& pose_b,
                    const Tolerances& tol, GeometryMode mode, double padding, SimplexCache* hull_cache,
                    bool parts) noexcept {
-  const Screen cheap = cheapRungs(a, pose_a, b, pose_b, tol, padding);
-  return cheap != Screen::Unsure ? cheap : dearRungs(a, pose_a, b, pose_b, tol, mode, padding, hull_cache, parts);
+  Pose b_in_a;
+  const Screen cheap = cheapRungs(a, pose_a, b, pose_b, tol, padding, &b_in_a);
+  return cheap != Screen::Unsure ? cheap
+                                 : dearRungs(a, pose_a, b, pose_b, tol, mode, padding, hull_cache, parts, &b_in_a);
 }
 }  // namespace
 
