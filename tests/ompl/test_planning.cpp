@@ -4,6 +4,7 @@
 #include <clearway/motion/motion.h>
 #include <clearway/ompl/planning.h>
 
+#include "load/robot_files.h"
 #include "ompl/obstacle_on_path.h"
 
 #include <gtest/gtest.h>
@@ -57,6 +58,45 @@ TEST(Planning, ReturnsACertifiedPathOnTheBundledScene) {
 
 // OMPL's RNGs draw their seeds from one process-wide generator: a seeded query reseeds it, so neither an
 // unseeded query nor one of another seed before it changes its path.
+// A bar on a continuous joint and a post at angle 0: from 3 to −3 rad the straight values pass the post
+// (through 0), the short way (through π, as OMPL's SO(2) turns) does not. The returned path's angles are
+// unwrapped, so its straight segments are the ones certified: a checker of raw values agrees.
+TEST(Planning, ContinuousJointsAreUnwrappedAlongThePath) {
+  test::TempDir dir;
+  const std::string urdf = dir.write("spinner.urdf", R"(<?xml version="1.0"?>
+<robot name="spinner">
+  <link name="base"/>
+  <link name="bar">
+    <collision><origin xyz="0.5 0 0"/><geometry><box size="1 0.05 0.05"/></geometry></collision>
+  </link>
+  <joint name="spin" type="continuous">
+    <parent link="base"/><child link="bar"/><axis xyz="0 0 1"/>
+  </joint>
+</robot>
+)");
+  const auto scene = Scene::load(dir.write(
+      "spinner.yaml", "format: 1\nname: spinner\nrobot:\n  urdf: " + urdf +
+                          "\n  group: [spin]\nenvironment:\n  obstacles:\n"
+                          "    - {name: post, cylinder: {radius: 0.02, length: 1}, pose: {position: [0.8, 0, 0]}}\n"
+                          "checks: [environment, continuous]\nstart: [3]\ngoal: [-3]\n"));
+  const MotionChecker checker(scene);
+  MotionContext ctx = checker.makeContext();
+  const double start = 3.0, goal = -3.0;
+  ASSERT_FALSE(checker.check(&start, &goal, ctx).free);  // the straight values pass the post
+  PlanRequest request;
+  request.seed = 3;
+  const PlanResult r = plan(scene, request);
+  ASSERT_TRUE(r.solved()) << toString(r.status) << ": " << r.message;
+  ASSERT_GE(r.stateCount(), 2u);
+  EXPECT_DOUBLE_EQ(r.path.front(), start);
+  EXPECT_NEAR(std::remainder(r.path.back() - goal, 2.0 * M_PI), 0.0, 1e-9);  // the goal, whole turns apart
+  EXPECT_NEAR(r.path.back(), goal + 2.0 * M_PI, 1e-9);                       // reached through π
+  for (std::size_t i = 0; i + 1 < r.stateCount(); ++i) {
+    EXPECT_LE(std::abs(r.path[i + 1] - r.path[i]), M_PI) << "segment " << i;
+    EXPECT_TRUE(checker.check(&r.path[i], &r.path[i + 1], ctx).free) << "segment " << i;
+  }
+}
+
 TEST(Planning, TheSameSeedGivesTheSamePath) {
   const auto scene = Scene::load(bundledScene());
   PlanRequest request;

@@ -265,8 +265,14 @@ PlanResult plan(const std::shared_ptr<const MotionChecker>& checker, const PlanR
   for (std::size_t i = 0; i + 1 < path.getStateCount(); ++i)
     if (!checking.motion->check(path.getState(i), path.getState(i + 1)).free) result.uncertified_segments.push_back(i);
   result.path.resize(path.getStateCount() * static_cast<std::size_t>(scene.dimension()));
-  for (std::size_t i = 0; i < path.getStateCount(); ++i)
-    map.toVector(path.getState(i), result.path.data() + i * scene.dimension());
+  // Each angle of a continuous joint (and of a planar joint) shifted by whole turns against the state before,
+  // as the motion validator unwraps it: the path's straight segments are then the ones certified, turning
+  // the short way, whatever reads the path back (clearway motion, Scene/MotionChecker from C++ or Python).
+  for (std::size_t i = 0; i < path.getStateCount(); ++i) {
+    double* q = result.path.data() + i * scene.dimension();
+    map.toVector(path.getState(i), q);
+    if (i > 0) map.unwrap(q - scene.dimension(), q);
+  }
   counters();
   if (result.uncertified_segments.empty()) {
     result.status = PlanStatus::Solved;

@@ -50,6 +50,8 @@ struct PlanResult {
   std::string ompl_status;  ///< the planner's ompl::base::PlannerStatus as text ("Exact solution", "Timeout", ...)
   int dimension = 0;        ///< values per state
   /// The states, one after another (dimension values each); set when a path was found, certified or not.
+  /// The angles of continuous and planar joints are unwrapped along the path (each within π of the one
+  /// before, so beyond [−π, π) where the path turns past it): each straight segment turns the short way.
   std::vector<double> path;
   double length = 0.0;            ///< the path's length in OMPL's state space metric
   double solve_seconds = 0.0;     ///< wall time of the planner's solve
