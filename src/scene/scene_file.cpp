@@ -232,11 +232,19 @@ class Parser {
     YAML::Node root;
     std::error_code ec;
     if (!text_ && !fs::is_regular_file(file_, ec)) fail("", "scene file not found");
+    std::vector<YAML::Node> documents;
     try {
-      root = text_ ? YAML::Load(*text_) : YAML::LoadFile(file_);
+      documents = text_ ? YAML::LoadAll(*text_) : YAML::LoadAllFromFile(file_);
     } catch (const YAML::Exception& e) {
       fail("", std::string("not valid YAML: ") + e.what());
     }
+    // One scene per file: what a second document (after `---`) holds would otherwise be dropped unread, an
+    // obstacle among it never checked. (Empty documents, a stray `---`, hold nothing to drop.)
+    for (std::size_t i = 1; i < documents.size(); ++i)
+      if (!documents[i].IsNull())
+        fail("", "holds " + std::to_string(documents.size()) + " YAML documents, where a scene is one: document " +
+                     std::to_string(i + 1) + " is not empty" + where(documents[i]));
+    if (!documents.empty()) root = documents.front();
     SceneDescription d;
     d.file = file_;
     requireMap(root, "", {"format", "name", "source", "package_paths", "robot", "environment", "checks", "start", "goal"});

@@ -106,7 +106,8 @@ TEST(SceneFile, BadInputNamesFileAndKey) {
       {replaced("goal: [-1.5, 0]", "goal: [-1.5, .nan]"), "key 'goal[1]'", "not a finite number"},
       {replaced("goal: [-1.5, 0]", "goal: [-1.5, zero]"), "key 'goal[1]'", "not a number"},
       {replaced("[self, environment]", "[self, gravity]"), "key 'checks'", "unknown check 'gravity'"},
-      {replaced("size: [0.1, 2, 1]", "size: [0.1, 2]"), "key 'environment.obstacles[0].box.size'", "expected 3 numbers"},
+      {replaced("size: [0.1, 2, 1]", "size: [0.1, 2]"), "key 'environment.obstacles[0].box.size'",
+       "expected 3 numbers"},
       {replaced("size: [0.1, 2, 1]", "size: [0.1, -2, 1]"), "key 'environment.obstacles[0].box.size[1]'",
        "'-2' m: a size must be >= 0"},
       {replaced("box: {size: [0.1, 2, 1]}", "cone: {radius: 1}"), "key 'environment.obstacles[0].cone'", "unknown key"},
@@ -114,19 +115,24 @@ TEST(SceneFile, BadInputNamesFileAndKey) {
        "key 'environment.obstacles[0].pose.orientation'", "norm"},
       {replaced("format: 1", "format: 2"), "key 'format'", "unsupported format"},
       {replaced("  group:", "  bounds: {elbow: [0]}\n  group:"), "key 'robot.bounds.elbow'", "expected [lower, upper]"},
-      {replaced("  group:", "  bounds: {elbow: [0, .nan]}\n  group:"), "key 'robot.bounds.elbow'", "not a finite number"},
+      {replaced("  group:", "  bounds: {elbow: [0, .nan]}\n  group:"), "key 'robot.bounds.elbow'",
+       "not a finite number"},
       {replaced("  group:", "  bounds: [elbow]\n  group:"), "key 'robot.bounds'", "expected a mapping"},
       {"format: 1\nrobot: [\n", "", "not valid YAML"},
       {replaced("environment:\n  obstacles:", "environment:\n  octomap: missing.bt\n  obstacles:"),
        "key 'environment.octomap'", "file not found"},
       // A repeated key silently lost to the first (a colliding state was called free).
-      {replaced("checks:", "checks: [self]\nchecks:"), "key 'checks'", "given twice with different values (lines 9 and 10)"},
+      {replaced("checks:", "checks: [self]\nchecks:"), "key 'checks'",
+       "given twice with different values (lines 9 and 10)"},
       {replaced("  group:", "  padding: 0\n  padding: 0.1\n  group:"), "key 'robot.padding'", "given twice"},
       {replaced("  group:", "  hold: {elbow: 0, elbow: 1}\n  group:"), "key 'robot.hold.elbow'", "given twice"},
-      {replaced("  group:", "  bounds: {elbow: [0, 1], elbow: [0, 2]}\n  group:"), "key 'robot.bounds.elbow'", "given twice"},
-      {replaced("{name: wall, box:", "{name: wall, name: post, box:"), "key 'environment.obstacles[0].name'", "given twice"},
+      {replaced("  group:", "  bounds: {elbow: [0, 1], elbow: [0, 2]}\n  group:"), "key 'robot.bounds.elbow'",
+       "given twice"},
+      {replaced("{name: wall, box:", "{name: wall, name: post, box:"), "key 'environment.obstacles[0].name'",
+       "given twice"},
       // Complex keys: yaml-cpp's "bad conversion" named neither the file nor the key.
-      {replaced("  group:", "  hold: {? [a, b] : 1}\n  group:"), "key 'robot.hold'", "a key must be a plain name, not a list"},
+      {replaced("  group:", "  hold: {? [a, b] : 1}\n  group:"), "key 'robot.hold'",
+       "a key must be a plain name, not a list"},
       {"? {a: 1}\n: 2\n" + good, "", "a key must be a plain name, not a mapping"},
       // Checks that check nothing: every state was free without a word.
       {replaced("[self, environment]", "[]"), "key 'checks'", "is empty: every state would be free"},
@@ -141,6 +147,9 @@ TEST(SceneFile, BadInputNamesFileAndKey) {
        "'0' m: a size must be > 0"},
       {replaced("box: {size: [0.1, 2, 1]}", "capsule: {radius: 0.1, length: 2e6}"),
        "key 'environment.obstacles[0].capsule.length'", "beyond the largest length"},
+      // A second document was dropped unread: its obstacles never checked.
+      {good + "---\nenvironment:\n  obstacles: []\n", "",
+       "holds 2 YAML documents, where a scene is one: document 2 is not empty"},
   };
   for (const Case& c : cases) {
     const std::string path = dir.write("bad.yaml", c.text);
@@ -151,6 +160,9 @@ TEST(SceneFile, BadInputNamesFileAndKey) {
   // A key repeated with the same value says nothing new: read once.
   const std::string same = dir.write("same.yaml", replaced("checks:", "checks: [self, environment]\nchecks:"));
   EXPECT_TRUE(parseSceneFile(same).effects.environment);
+  // Nor does a stray `---` with nothing after it.
+  const std::string stray = dir.write("stray.yaml", good + "---\n");
+  EXPECT_EQ(parseSceneFile(stray).obstacles.size(), parseSceneFile(dir.write("good.yaml", good)).obstacles.size());
 }
 
 // Text quoted from a scene file is cut to a few dozen characters: a 100 KB "number" or joint name made
