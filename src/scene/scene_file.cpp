@@ -327,6 +327,17 @@ class Parser {
     if (!d.effects.self && !d.effects.environment)
       fail("checks", std::string(root["checks"].size() == 0 ? "is empty" : "names no collision check") +
                          ": every state would be free; list self, environment or both" + where(root["checks"]));
+    // Obstacles the checks never look at: a self-only scene may mean it (an audit of the robot alone), but a
+    // state inside them is then free, so it is said.
+    if (!d.effects.environment && (!d.obstacles.empty() || !d.octomap.empty()))
+      warnings_.push_back(LoadError::format(
+          file_, "key 'checks'",
+          "'environment' is not among the checks: the scene's " +
+              (d.obstacles.empty()
+                   ? std::string("OctoMap is")
+                   : std::to_string(d.obstacles.size()) + " obstacle" + (d.obstacles.size() == 1 ? " is" : "s are") +
+                         (d.octomap.empty() ? "" : " and the OctoMap")) +
+              " never checked"));
     bool any_moving = false;
     for (const auto& o : d.obstacles) any_moving = any_moving || o.velocity != Vec3::Zero();
     if (any_moving && !d.effects.moving)

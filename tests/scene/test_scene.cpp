@@ -59,6 +59,20 @@ TEST(SceneFile, TextFromElsewhereTakesItsPathsFromTheGivenFolder) {
                     dir.path("nowhere.urdf"));
 }
 
+// Obstacles declared but never checked (no 'environment' among the checks): accepted, as a self-only audit
+// may mean it, but said, since a state inside them is free.
+TEST(SceneFile, ObstaclesTheChecksOmitAreSaid) {
+  TempDir dir;
+  const SceneDescription self_only = parseSceneFile(dir.write("self.yaml", planarScene("[self]")));
+  ASSERT_EQ(self_only.warnings.size(), 1u);
+  EXPECT_NE(self_only.warnings[0].find(
+                "key 'checks': 'environment' is not among the checks: the scene's 1 obstacle is never checked"),
+            std::string::npos)
+      << self_only.warnings[0];
+  EXPECT_TRUE(parseSceneFile(dir.write("both.yaml", planarScene())).warnings.empty());
+  EXPECT_TRUE(parseSceneFile(dir.write("none.yaml", planarScene("[self]", ""))).warnings.empty());
+}
+
 TEST(SceneFile, ParsesEveryKey) {
   TempDir dir;
   const std::string path = dir.write("s.yaml", planarScene("[self, environment]",
