@@ -5,6 +5,8 @@
 
 #include <iostream>
 #include <memory>
+#include <string>
+#include <utility>
 
 namespace clearway::cli {
 
@@ -45,10 +47,15 @@ int runCheck(const CheckSettings& s) {
       std::cerr << "clearway check: " << s.scene << " has no start or goal; give --states FILE\n";
       return kExitUsage;
     }
-    if (!d.start.empty()) std::cout << "start: " << verdict(*scene, d.start, ctx) << "\n";
-    if (!d.goal.empty()) std::cout << "goal: " << verdict(*scene, d.goal, ctx) << "\n";
+    int status = kExitOk;  // (as for --states: a state that is an error makes the exit status 1)
+    for (const auto& [name, q] : {std::pair{"start", &d.start}, std::pair{"goal", &d.goal}}) {
+      if (q->empty()) continue;
+      const std::string v = verdict(*scene, *q, ctx);
+      if (v.compare(0, 5, "error") == 0) status = kExitNo;
+      std::cout << name << ": " << v << "\n";
+    }
     std::cout.flush();
-    return std::cout ? kExitOk : kExitUsage;
+    return std::cout ? status : kExitUsage;
   }
   std::ifstream file;
   std::istream* input = openInput("check", s.states, file);

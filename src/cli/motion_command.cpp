@@ -73,6 +73,12 @@ int runMotion(const MotionSettings& s) {
       std::cerr << "clearway motion: " << scene_path << " needs a start and a goal; give --motions FILE\n";
       return kExitUsage;
     }
+    // (As a line of --motions: an end that is no valid state is an error, exit status 1.)
+    std::string bad;
+    if (!scene->validState(d.start.data(), &bad) || !scene->validState(d.goal.data(), &bad)) {
+      std::cout << "start -> goal: error " << bad << "\n";
+      return std::cout.flush() ? kExitNo : kExitUsage;
+    }
     std::cout << "start -> goal: " << verdict(*checker, d.start.data(), d.goal.data(), ctx) << "\n";
     return std::cout.flush() ? kExitOk : kExitUsage;
   }

@@ -235,6 +235,23 @@ TEST(Arguments, PlannedPathsReadBackExactly) {
   EXPECT_MENTIONS(refused.out + refused.err, "= 2.5000001 is outside [-2.5, 2.5]");
 }
 
+// The scene's own start and goal, when no valid state: check and motion say "error" and exit 1, as for a
+// line of --states or --motions (they exited 0).
+TEST(Arguments, AStartOrGoalOutOfBoundsExitsOne) {
+  const std::string scene =
+      writeTemp("bounds.yaml",
+                "format: 1\nname: bounds\nrobot:\n  urdf: " + std::string(CLEARWAY_SOURCE_DIR) +
+                    "/robots/planar_arm/planar_arm.urdf\n  group: [shoulder, elbow]\nenvironment:\n  obstacles: []\n"
+                    "checks: [self, environment]\nstart: [0.3, 0]\ngoal: [1.9, 3]\n");
+  const ToolRun check = runTool("check '" + scene + "'");
+  EXPECT_EQ(check.exit_code, 1) << check.out << check.err;
+  EXPECT_MENTIONS(check.out, "start: free");
+  EXPECT_MENTIONS(check.out, "goal: error state[1] (elbow) = 3 is outside [-2.5, 2.5]");
+  const ToolRun motion = runTool("motion '" + scene + "'");
+  EXPECT_EQ(motion.exit_code, 1) << motion.out << motion.err;
+  EXPECT_MENTIONS(motion.out, "start -> goal: error state[1] (elbow) = 3 is outside [-2.5, 2.5]");
+}
+
 // Input that cannot be read to its end (/dev/zero: no end of line, ever) stops check and motion with an
 // error naming the file, exit 2: they stopped early and exited 0, as if every line had run.
 TEST(Arguments, UnreadableStatesAndMotionsFail) {
