@@ -325,6 +325,58 @@ OverflowSite locateOverflow(const std::string& line) {
   return {path.empty() ? "line" : path, id};
 }
 
+// The key path of the first key an object of the line repeats ("" for none). nlohmann::json keeps the last
+// value of a repeated key, so a case could be answered for a shape other than the one written first; the
+// scene files refuse repeated keys too. Parsed again only for a line that parsed.
+std::string repeatedKey(const std::string& line) {
+  struct Frame {
+    bool is_array;
+    std::string key;
+    std::size_t count = 0;
+    std::vector<std::string> keys;  // (an object's few keys: a scan beats a set)
+  };
+  std::vector<Frame> stack;
+  std::string found;
+  auto callback = [&](int, json::parse_event_t event, json& parsed) {
+    if (!found.empty()) return false;
+    switch (event) {
+      case json::parse_event_t::object_start:
+        stack.push_back({false, "", 0, {}});
+        break;
+      case json::parse_event_t::array_start:
+        stack.push_back({true, "", 0, {}});
+        break;
+      case json::parse_event_t::key:
+        if (!stack.empty()) {
+          Frame& f = stack.back();
+          f.key = parsed.get<std::string>();
+          if (std::find(f.keys.begin(), f.keys.end(), f.key) != f.keys.end()) {
+            for (const Frame& g : stack) found = g.is_array ? index(found, g.count) : join(found, g.key);
+          } else {
+            f.keys.push_back(f.key);
+          }
+        }
+        break;
+      case json::parse_event_t::value:
+        if (!stack.empty() && stack.back().is_array) ++stack.back().count;
+        break;
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        if (!stack.empty()) stack.pop_back();
+        if (!stack.empty() && stack.back().is_array) ++stack.back().count;
+        break;
+    }
+    return true;
+  };
+  try {
+    const json discarded = json::parse(line, callback);
+    static_cast<void>(discarded);
+  } catch (const json::exception&) {
+    // (the line parsed once already: nothing new to say)
+  }
+  return found;
+}
+
 }  // namespace
 
 QueryCase parseQueryCase(const json& line) {
@@ -412,6 +464,11 @@ QueryLineResult runQueryLine(const std::string& line, long line_number) {
     return {errorResult(nullptr, line_number, "arrays and objects nested deeper than " + std::to_string(kMaxJsonDepth) +
                                                   " levels (a query needs at most 4)"),
             true};
+  // (nlohmann::json reads a line only to its first NUL byte: what follows was dropped unread.)
+  if (const std::size_t nul = line.find('\0'); nul != std::string::npos)
+    return {
+        errorResult(nullptr, line_number, "a NUL byte at column " + std::to_string(nul + 1) + ": a query line is text"),
+        true};
   json parsed;
   try {
     parsed = json::parse(line);
@@ -427,6 +484,8 @@ QueryLineResult runQueryLine(const std::string& line, long line_number) {
     const auto it = parsed.find("id");
     if (it != parsed.end() && validId(*it)) id = *it;
   }
+  if (const std::string repeated = repeatedKey(line); !repeated.empty())
+    return {errorResult(id, line_number, repeated + " is given twice (each key once)"), true};
   try {
     return {runQueryCase(parseQueryCase(parsed)), false};
   } catch (const QueryError& e) {

@@ -287,6 +287,27 @@ TEST(QueryFileErrors, NotJson) {
   EXPECT_MENTIONS(error("[1, 2, 3]"), "must be an object");
 }
 
+// A key given twice kept its last value (a case answered for a shape other than the one written first), and
+// what followed a NUL byte was dropped unread: both refused, naming where.
+TEST(QueryFileErrors, RepeatedKeysAndNulBytes) {
+  const std::string sphere = R"({"type": "sphere", "radius": 1})";
+  const std::string line = pair("intersect", body(sphere), body(sphere, "[1, 0, 0]"));
+  EXPECT_TRUE(ok(line)["intersect"].get<bool>());
+  EXPECT_EQ(error(pair("intersect", body(sphere), body(sphere, "[1, 0, 0]"), R"(, "b": )" + body(sphere, "[5, 0, 0]"))),
+            "b is given twice (each key once)");
+  EXPECT_EQ(
+      error(pair("distance", body(R"({"type": "sphere", "radius": 1, "radius": 0.1})"), body(sphere, "[3, 0, 0]"))),
+      "a.shape.radius is given twice (each key once)");
+  EXPECT_EQ(error(pair("distance", body(sphere),
+                       body(R"({"type": "convex", "vertices": [[0, 0, 0], [1, 0, 0], )"
+                            R"([0, 1, 0], [0, 0, 1]], "vertices": [[0, 0, 0]]})",
+                            "[3, 0, 0]"))),
+            "b.shape.vertices is given twice (each key once)");
+  std::string nul = line;
+  nul.insert(nul.size() - 1, std::string(", \"b\": ") + '\0');
+  EXPECT_EQ(error(nul), "a NUL byte at column " + std::to_string(line.size() + 7) + ": a query line is text");
+}
+
 TEST(QueryFileErrors, MissingKeys) {
   const std::string unit = body(R"({"type": "sphere", "radius": 1})");
   EXPECT_MENTIONS(error(R"({"query": "distance", "a": )" + unit + R"(, "b": )" + unit + "}"), "id is missing");
