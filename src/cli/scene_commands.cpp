@@ -92,9 +92,21 @@ std::istream* openInput(const char* command, const std::string& path, std::ifstr
 bool parseNumbers(const std::string& line, std::vector<double>& out, std::string& why) {
   out.clear();
   const char* p = line.c_str();
+  // A comma stands between two numbers: "1,,2" or ",1" is a value left out, not a separator repeated.
+  bool comma_due = false;  // a comma since the last number
+  const auto emptyField = [&] {
+    why = "an empty field at column " + std::to_string(p - line.c_str() + 1) + " (a comma needs a number on each side)";
+    return false;
+  };
   while (true) {
-    while (*p == ' ' || *p == '\t' || *p == ',' || *p == '\r') ++p;
-    if (*p == '\0' || *p == '#') return true;
+    while (*p == ' ' || *p == '\t' || *p == ',' || *p == '\r') {
+      if (*p == ',') {
+        if (out.empty() || comma_due) return emptyField();
+        comma_due = true;
+      }
+      ++p;
+    }
+    if (*p == '\0' || *p == '#') return comma_due ? emptyField() : true;
     char* end = nullptr;
     errno = 0;
     const double v = std::strtod(p, &end);
@@ -107,6 +119,7 @@ bool parseNumbers(const std::string& line, std::vector<double>& out, std::string
       return false;
     }
     out.push_back(v);
+    comma_due = false;
     p = end;
   }
 }

@@ -608,14 +608,16 @@ TEST(PlanTool, BadInput) {
 
 TEST(CheckTool, ClassifiesStates) {
   const std::string file = testing::TempDir() + "clearway_check_" + std::to_string(::getpid()) + ".txt";
-  std::ofstream(file) << "# start, goal, into the floor, a bad line, out of bounds\n"
-                         "0 -0.6 -1.2 -1.34 0 0\n0, 0.6, 1.2, 1.34, 0, 0\n0 1.7 0.5 0 0 0\n0 1 x\n0 0 0 0 0 99\n";
+  std::ofstream(file) << "# start, goal, into the floor, a bad line, out of bounds; empty fields (read as\n"
+                         "# values left out: they were skipped, shifting the rest into other joints)\n"
+                         "0 -0.6 -1.2 -1.34 0 0\n0, 0.6, 1.2, 1.34, 0, 0\n0 1.7 0.5 0 0 0\n0 1 x\n0 0 0 0 0 99\n"
+                         "0,,0.6, 1.2, 1.34, 0, 0\n,0, 0.6, 1.2, 1.34, 0, 0\n0, 0.6, 1.2, 1.34, 0, 0,\n";
   ToolRun r = runTool("check " + bundledScene() + " --states '" + file + "'");
   EXPECT_EQ(r.exit_code, 1) << r.err;
   std::istringstream out(r.out);
   std::vector<std::string> lines;
   for (std::string l; std::getline(out, l);) lines.push_back(l);
-  ASSERT_EQ(lines.size(), 5u) << r.out;
+  ASSERT_EQ(lines.size(), 8u) << r.out;
   EXPECT_EQ(lines[0], "free");
   EXPECT_EQ(lines[1], "free");
   EXPECT_EQ(lines[2].rfind("collision ", 0), 0u) << lines[2];
@@ -623,6 +625,9 @@ TEST(CheckTool, ClassifiesStates) {
   EXPECT_EQ(lines[3].rfind("error ", 0), 0u) << lines[3];
   EXPECT_EQ(lines[4].rfind("error ", 0), 0u) << lines[4];
   EXPECT_NE(lines[4].find("wrist_3_joint"), std::string::npos) << lines[4];
+  EXPECT_EQ(lines[5], "error line 8: an empty field at column 3 (a comma needs a number on each side)");
+  EXPECT_EQ(lines[6], "error line 9: an empty field at column 1 (a comma needs a number on each side)");
+  EXPECT_EQ(lines[7], "error line 10: an empty field at column 25 (a comma needs a number on each side)");
   r = runTool("check " + bundledScene());
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_MENTIONS(r.out, "start: free");
