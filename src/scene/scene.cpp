@@ -192,6 +192,8 @@ void Scene::init() {
     const std::string key = "robot.hold." + inputExcerpt(name);
     const int j = model.jointIndex(name);
     if (j < 0) fail(key, "joint '" + inputExcerpt(name) + "' is not in robot '" + inputExcerpt(model.name()) + "'");
+    if (!(std::abs(value) <= kMaxJointValue))  // (as a state's values: a link 1e300 m away is no placement)
+      fail(key, "'" + exactText(value) + "' is beyond ±1e6, the largest joint value a state may hold");
     const Joint& joint = model.joint(j);
     if (joint.type == JointType::Fixed) {
       // A fixed joint has no value; MoveIt's converters still list it at 0, which says nothing.

@@ -270,6 +270,9 @@ TEST(Scene, BadRobotReferencesNameTheKey) {
       {"", "[shoulder]", "key 'start'", "has 2 values for 1 group variables"},
       {"  bounds: {elbow: [1, 0]}\n", "[shoulder, elbow]", "key 'robot.bounds.elbow'", "lower < upper"},
       {"  bounds: {elbow: [-9, 0]}\n", "[shoulder, elbow]", "key 'robot.bounds.elbow'", "outside the joint's limits"},
+      // A held value no state may hold (the link was placed 1e300 m away).
+      {"  hold: {elbow: 1e300}\n", "[shoulder]", "key 'robot.hold.elbow'",
+       "'1e+300' is beyond ±1e6, the largest joint value a state may hold"},
   };
   for (const Case& c : cases) {
     std::string text = planarScene("[self]", "", c.robot_extra);
