@@ -77,7 +77,8 @@ std::shared_ptr<const RobotGeometry> loadRobotGeometry(const SceneDescription& d
   return std::make_shared<const RobotGeometry>(std::move(model));
 }
 
-std::shared_ptr<const Environment> loadEnvironment(const SceneDescription& d, const LoadOptions& options) {
+std::shared_ptr<const Environment> loadEnvironment(const SceneDescription& d, const LoadOptions& options,
+                                                   std::vector<std::string>* warnings) {
   std::vector<Obstacle> obstacles;
   for (std::size_t i = 0; i < d.obstacles.size(); ++i) {
     const SceneDescription::ObstacleSpec& s = d.obstacles[i];
@@ -87,13 +88,16 @@ std::shared_ptr<const Environment> loadEnvironment(const SceneDescription& d, co
     o.pose = s.pose;
     o.velocity = s.velocity;
     if (!s.mesh_file.empty()) {
-      std::vector<std::string> warnings;
-      const TriangleMesh mesh = loadMesh(s.mesh_file, s.mesh_scale, &warnings, options.mesh);
+      // The mesh's own errors and warnings name its file; the scene's key says which obstacle reads it.
+      const std::string key = "key 'environment.obstacles[" + std::to_string(i) + "].mesh'";
+      std::vector<std::string> said;
       try {
-        o.mesh = std::make_shared<const LinkGeometry>(mesh);
+        o.mesh = std::make_shared<const LinkGeometry>(loadMesh(s.mesh_file, s.mesh_scale, &said, options.mesh));
       } catch (const std::exception& e) {
-        throw LoadError(d.file, "key 'environment.obstacles[" + std::to_string(i) + "].mesh'", e.what());
+        throw LoadError(d.file, key, e.what());
       }
+      if (warnings)
+        for (const std::string& w : said) warnings->push_back(LoadError::format(d.file, key, w));
     }
     obstacles.push_back(std::move(o));
   }
@@ -103,8 +107,16 @@ std::shared_ptr<const Environment> loadEnvironment(const SceneDescription& d, co
 }
 
 Scene::Scene(const SceneDescription& description, const SceneOptions& options)
-    : Scene(description, loadRobotGeometry(description, options.load), loadEnvironment(description, options.load),
-            options) {}
+    : Scene(
+          [&] {
+            Described loaded{description, nullptr};
+            loaded.second = loadEnvironment(description, options.load, &loaded.first.warnings);
+            return loaded;
+          }(),
+          options) {}
+
+Scene::Scene(Described loaded, const SceneOptions& options)
+    : Scene(loaded.first, loadRobotGeometry(loaded.first, options.load), std::move(loaded.second), options) {}
 
 Scene::Scene(const SceneDescription& description, std::shared_ptr<const RobotGeometry> robot,
              std::shared_ptr<const Environment> environment, const SceneOptions& options)

@@ -73,6 +73,31 @@ TEST(SceneFile, ObstaclesTheChecksOmitAreSaid) {
   EXPECT_TRUE(parseSceneFile(dir.write("none.yaml", planarScene("[self]", ""))).warnings.empty());
 }
 
+// A mesh obstacle's errors and warnings name the scene file and the obstacle's key, then the mesh file and
+// the reason; an open mesh (a surface: a body wholly inside it does not collide) is said as for a robot's
+// link. (The errors named the mesh alone, and the warnings were dropped.)
+TEST(Scene, MeshObstaclesSayTheirKey) {
+  TempDir dir;
+  dir.write("tet.stl", test::tetrahedronStl());
+  // Two of its faces: not closed.
+  dir.write("open.stl", "solid tet\n" + test::stlFacet("0 0 0", "0 1 0", "1 0 0") +
+                            test::stlFacet("0 0 0", "1 0 0", "0 0 1") + "endsolid tet\n");
+  const auto scene = [&](const std::string& mesh) {
+    return dir.write("mesh.yaml", planarScene("[self, environment]",
+                                              "    - {name: m, mesh: " + mesh + ", pose: {position: [3, 0, 0]}}\n"));
+  };
+  const std::string closed = scene("{file: tet.stl}");
+  EXPECT_TRUE(Scene(parseSceneFile(closed)).description().warnings.empty());
+  const std::string opened = scene("{file: open.stl}");
+  const std::vector<std::string> said = Scene(parseSceneFile(opened)).description().warnings;
+  ASSERT_EQ(said.size(), 1u);
+  EXPECT_NE(said[0].find(opened + ": key 'environment.obstacles[0].mesh': "), std::string::npos) << said[0];
+  EXPECT_NE(said[0].find("open.stl: not closed"), std::string::npos) << said[0];
+  const std::string flat = scene("{file: tet.stl, scale: [0, 1, 1]}");
+  EXPECT_LOAD_ERROR(Scene(parseSceneFile(flat)), flat, "key 'environment.obstacles[0].mesh'",
+                    "tet.stl: scale must be finite and non-zero in every component");
+}
+
 TEST(SceneFile, ParsesEveryKey) {
   TempDir dir;
   const std::string path = dir.write("s.yaml", planarScene("[self, environment]",

@@ -20,6 +20,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace clearway {
@@ -84,8 +85,11 @@ class SceneContext {
 /// of their own; options.package_paths are searched before the description's. Throws LoadError.
 std::shared_ptr<const RobotGeometry> loadRobotGeometry(const SceneDescription& description,
                                                        const LoadOptions& options = {});
-/// The environment a description names (obstacles, meshes read with options.mesh, OctoMap). Throws LoadError.
-std::shared_ptr<const Environment> loadEnvironment(const SceneDescription& description, const LoadOptions& options = {});
+/// The environment a description names (obstacles, meshes read with options.mesh, OctoMap). Throws LoadError
+/// naming the scene file and the obstacle's key; the meshes' warnings (a mesh that is not closed, ...) are
+/// appended to `warnings` when given, in the same form.
+std::shared_ptr<const Environment> loadEnvironment(const SceneDescription& description, const LoadOptions& options = {},
+                                                   std::vector<std::string>* warnings = nullptr);
 
 /// How a scene checks geometry (not part of the scene file: a choice of the caller).
 struct SceneOptions {
@@ -107,7 +111,8 @@ class Scene {
  public:
   /// Loads the robot and environment a description names and checks that they fit together: every
   /// group and hold joint exists, held joints are not in the group, allowed links exist, start and goal
-  /// have the group's length. Throws LoadError naming the scene file and key (or the robot file).
+  /// have the group's length. Throws LoadError naming the scene file and key (or the robot file). The
+  /// obstacles' mesh warnings join description().warnings.
   explicit Scene(const SceneDescription& description, const SceneOptions& options = {});
   /// The scene with a robot already loaded (shared with other scenes) and an environment built in code.
   Scene(const SceneDescription& description, std::shared_ptr<const RobotGeometry> robot,
@@ -227,6 +232,9 @@ class Scene {
   std::string describe(const CollisionReport& report) const;
 
  private:
+  // The description with its environment's load warnings, and that environment (Scene(description, options)).
+  using Described = std::pair<SceneDescription, std::shared_ptr<const Environment>>;
+  Scene(Described loaded, const SceneOptions& options);
   void init();
   void initEnvironment();  // the part of init() that depends on the environment
   SceneContext& threadContext() const;
