@@ -102,7 +102,13 @@ std::shared_ptr<const Environment> loadEnvironment(const SceneDescription& d, co
     obstacles.push_back(std::move(o));
   }
   std::shared_ptr<const OccupancyMap> map;
-  if (!d.octomap.empty()) map = std::make_shared<const OccupancyMap>(loadOctomap(d.octomap, d.unknown));
+  if (!d.octomap.empty()) {
+    try {  // (its errors name the map's file; the key says which scene reads it)
+      map = std::make_shared<const OccupancyMap>(loadOctomap(d.octomap, d.unknown));
+    } catch (const std::exception& e) {
+      throw LoadError(d.file, "key 'environment.octomap'", e.what());
+    }
+  }
   return std::make_shared<const Environment>(std::move(obstacles), std::move(map));
 }
 

@@ -76,7 +76,7 @@ TEST(SceneFile, ObstaclesTheChecksOmitAreSaid) {
 // A mesh obstacle's errors and warnings name the scene file and the obstacle's key, then the mesh file and
 // the reason; an open mesh (a surface: a body wholly inside it does not collide) is said as for a robot's
 // link. (The errors named the mesh alone, and the warnings were dropped.)
-TEST(Scene, MeshObstaclesSayTheirKey) {
+TEST(Scene, MeshObstaclesAndMapsSayTheirKey) {
   TempDir dir;
   dir.write("tet.stl", test::tetrahedronStl());
   // Two of its faces: not closed.
@@ -96,6 +96,12 @@ TEST(Scene, MeshObstaclesSayTheirKey) {
   const std::string flat = scene("{file: tet.stl, scale: [0, 1, 1]}");
   EXPECT_LOAD_ERROR(Scene(parseSceneFile(flat)), flat, "key 'environment.obstacles[0].mesh'",
                     "tet.stl: scale must be finite and non-zero in every component");
+  // The same for the OctoMap.
+  dir.write("junk.bt", "not an octree\n");
+  std::string text = planarScene();
+  text.replace(text.find("environment:\n"), 13, "environment:\n  octomap: junk.bt\n");
+  const std::string junk = dir.write("junk.yaml", text);
+  EXPECT_LOAD_ERROR(Scene(parseSceneFile(junk)), junk, "key 'environment.octomap'", "junk.bt: not an OctoMap file");
 }
 
 TEST(SceneFile, ParsesEveryKey) {
