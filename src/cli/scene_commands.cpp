@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <new>
 #include <set>
 #include <sstream>
 
@@ -41,6 +42,9 @@ std::shared_ptr<const Scene> loadScene(const char* command, const std::string& p
     for (const std::string& w : scene->description().warnings) printWarning(w);
     for (const std::string& w : scene->robot().loadWarnings()) printWarning(w);
     return scene;
+  } catch (const std::bad_alloc&) {  // (its what() names neither the file nor the reason)
+    std::cerr << "clearway " << command << ": " << path << ": not enough memory to load the scene\n";
+    return nullptr;
   } catch (const std::exception& e) {
     std::cerr << "clearway " << command << ": " << e.what() << "\n";
     return nullptr;

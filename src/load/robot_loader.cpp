@@ -4,6 +4,7 @@
 // file and the element.
 #include <clearway/load/robot_loader.h>
 
+#include <clearway/load/input_limits.h>
 #include <clearway/load/mesh_loader.h>
 
 #include "load/mesh_uri.h"
@@ -119,6 +120,10 @@ class Loader {
 
 RobotModel Loader::load(const std::string& srdf) {
   outline_ = detail::readUrdfOutline(urdf_);
+  if (outline_.links.size() > static_cast<std::size_t>(kMaxLinks))
+    throw LoadError(urdf_, "<robot>",
+                    std::to_string(outline_.links.size()) + " links, more than the " + std::to_string(kMaxLinks) +
+                        " a robot may have");
   for (const auto& w : outline_.warnings) warn(w.element, w.reason);
   const urdf::ModelInterfaceSharedPtr model = parseWithUrdfdom(outline_.text_for_urdfdom, urdf_, &warnings_);
   buildLinks(*model);

@@ -2,6 +2,7 @@
 // names the file, the element (with its line) and the reason.
 #include <clearway/body/robot_geometry.h>
 #include <clearway/load/robot_loader.h>
+#include <clearway/load/input_limits.h>
 #include <clearway/load/mesh_loader.h>
 
 #include "load/robot_files.h"
@@ -50,6 +51,25 @@ TEST_F(BadInput, MalformedXml) {
   EXPECT_LOAD_ERROR(loadRobot(urdf), urdf, "line 2", "malformed XML");  // the unclosed element
   const std::string not_robot = dir.write("not_robot.urdf", "<model name=\"r\"/>\n");
   EXPECT_LOAD_ERROR(loadRobot(not_robot), not_robot, "", "not <robot>");
+}
+
+// A chain of more links than kMaxLinks: refused naming the file (50,000 links ran out of memory, naming
+// nothing); one link fewer loads.
+TEST_F(BadInput, MoreLinksThanTheLimit) {
+  const auto chain = [](int links) {
+    std::string text = "<robot name=\"chain\">\n<link name=\"l0\"/>\n";
+    for (int i = 1; i < links; ++i) {
+      const std::string l = std::to_string(i), p = std::to_string(i - 1);
+      text += "<link name=\"l" + l + "\"/><joint name=\"j" + l + "\" type=\"fixed\"><parent link=\"l" + p +
+              "\"/><child link=\"l" + l + "\"/></joint>\n";
+    }
+    return text + "</robot>\n";
+  };
+  const std::string too_many = dir.write("too_many.urdf", chain(kMaxLinks + 1));
+  EXPECT_LOAD_ERROR(
+      loadRobot(too_many), too_many, "<robot>",
+      std::to_string(kMaxLinks + 1) + " links, more than the " + std::to_string(kMaxLinks) + " a robot may have");
+  EXPECT_EQ(loadRobot(dir.write("many.urdf", chain(kMaxLinks))).linkCount(), kMaxLinks);
 }
 
 TEST_F(BadInput, UnknownJointType) {

@@ -16,6 +16,11 @@ constexpr double kMinInputLength = 1e-9;
 /// no digit of a link's size (a segment starting inside a wall was called free).
 constexpr double kMaxJointValue = 1e6;
 
+/// The most links a robot may have (the URDF's, its attached bodies not counted). The checker keeps per-pair
+/// and per-chain tables, quadratic in the links: a 5,000-link chain took 3 GB and 17 s to load, one of
+/// 50,000 ran out of memory; the largest robots planned for have a few hundred.
+constexpr int kMaxLinks = 4096;
+
 /// The largest magnitude of a moment (s) a query may place moving obstacles at: an obstacle's path over
 /// a longer span leaves no digit of its size (a segment of 1e17 s was called free).
 constexpr double kMaxTime = 1e6;
