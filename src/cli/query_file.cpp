@@ -281,54 +281,9 @@ std::string bareMessage(const std::exception& e) {
   return cut == std::string::npos ? s : s.substr(cut + 2);
 }
 
-// Where nlohmann stopped on a number that overflows a double (JSON's only way to spell a
-// non-finite number): the key path of that value, and the case's id if it came earlier in the line.
-struct OverflowSite {
-  std::string path;
-  json id;
-};
-
-// Re-parses the line with a callback that tracks the key path; used only on that error.
-OverflowSite locateOverflow(const std::string& line) {
-  struct Frame {
-    bool is_array;
-    std::string key;
-    std::size_t count = 0;
-  };
-  std::vector<Frame> stack;
-  json id = nullptr;
-  auto callback = [&](int depth, json::parse_event_t event, json& parsed) {
-    switch (event) {
-      case json::parse_event_t::object_start: stack.push_back({false, "", 0}); break;
-      case json::parse_event_t::array_start: stack.push_back({true, "", 0}); break;
-      case json::parse_event_t::key: if (!stack.empty()) stack.back().key = parsed.get<std::string>(); break;
-      case json::parse_event_t::value:
-        if (!stack.empty() && stack.back().is_array) ++stack.back().count;
-        if (depth == 1 && stack.size() == 1 && stack[0].key == "id" && validId(parsed)) id = parsed;
-        break;
-      case json::parse_event_t::object_end:
-      case json::parse_event_t::array_end:
-        if (!stack.empty()) stack.pop_back();
-        if (!stack.empty() && stack.back().is_array) ++stack.back().count;
-        break;
-    }
-    return true;
-  };
-  try {
-    const json discarded = json::parse(line, callback);
-    static_cast<void>(discarded);
-  } catch (const json::exception&) {
-    // expected: the same error as before, now with the path recorded
-  }
-  std::string path;
-  for (const Frame& f : stack) path = f.is_array ? index(path, f.count) : join(path, f.key);
-  return {path.empty() ? "line" : path, id};
-}
-
-// The key path of the first key an object of the line repeats ("" for none). nlohmann::json keeps the last
-// value of a repeated key, so a case could be answered for a shape other than the one written first; the
-// scene files refuse repeated keys too. Parsed again only for a line that parsed.
-std::string repeatedKey(const std::string& line) {
+// Where a parse is, followed through nlohmann's callback events: the key path of the current value, and
+// the keys each open object gave so far.
+struct KeyPath {
   struct Frame {
     bool is_array;
     std::string key;
@@ -336,9 +291,9 @@ std::string repeatedKey(const std::string& line) {
     std::vector<std::string> keys;  // (an object's few keys: a scan beats a set)
   };
   std::vector<Frame> stack;
-  std::string found;
-  auto callback = [&](int, json::parse_event_t event, json& parsed) {
-    if (!found.empty()) return false;
+
+  // Follows one event; true when it is a key its object gave before.
+  bool follow(json::parse_event_t event, const json& parsed) {
     switch (event) {
       case json::parse_event_t::object_start:
         stack.push_back({false, "", 0, {}});
@@ -350,11 +305,8 @@ std::string repeatedKey(const std::string& line) {
         if (!stack.empty()) {
           Frame& f = stack.back();
           f.key = parsed.get<std::string>();
-          if (std::find(f.keys.begin(), f.keys.end(), f.key) != f.keys.end()) {
-            for (const Frame& g : stack) found = g.is_array ? index(found, g.count) : join(found, g.key);
-          } else {
-            f.keys.push_back(f.key);
-          }
+          if (std::find(f.keys.begin(), f.keys.end(), f.key) != f.keys.end()) return true;
+          f.keys.push_back(f.key);
         }
         break;
       case json::parse_event_t::value:
@@ -366,14 +318,58 @@ std::string repeatedKey(const std::string& line) {
         if (!stack.empty() && stack.back().is_array) ++stack.back().count;
         break;
     }
-    return true;
-  };
+    return false;
+  }
+  std::string path() const {
+    std::string out;
+    for (const Frame& f : stack) out = f.is_array ? index(out, f.count) : join(out, f.key);
+    return out;
+  }
+};
+
+// Parses the line again with a callback (what it returns is kept); the error the line gave before is
+// expected, now with the callback's record of where.
+template <class Callback>
+void parseFollowing(const std::string& line, Callback&& callback) {
   try {
     const json discarded = json::parse(line, callback);
     static_cast<void>(discarded);
   } catch (const json::exception&) {
-    // (the line parsed once already: nothing new to say)
   }
+}
+
+// Where nlohmann stopped on a number that overflows a double (JSON's only way to spell a
+// non-finite number): the key path of that value, and the case's id if it came earlier in the line.
+struct OverflowSite {
+  std::string path;
+  json id;
+};
+
+// Re-parses the line following the key path; used only on that error.
+OverflowSite locateOverflow(const std::string& line) {
+  KeyPath at;
+  json id = nullptr;
+  parseFollowing(line, [&](int depth, json::parse_event_t event, json& parsed) {
+    at.follow(event, parsed);
+    if (event == json::parse_event_t::value && depth == 1 && at.stack.size() == 1 && at.stack[0].key == "id" &&
+        validId(parsed))
+      id = parsed;
+    return true;
+  });
+  const std::string path = at.path();
+  return {path.empty() ? "line" : path, id};
+}
+
+// The key path of the first key an object of the line repeats ("" for none). nlohmann::json keeps the last
+// value of a repeated key, so a case could be answered for a shape other than the one written first; the
+// scene files refuse repeated keys too. Parsed again only for a line that parsed.
+std::string repeatedKey(const std::string& line) {
+  KeyPath at;
+  std::string found;
+  parseFollowing(line, [&](int, json::parse_event_t event, json& parsed) {
+    if (found.empty() && at.follow(event, parsed)) found = at.path();
+    return true;
+  });
   return found;
 }
 
