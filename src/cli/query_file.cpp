@@ -327,8 +327,8 @@ struct KeyPath {
   }
 };
 
-// Parses the line again with a callback (what it returns is kept); the error the line gave before is
-// expected, now with the callback's record of where.
+// Parses the line again, every event through `callback` (which keeps every value: it returns true); an
+// error ends it quietly, as it is the one the line already gave (the callback has recorded where).
 template <class Callback>
 void parseFollowing(const std::string& line, Callback&& callback) {
   try {
