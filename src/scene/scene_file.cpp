@@ -329,15 +329,14 @@ class Parser {
                          ": every state would be free; list self, environment or both" + where(root["checks"]));
     // Obstacles the checks never look at: a self-only scene may mean it (an audit of the robot alone), but a
     // state inside them is then free, so it is said.
-    if (!d.effects.environment && (!d.obstacles.empty() || !d.octomap.empty()))
-      warnings_.push_back(LoadError::format(
-          file_, "key 'checks'",
-          "'environment' is not among the checks: the scene's " +
-              (d.obstacles.empty()
-                   ? std::string("OctoMap is")
-                   : std::to_string(d.obstacles.size()) + " obstacle" + (d.obstacles.size() == 1 ? " is" : "s are") +
-                         (d.octomap.empty() ? "" : " and the OctoMap")) +
-              " never checked"));
+    if (!d.effects.environment && (!d.obstacles.empty() || !d.octomap.empty())) {
+      const std::size_t n = d.obstacles.size();
+      const std::string what = (n == 0 ? std::string() : std::to_string(n) + (n == 1 ? " obstacle" : " obstacles")) +
+                               (n == 0 || d.octomap.empty() ? "" : " and ") + (d.octomap.empty() ? "" : "OctoMap");
+      warnings_.push_back(LoadError::format(file_, "key 'checks'",
+                                            "'environment' is not among the checks: the scene's " + what +
+                                                ((n + !d.octomap.empty()) == 1 ? " is" : " are") + " never checked"));
+    }
     bool any_moving = false;
     for (const auto& o : d.obstacles) any_moving = any_moving || o.velocity != Vec3::Zero();
     if (any_moving && !d.effects.moving)
