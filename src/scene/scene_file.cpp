@@ -8,12 +8,15 @@
 
 #include "load/mesh_uri.h"
 
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <set>
+#include <sstream>
 
 namespace clearway {
 
@@ -228,23 +231,77 @@ class Parser {
     d.attached.push_back(std::move(a));
   }
 
+  // One scene per file: what a second document (after `---`) holds would otherwise be dropped unread, an
+  // obstacle among it never checked. (Empty documents, a stray `---`, hold nothing to drop.) The documents
+  // are walked by events, not built: yaml-cpp's LoadAll loops for ever on some stray text (a `}` after the
+  // last), reading it as one empty document after another at the same place. A document must begin past
+  // the last one's end, so the walk ends within the text's length in documents.
+  void requireOneDocument(const std::string& bytes) const {
+    struct Walk : YAML::EventHandler {
+      YAML::Mark content = YAML::Mark::null_mark();  // the first event other than a null, if any
+      int furthest = -1;                             // the furthest event's position
+      void at(const YAML::Mark& m, bool null) {
+        if (!null && content.pos < 0) content = m;
+        furthest = std::max(furthest, m.pos);
+      }
+      void OnDocumentStart(const YAML::Mark&) override {}
+      void OnDocumentEnd() override {}
+      void OnNull(const YAML::Mark& m, YAML::anchor_t) override { at(m, true); }
+      void OnAlias(const YAML::Mark& m, YAML::anchor_t) override { at(m, false); }
+      void OnScalar(const YAML::Mark& m, const std::string&, YAML::anchor_t, const std::string&) override {
+        at(m, false);
+      }
+      void OnSequenceStart(const YAML::Mark& m, const std::string&, YAML::anchor_t,
+                           YAML::EmitterStyle::value) override {
+        at(m, false);
+      }
+      void OnSequenceEnd() override {}
+      void OnMapStart(const YAML::Mark& m, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+        at(m, false);
+      }
+      void OnMapEnd() override {}
+    };
+    std::istringstream in(bytes);
+    YAML::Parser parser(in);
+    int end = -1;  // the furthest position of the documents so far
+    for (std::size_t document = 1; document <= bytes.size() + 2; ++document) {
+      Walk w;
+      if (!parser.HandleNextDocument(w)) return;
+      if (document > 1 && w.content.pos >= 0)
+        fail("", "holds more than one YAML document, where a scene is one: document " + std::to_string(document) +
+                     " is not empty (line " + std::to_string(w.content.line + 1) + ")");
+      if (document > 1 && w.furthest <= end)
+        fail("", "not valid YAML: the text after line " + std::to_string(lineAt(bytes, end) + 1) +
+                     " cannot be read (stray brackets or braces?)");
+      end = std::max(end, w.furthest);
+    }
+    fail("", "not valid YAML: more documents than bytes");  // (not reached: each document moves on)
+  }
+
+  static int lineAt(const std::string& bytes, int pos) {
+    return static_cast<int>(std::count(bytes.begin(), bytes.begin() + std::clamp<int>(pos, 0, bytes.size()), '\n'));
+  }
+
   SceneDescription parse() const {
     YAML::Node root;
     std::error_code ec;
     if (!text_ && !fs::is_regular_file(file_, ec)) fail("", "scene file not found");
-    std::vector<YAML::Node> documents;
+    std::string bytes;
+    if (text_) {
+      bytes = *text_;
+    } else {
+      std::ifstream in(file_, std::ios::binary);
+      std::ostringstream all;
+      all << in.rdbuf();
+      if (!in && !in.eof()) fail("", "cannot be read");
+      bytes = all.str();
+    }
     try {
-      documents = text_ ? YAML::LoadAll(*text_) : YAML::LoadAllFromFile(file_);
+      root = YAML::Load(bytes);
+      requireOneDocument(bytes);
     } catch (const YAML::Exception& e) {
       fail("", std::string("not valid YAML: ") + e.what());
     }
-    // One scene per file: what a second document (after `---`) holds would otherwise be dropped unread, an
-    // obstacle among it never checked. (Empty documents, a stray `---`, hold nothing to drop.)
-    for (std::size_t i = 1; i < documents.size(); ++i)
-      if (!documents[i].IsNull())
-        fail("", "holds " + std::to_string(documents.size()) + " YAML documents, where a scene is one: document " +
-                     std::to_string(i + 1) + " is not empty" + where(documents[i]));
-    if (!documents.empty()) root = documents.front();
     SceneDescription d;
     d.file = file_;
     requireMap(root, "", {"format", "name", "source", "package_paths", "robot", "environment", "checks", "start", "goal"});

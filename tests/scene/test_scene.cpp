@@ -194,7 +194,12 @@ TEST(SceneFile, BadInputNamesFileAndKey) {
        "key 'environment.obstacles[0].capsule.length'", "beyond the largest length"},
       // A second document was dropped unread: its obstacles never checked.
       {good + "---\nenvironment:\n  obstacles: []\n", "",
-       "holds 2 YAML documents, where a scene is one: document 2 is not empty"},
+       "holds more than one YAML document, where a scene is one: document 2 is not empty (line 13)"},
+      // Stray closing brackets after the scene: yaml-cpp's own reading of every document looped for ever
+      // (a fuzzer's find), and its reading of the first dropped the text after them unread.
+      {"{format: 1, robot: {urdf: a.urdf, group: [drive], drive/y: [-3, 2]}},\n envnvironment], start: [0]}\n", "",
+       "not valid YAML: the text after line 1 cannot be read"},
+      {"\n{format: 1, name: x},\n{checks: []}\n", "", "not valid YAML: the text after line 2 cannot be read"},
   };
   for (const Case& c : cases) {
     const std::string path = dir.write("bad.yaml", c.text);
