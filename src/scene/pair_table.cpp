@@ -3,6 +3,7 @@
 #include <clearway/body/proximity.h>
 #include <clearway/detail/margins.h>
 #include <clearway/detail/parallel_for.h>
+#include <clearway/detail/weak_memo.h>
 #include <clearway/shape/convex_hull.h>
 
 #include <algorithm>
@@ -333,26 +334,17 @@ struct Builder {
 // same settings (scenes that share a loaded robot, one after another or at once; a scene and its edits,
 // a body attached or detached elsewhere on the robot included): a table depends on nothing else. An entry
 // lives as long as both geometries (the addresses are then theirs alone).
-struct TableCache {
-  struct Key {
-    const LinkGeometry* ga;
-    const LinkGeometry* gb;
-    int a, b;
-    std::vector<double> settings;  // padding, mode, tolerances, grid, held values, the chain's joints
-    bool operator<(const Key& o) const {
-      return std::tie(ga, gb, a, b, settings) < std::tie(o.ga, o.gb, o.a, o.b, o.settings);
-    }
-  };
-  struct Entry {
-    std::weak_ptr<const LinkGeometry> ga, gb;
-    std::shared_ptr<const PairTable> table;  // null: the pair gets none
-    bool expired() const noexcept { return ga.expired() || gb.expired(); }
-  };
-  std::mutex mutex;
-  std::map<Key, Entry> tables;
-  std::size_t sweep_at = 64;  // the size at which entries of robots gone are next dropped
-  long long built = 0, swept = 0;
+struct TableKey {
+  const LinkGeometry* ga;
+  const LinkGeometry* gb;
+  int a, b;
+  std::vector<double> settings;  // padding, mode, tolerances, grid, held values, the chain's joints
+  bool operator<(const TableKey& o) const {
+    return std::tie(ga, gb, a, b, settings) < std::tie(o.ga, o.gb, o.a, o.b, o.settings);
+  }
 };
+// A null table: the pair gets none.
+using TableCache = detail::WeakMemo<TableKey, std::shared_ptr<const PairTable>, LinkGeometry>;
 
 TableCache& tableCache() {
   static TableCache cache;
@@ -404,27 +396,12 @@ std::shared_ptr<const PairTable> PairTable::shared(const std::shared_ptr<const R
                                                    const std::vector<double>& held, const PairTableOptions& options) {
   if (!geometry || !geometry->link(a) || !geometry->link(b)) return nullptr;
   TableCache& cache = tableCache();
-  TableCache::Key key{geometry->link(a), geometry->link(b), a, b, tableSettings(padding, mode, tol, held, options)};
+  TableKey key{geometry->link(a), geometry->link(b), a, b, tableSettings(padding, mode, tol, held, options)};
   appendChain(geometry->model(), a, b, key.settings);
-  {
-    const std::lock_guard<std::mutex> lock(cache.mutex);
-    const auto it = cache.tables.find(key);
-    if (it != cache.tables.end() && !it->second.expired()) return it->second.table;
-  }
+  if (std::optional<std::shared_ptr<const PairTable>> known = cache.find(key)) return *known;
   std::shared_ptr<const PairTable> t =
       build(geometry->model(), a, *geometry->link(a), b, *geometry->link(b), padding, mode, tol, held, options);
-  const std::lock_guard<std::mutex> lock(cache.mutex);
-  // Entries of robots gone are dropped as new ones come, in a sweep each time the cache has doubled since
-  // the last: a sweep per table made loading a robot quartic in its links (a table per pair, each sweep
-  // over every table); this way each entry is swept a constant number of times on average.
-  cache.tables[std::move(key)] = {geometry->linkPtr(a), geometry->linkPtr(b), t};
-  ++cache.built;
-  if (cache.tables.size() >= cache.sweep_at) {
-    cache.swept += static_cast<long long>(cache.tables.size());
-    for (auto it = cache.tables.begin(); it != cache.tables.end();)
-      it = it->second.expired() ? cache.tables.erase(it) : std::next(it);
-    cache.sweep_at = std::max<std::size_t>(64, 2 * cache.tables.size());
-  }
+  cache.store(std::move(key), geometry->linkPtr(a), geometry->linkPtr(b), t);
   return t;
 }
 
@@ -440,12 +417,11 @@ std::vector<std::shared_ptr<const PairTable>> PairTable::sharedMany(
 }
 
 PairTable::CacheStats PairTable::cacheStats() {
-  TableCache& cache = tableCache();
-  const std::lock_guard<std::mutex> lock(cache.mutex);
+  const TableCache::Stats m = tableCache().stats();
   CacheStats s;
-  s.entries = cache.tables.size();
-  s.built = cache.built;
-  s.swept = cache.swept;
+  s.entries = m.entries;
+  s.built = m.stored;
+  s.swept = m.swept;
   return s;
 }
 

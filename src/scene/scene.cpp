@@ -6,6 +6,7 @@
 #include <clearway/serial.h>
 #include <clearway/body/proximity.h>
 #include <clearway/detail/margins.h>
+#include <clearway/detail/weak_memo.h>
 #include <clearway/tree/aabb.h>
 
 #include <clearway/per_thread.h>
@@ -22,7 +23,11 @@
 #include <charconv>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
+#include <tuple>
+#include <utility>
+#include <vector>
 
 namespace clearway {
 namespace {
@@ -32,6 +37,40 @@ SelfCollisionOptions placeholderOptions() {
   SelfCollisionOptions o;
   o.pair_tables = false;
   return o;
+}
+
+// Whether two links that no state moves apart meet, remembered: every scene over a loaded robot asks it
+// again, for the same links at the same poses, and on meshes that touch (a gripper bolted to its flange)
+// the answer is a search among their triangles. Keyed by both poses, padding, mode and tolerances, the
+// answer remembered is the one meshesIntersect gives.
+struct RigidPairKey {
+  const LinkGeometry* a;
+  const LinkGeometry* b;
+  std::vector<double> values;
+  bool operator<(const RigidPairKey& o) const { return std::tie(a, b, values) < std::tie(o.a, o.b, o.values); }
+};
+
+bool rigidPairIntersects(const RobotGeometry& geometry, int a, const Pose& pose_a, int b, const Pose& pose_b,
+                         const Tolerances& tol, GeometryMode mode, double padding) {
+  static detail::WeakMemo<RigidPairKey, bool, LinkGeometry> memo;
+  const LinkGeometry& ga = *geometry.link(a);
+  const LinkGeometry& gb = *geometry.link(b);
+  RigidPairKey key{&ga, &gb, {}};
+  for (const Pose* p : {&pose_a, &pose_b}) {
+    key.values.insert(key.values.end(), p->R.data(), p->R.data() + 9);
+    key.values.insert(key.values.end(), p->t.data(), p->t.data() + 3);
+  }
+  key.values.insert(key.values.end(), {padding, static_cast<double>(mode), tol.gjk_relative, tol.gjk_absolute,
+                                       static_cast<double>(tol.gjk_max_iterations), tol.cast_relative,
+                                       static_cast<double>(tol.cast_max_iterations), tol.epa_relative,
+                                       static_cast<double>(tol.epa_max_iterations)});
+  // (A NaN would break the keys' order: such a question is answered afresh.)
+  if (std::any_of(key.values.begin(), key.values.end(), [](double v) { return std::isnan(v); }))
+    return meshesIntersect(ga, pose_a, gb, pose_b, tol, mode, padding);
+  if (const std::optional<bool> known = memo.find(key)) return *known;
+  const bool meet = meshesIntersect(ga, pose_a, gb, pose_b, tol, mode, padding);
+  memo.store(std::move(key), geometry.linkPtr(a), geometry.linkPtr(b), meet);
+  return meet;
 }
 
 }  // namespace
@@ -302,8 +341,8 @@ void Scene::init() {
   computeLinkPoses(model, base_q_.data(), poses.data());
   if (description_.effects.self)
     for (const auto& [a, b] : static_pairs)
-      if (meshesIntersect(*geometry_->link(a), poses[a], *geometry_->link(b), poses[b], options_.tolerances,
-                          options_.mode, link_padding_[a] + link_padding_[b])) {
+      if (rigidPairIntersects(*geometry_, a, poses[a], b, poses[b], options_.tolerances, options_.mode,
+                              link_padding_[a] + link_padding_[b])) {
         static_collision_.kind = CollisionReport::Kind::Self;
         static_collision_.link = a;
         static_collision_.other_link = b;

@@ -1150,5 +1150,50 @@ TEST(Scene, PairsWithinOneRigidBodyAreCheckedOnce) {
   }
 }
 
+TEST(Scene, ARigidPairsAnswerIsRememberedPerPaddingAndRobot) {
+  // Scenes over one loaded robot share the answers of its rigid pairs (searched once, not per scene), yet
+  // what each scene is told depends on its own padding and its own robot. The finger is fixed 0.45 m clear
+  // of the arm, past a mount that keeps the two from being adjacent.
+  const auto urdf = [](double finger_x) {
+    const auto box = [](const char* size) {
+      return std::string("<collision><geometry><box size=\"") + size + "\"/></geometry></collision>";
+    };
+    return std::string("<robot name=\"rigid\"><link name=\"base\"/><link name=\"arm\">") + box("0.6 0.1 0.1") +
+           "</link><link name=\"mount\">" + box("0.02 0.02 0.02") + "</link><link name=\"finger\">" +
+           box("0.1 0.1 0.1") +
+           "</link><joint name=\"turn\" type=\"revolute\"><parent link=\"base\"/><child link=\"arm\"/>"
+           "<axis xyz=\"0 0 1\"/><limit lower=\"-3\" upper=\"3\" effort=\"1\" velocity=\"1\"/></joint>"
+           "<joint name=\"to_mount\" type=\"fixed\"><parent link=\"arm\"/><child link=\"mount\"/>"
+           "<origin xyz=\"0.5 0 0.3\"/></joint><joint name=\"to_finger\" type=\"fixed\"><parent link=\"mount\"/>"
+           "<child link=\"finger\"/><origin xyz=\"" +
+           std::to_string(finger_x - 0.5) + " 0 -0.3\"/></joint></robot>";
+  };
+  TempDir dir;
+  const auto scene = [&](const std::string& robot_file, const std::shared_ptr<const RobotGeometry>& robot,
+                         double padding) {
+    SceneDescription d = parseSceneFile(dir.write(
+        "rigid.yaml", "format: 1\nname: rigid\nrobot:\n  urdf: " + robot_file + "\n  group: [turn]\nchecks: [self]\n"));
+    d.padding = padding;
+    const auto r = robot ? robot : loadRobotGeometry(d);
+    return std::make_shared<const Scene>(d, r, std::make_shared<const Environment>());
+  };
+  const std::string clear_file = dir.write("clear.urdf", urdf(0.8));
+  const std::shared_ptr<const RobotGeometry> clear = scene(clear_file, nullptr, 0.0)->geometryPtr();
+  // A padding of p per link meets across the gap when 2p >= 0.45.
+  for (const double padding : {0.2, 0.25, 0.0, 0.2, 0.25}) {
+    const bool meet = padding > 0.225;
+    EXPECT_EQ(scene(clear_file, clear, padding)->staticCollision().kind,
+              meet ? CollisionReport::Kind::Self : CollisionReport::Kind::None)
+        << "padding " << padding;
+  }
+  // Another robot, loaded from other bytes, is asked afresh (whatever addresses its links happen to get).
+  for (int k = 0; k < 3; ++k) {
+    const std::string over_file = dir.write("over.urdf", urdf(k % 2 == 0 ? 0.2 : 0.8));
+    EXPECT_EQ(scene(over_file, nullptr, 0.0)->staticCollision().kind,
+              k % 2 == 0 ? CollisionReport::Kind::Self : CollisionReport::Kind::None)
+        << "load " << k;
+  }
+}
+
 }  // namespace
 }  // namespace clearway
