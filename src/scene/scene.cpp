@@ -330,7 +330,7 @@ void Scene::init() {
   so.tolerances = options_.tolerances;
   so.link_padding = link_padding_;
   // Variables outside the group keep their base values in every query (computePoses writes only the group).
-  so.pair_tables = options_.pair_tables;
+  so.pair_tables = options_.pair_tables && description_.effects.self;  // (none for a check not made)
   so.table_seconds = options_.pair_table_seconds;
   so.held = base_q_;
   for (int v : group_variables_) so.held[v] = std::numeric_limits<double>::quiet_NaN();

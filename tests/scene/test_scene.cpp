@@ -1195,5 +1195,23 @@ TEST(Scene, ARigidPairsAnswerIsRememberedPerPaddingAndRobot) {
   }
 }
 
+TEST(Scene, NoPairTablesForASceneThatLeavesOutSelf) {
+  // Simulate only the effects a scene calls for: tables are a self check's, and take most of a load.
+  SceneDescription d = parseSceneFile(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/arm6_wall.yaml");
+  ASSERT_TRUE(d.effects.self && d.effects.environment);
+  const auto tabled = [](const Scene& scene) {
+    int n = 0;
+    for (std::size_t k = 0; k < scene.selfCollision().pairs().size(); ++k)
+      n += scene.selfCollision().pairTable(k) != nullptr;
+    return n;
+  };
+  EXPECT_GT(tabled(Scene(d)), 0);
+  d.effects.self = false;
+  const long long built = PairTable::cacheStats().built;
+  const Scene environment_only(d);
+  EXPECT_EQ(tabled(environment_only), 0);
+  EXPECT_EQ(PairTable::cacheStats().built, built) << "no table was built";
+}
+
 }  // namespace
 }  // namespace clearway

@@ -99,7 +99,7 @@ struct SceneOptions {
   /// COLLADA up axis).
   LoadOptions load;
   /// Tabulate the self pairs moved by one or two joints, or three whose lowest turns the lower link, at load
-  /// (scene/pair_table.h): same verdicts, faster queries, a longer load.
+  /// (scene/pair_table.h): same verdicts, faster queries, a longer load. None when the checks leave out self.
   bool pair_tables = true;
   /// Seconds the tables may take to build (SelfCollisionOptions::table_seconds): none by default.
   double pair_table_seconds = std::numeric_limits<double>::infinity();
