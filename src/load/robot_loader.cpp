@@ -15,10 +15,13 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <iomanip>
 #include <map>
 #include <mutex>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 #include <tuple>
 #include <unordered_map>
@@ -274,9 +277,19 @@ void Loader::buildJoints(const urdf::ModelInterface& model) {
       j.mimic.joint = next.joint;
     }
     const Joint& leader = joints_[j.mimic.joint];
+    const std::string& element = outline_.joints[outline_.joint_order[&j - joints_.data()]].element;
     if (jointVariableCount(leader.type) != 1)
-      throw LoadError(urdf_, outline_.joints[outline_.joint_order[&j - joints_.data()]].element,
+      throw LoadError(urdf_, element,
                       "mimics '" + leader.name + "', a " + jointTypeName(leader.type) + " joint (not one variable)");
+    // Bounded as a held value is: a multiplier of 1e300 placed a link 1e300 m away (at infinity, composed).
+    for (const auto& [what, value] : {std::pair{"multiplier", j.mimic.multiplier}, std::pair{"offset", j.mimic.offset}})
+      if (!(std::abs(value) <= kMaxJointValue)) {
+        std::ostringstream text;
+        text << std::setprecision(17) << value;
+        throw LoadError(urdf_, element,
+                        std::string("mimic ") + what + " " + text.str() + " (composed along its chain of mimics) " +
+                            "is beyond ±1e6, the largest joint value an input may give");
+      }
   }
 }
 

@@ -171,6 +171,31 @@ TEST_F(BadInput, Mimics) {
     <joint name="j2" type="planar"><parent link="b"/><child link="c"/><mimic joint="j1"/></joint>
   </robot>)");
   EXPECT_LOAD_ERROR(loadRobot(planar), planar, "joint 'j2'", "a planar joint cannot mimic");
+  // Multipliers and offsets are bounded as joint values are (a link 1e300 m away was placed), also once
+  // composed along a chain of mimics (1e4 · 1e4 = 1e8); within the bound, as any real gear is, they load.
+  const auto chain = [&](const std::string& m2, const std::string& o2, const std::string& m3) {
+    return dir.write("mimic_far.urdf", R"(<robot name="r">
+    <link name="a"/><link name="b"/><link name="c"/><link name="d"/>
+    <joint name="j1" type="continuous"><parent link="a"/><child link="b"/></joint>
+    <joint name="j2" type="prismatic"><parent link="b"/><child link="c"/><limit lower="0" upper="1" effort="1" velocity="1"/>
+      <mimic joint="j1" multiplier=")" + m2 +
+                                           R"(" offset=")" + o2 + R"("/></joint>
+    <joint name="j3" type="prismatic"><parent link="c"/><child link="d"/><limit lower="0" upper="1" effort="1" velocity="1"/>
+      <mimic joint="j2" multiplier=")" + m3 +
+                                           R"("/></joint>
+  </robot>)");
+  };
+  const std::string far = chain("1e300", "0", "1");
+  EXPECT_LOAD_ERROR(loadRobot(far), far, "joint 'j2'", "mimic multiplier 1.0000000000000001e+300 (composed");
+  const std::string offset = chain("1", "-2e6", "1");
+  EXPECT_LOAD_ERROR(loadRobot(offset), offset, "joint 'j2'",
+                    "mimic offset -2000000 (composed along its chain of mimics) "
+                    "is beyond ±1e6");
+  const std::string composed = chain("1e4", "0", "1e4");
+  EXPECT_LOAD_ERROR(loadRobot(composed), composed, "joint 'j3'", "mimic multiplier 100000000 (composed");
+  const std::string geared = chain("-2.5", "0.1", "1e4");
+  const RobotModel m = loadRobot(geared);
+  EXPECT_EQ(m.joint(m.jointIndex("j3")).mimic.multiplier, -2.5e4);
 }
 
 TEST_F(BadInput, AMimicOnAFixedJointIsIgnoredWithAWarning) {
