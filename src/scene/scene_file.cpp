@@ -15,6 +15,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -366,8 +367,19 @@ class Parser {
       }
       if (const YAML::Node obs = env["obstacles"]; obs && !obs.IsNull()) {
         if (!obs.IsSequence()) fail("environment.obstacles", "expected a list" + where(obs));
-        for (std::size_t i = 0; i < obs.size(); ++i)
-          obstacle(obs[i], "environment.obstacles[" + std::to_string(i) + "]", d);
+        std::map<std::string, std::size_t> first;  // the first obstacle of each name
+        for (std::size_t i = 0; i < obs.size(); ++i) {
+          const std::string key = "environment.obstacles[" + std::to_string(i) + "]";
+          obstacle(obs[i], key, d);
+          // Both are kept and checked (as MoveIt keeps two shapes under one id), but a report or an edit
+          // naming them cannot say which one.
+          const auto [at, added] = first.emplace(d.obstacles.back().name, i);
+          if (!added)
+            warnings_.push_back(LoadError::format(
+                file_, "key '" + key + ".name'",
+                "'" + inputExcerpt(at->first) + "' also names obstacles[" + std::to_string(at->second) +
+                    "]: both are checked, but a report naming it does not say which, and edits by name refuse it"));
+        }
       }
     }
 

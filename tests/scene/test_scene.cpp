@@ -73,6 +73,29 @@ TEST(SceneFile, ObstaclesTheChecksOmitAreSaid) {
   EXPECT_TRUE(parseSceneFile(dir.write("none.yaml", planarScene("[self]", ""))).warnings.empty());
 }
 
+// Two obstacles of one name: both kept and checked (MoveIt keeps shapes under one id), but said, since a
+// report naming it cannot tell them apart (nor can an edit by name, which refuses it).
+TEST(SceneFile, ObstaclesOfOneNameAreSaid) {
+  TempDir dir;
+  const std::string two =
+      dir.write("two.yaml", planarScene("[self, environment]",
+                                        "    - {name: wall, box: {size: [0.1, 2, 1]}, pose: {position: [1.2, 0, 0]}}\n"
+                                        "    - {name: post, sphere: {radius: 0.1}, pose: {position: [0, 3, 0]}}\n"
+                                        "    - {name: wall, sphere: {radius: 0.1}, pose: {position: [0, -3, 0]}}\n"));
+  const SceneDescription d = parseSceneFile(two);
+  EXPECT_EQ(d.obstacles.size(), 3u);
+  ASSERT_EQ(d.warnings.size(), 1u);
+  EXPECT_NE(d.warnings[0].find(two + ": key 'environment.obstacles[2].name': 'wall' also names obstacles[0]: both are "
+                                     "checked"),
+            std::string::npos)
+      << d.warnings[0];
+  // Unnamed obstacles take their keys as names: never the same.
+  EXPECT_TRUE(parseSceneFile(dir.write("unnamed.yaml", planarScene("[self, environment]",
+                                                                   "    - {sphere: {radius: 0.1}}\n"
+                                                                   "    - {sphere: {radius: 0.2}}\n")))
+                  .warnings.empty());
+}
+
 // A mesh obstacle's errors and warnings name the scene file and the obstacle's key, then the mesh file and
 // the reason; an open mesh (a surface: a body wholly inside it does not collide) is said as for a robot's
 // link. (The errors named the mesh alone, and the warnings were dropped.)
