@@ -1,4 +1,6 @@
 #pragma once
+
+#include <vector>
 // Every tolerance and iteration cap of the narrow phase, with its unit and meaning, in one place.
 // Queries take a Tolerances by const reference; nothing here is global or mutable.
 
@@ -25,5 +27,13 @@ struct Tolerances {
   /// EPA: iteration cap (also bounded by the fixed polytope capacity).
   int epa_max_iterations = 96;
 };
+
+/// Appends every field of t to `out`, in a fixed order: the part of a key that results computed with these
+/// tolerances are remembered by (one list, so that a field added here reaches every such key).
+inline void appendTolerances(const Tolerances& t, std::vector<double>& out) {
+  out.insert(out.end(),
+             {t.gjk_relative, t.gjk_absolute, static_cast<double>(t.gjk_max_iterations), t.cast_relative,
+              static_cast<double>(t.cast_max_iterations), t.epa_relative, static_cast<double>(t.epa_max_iterations)});
+}
 
 }  // namespace clearway

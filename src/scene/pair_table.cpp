@@ -353,13 +353,12 @@ TableCache& tableCache() {
 
 std::vector<double> tableSettings(double padding, GeometryMode mode, const Tolerances& t,
                                   const std::vector<double>& held, const PairTableOptions& p) {
-  std::vector<double> s = {padding, static_cast<double>(mode), t.gjk_relative, t.gjk_absolute,
-                           static_cast<double>(t.gjk_max_iterations), t.cast_relative,
-                           static_cast<double>(t.cast_max_iterations), t.epa_relative,
-                           static_cast<double>(t.epa_max_iterations), static_cast<double>(p.coarse_one),
-                           static_cast<double>(p.fine_one), static_cast<double>(p.coarse_two),
-                           static_cast<double>(p.fine_two), static_cast<double>(p.max_checks), p.min_probe_share,
-                           static_cast<double>(p.max_exact_checks), static_cast<double>(p.max_exact_triangles)};
+  std::vector<double> s = {padding, static_cast<double>(mode)};
+  appendTolerances(t, s);
+  s.insert(s.end(),
+           {static_cast<double>(p.coarse_one), static_cast<double>(p.fine_one), static_cast<double>(p.coarse_two),
+            static_cast<double>(p.fine_two), static_cast<double>(p.max_checks), p.min_probe_share,
+            static_cast<double>(p.max_exact_checks), static_cast<double>(p.max_exact_triangles)});
   for (double h : held) s.push_back(std::isfinite(h) ? h : -std::numeric_limits<double>::infinity());
   return s;
 }

@@ -60,10 +60,8 @@ bool rigidPairIntersects(const RobotGeometry& geometry, int a, const Pose& pose_
     key.values.insert(key.values.end(), p->R.data(), p->R.data() + 9);
     key.values.insert(key.values.end(), p->t.data(), p->t.data() + 3);
   }
-  key.values.insert(key.values.end(), {padding, static_cast<double>(mode), tol.gjk_relative, tol.gjk_absolute,
-                                       static_cast<double>(tol.gjk_max_iterations), tol.cast_relative,
-                                       static_cast<double>(tol.cast_max_iterations), tol.epa_relative,
-                                       static_cast<double>(tol.epa_max_iterations)});
+  key.values.insert(key.values.end(), {padding, static_cast<double>(mode)});
+  appendTolerances(tol, key.values);
   // (A NaN would break the keys' order: such a question is answered afresh.)
   if (std::any_of(key.values.begin(), key.values.end(), [](double v) { return std::isnan(v); }))
     return meshesIntersect(ga, pose_a, gb, pose_b, tol, mode, padding);
