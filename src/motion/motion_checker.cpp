@@ -4,10 +4,12 @@
 
 #include <clearway/body/proximity.h>
 #include <clearway/detail/margins.h>
+#include <clearway/detail/weak_memo.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <tuple>
 
@@ -22,6 +24,45 @@ namespace {
 
 // Environment items keep a GJK warm start per static obstacle up to this many obstacles (2.5 KiB a link).
 constexpr std::size_t kWarmObstacles = 64;
+
+// A rigid body's links merged into one geometry in its anchor's frame, remembered while its robot lives:
+// every checker over a loaded robot (each scene, each form of it) merges the same links at the same
+// offsets again, and on a gripper bolted to a force sensor that is most of a checker's construction (hull,
+// tree, cores and convex parts of thousands of triangles). Keyed by the robot, the members and each
+// member's offset: the merge reads nothing else.
+struct MergedKey {
+  const RobotGeometry* robot;
+  std::vector<int> members;
+  std::vector<double> offsets;
+  bool operator<(const MergedKey& o) const {
+    return std::tie(robot, members, offsets) < std::tie(o.robot, o.members, o.offsets);
+  }
+};
+
+std::shared_ptr<const LinkGeometry> mergedGeometry(const std::shared_ptr<const RobotGeometry>& robot,
+                                                   const std::vector<int>& members, const std::vector<Pose>& offsets) {
+  static detail::WeakMemo<MergedKey, std::shared_ptr<const LinkGeometry>, RobotGeometry> memo;
+  const RobotModel& model = robot->model();
+  MergedKey key{robot.get(), members, {}};
+  for (const Pose& p : offsets) {
+    key.offsets.insert(key.offsets.end(), p.R.data(), p.R.data() + 9);
+    key.offsets.insert(key.offsets.end(), p.t.data(), p.t.data() + 3);
+  }
+  // (A NaN would break the keys' order: such a body is merged afresh.)
+  const bool keyed = std::none_of(key.offsets.begin(), key.offsets.end(), [](double v) { return std::isnan(v); });
+  if (keyed)
+    if (std::optional<std::shared_ptr<const LinkGeometry>> known = memo.find(key)) return std::move(*known);
+  // Every member's elements, placed in the anchor's frame (fixed: the joints in between do not move).
+  std::vector<CollisionElement> elements;
+  for (std::size_t i = 0; i < members.size(); ++i)
+    for (CollisionElement e : model.link(members[i]).collisions) {
+      e.origin = offsets[i] * e.origin;
+      elements.push_back(std::move(e));
+    }
+  auto merged = std::make_shared<const LinkGeometry>(elements, model.meshes());
+  if (keyed) memo.store(std::move(key), robot, robot, merged);
+  return merged;
+}
 
 }  // namespace
 
@@ -39,17 +80,10 @@ MotionChecker::Bodies MotionChecker::mergeBodies(const Scene& scene) {
   out.reference = ctx.poses();
   for (int anchor = 0; anchor < model.linkCount(); ++anchor) {
     if (members[anchor].size() < 2) continue;
-    // Every member's elements, placed in the anchor's frame (fixed: the joints in between do not move).
-    std::vector<CollisionElement> elements;
-    for (const int l : members[anchor]) {
-      const Pose in_anchor = relativePose(out.reference[anchor], out.reference[l]);
-      for (CollisionElement e : model.link(l).collisions) {
-        e.origin = in_anchor * e.origin;
-        elements.push_back(std::move(e));
-      }
-    }
+    std::vector<Pose> offsets;
+    for (const int l : members[anchor]) offsets.push_back(relativePose(out.reference[anchor], out.reference[l]));
     for (const int l : members[anchor]) out.index[l] = static_cast<int>(out.list.size());
-    out.geometry.push_back(std::make_shared<const LinkGeometry>(elements, model.meshes()));
+    out.geometry.push_back(mergedGeometry(scene.geometryPtr(), members[anchor], offsets));
     const LinkGeometry& g = *out.geometry.back();
     out.list.push_back({anchor, &g.hull(), g.sphereCenter(), g.sphereRadius()});
   }

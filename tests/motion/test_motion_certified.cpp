@@ -163,6 +163,56 @@ TEST(MotionCertified, RigidBodiesAreOneItemUntilNear) {
   EXPECT_LE(hit.first_contact, fine.check(a0, b1, fc).first_contact + 1e-9);
 }
 
+TEST(MotionCertified, AMergedBodyIsItsOwnScenesAndRobots) {
+  // An arm and a flap on a held joint at its end move as one body, merged once per robot and remembered:
+  // yet each scene merges at its own held value and each robot from its own links. Turning the arm 0.4 rad
+  // sweeps a flap that points on along the arm (fold 0) through the post at radius 0.74, while a flap
+  // folded back (fold -pi/2) stays within radius 0.59 and 0.2 m of the post's side.
+  const auto urdf = [](double flap_length) {
+    const std::string l = std::to_string(flap_length);
+    return "<robot name=\"flap\"><link name=\"base\"/><link name=\"arm\"><collision><origin xyz=\"0.25 0 0\"/>"
+           "<geometry><box size=\"0.5 0.05 0.05\"/></geometry></collision></link><link name=\"flap\"><collision>"
+           "<origin xyz=\"" +
+           std::to_string(flap_length / 2) + " 0 0\"/><geometry><box size=\"" + l +
+           " 0.05 0.05\"/></geometry></collision></link><joint name=\"turn\" type=\"revolute\"><parent link=\"base\"/>"
+           "<child link=\"arm\"/><axis xyz=\"0 0 1\"/><limit lower=\"-3\" upper=\"3\" effort=\"1\" velocity=\"1\"/>"
+           "</joint><joint name=\"fold\" type=\"revolute\"><origin xyz=\"0.5 0 0\"/><parent link=\"arm\"/>"
+           "<child link=\"flap\"/><axis xyz=\"0 0 1\"/><limit lower=\"-3\" upper=\"3\" effort=\"1\" velocity=\"1\"/>"
+           "</joint></robot>";
+  };
+  TempDir dir;
+  const auto description = [&](const std::string& urdf_file, double fold) {
+    return parseSceneFile(dir.write(
+        "flap.yaml", "format: 1\nname: flap\nrobot:\n  urdf: " + urdf_file +
+                         "\n  group: [turn]\n  hold: {fold: " + std::to_string(fold) +
+                         "}\nenvironment:\n  obstacles:\n    - {name: post, box: {size: [0.05, "
+                         "0.05, 0.3]}, pose: {position: [0.7, 0.25, 0]}}\nchecks: [environment, continuous]\n"));
+  };
+  const double q0[1] = {0}, q1[1] = {0.4};
+  const auto free = [&](const SceneDescription& d, const std::shared_ptr<const RobotGeometry>& robot) {
+    const auto scene = std::make_shared<const Scene>(d, robot, loadEnvironment(d));
+    const MotionChecker certified(scene);
+    MotionContext ctx = certified.makeContext();
+    const MotionResult r = certified.check(q0, q1, ctx);
+    EXPECT_FALSE(r.capped);
+    return r.free;
+  };
+  const std::string long_flap = dir.write("long.urdf", urdf(0.3));
+  {
+    // (Folded first: a merge remembered without its offsets would place the flap folded at fold 0 too.)
+    const std::shared_ptr<const RobotGeometry> robot = loadRobotGeometry(description(long_flap, 0.0));
+    for (const double fold : {-M_PI / 2, 0.0, -M_PI / 2, 0.0})
+      EXPECT_EQ(free(description(long_flap, fold), robot), fold != 0.0) << "fold " << fold;
+  }
+  // Two robots alive at once, alike but for the flap's length, whose merged bodies have the same links and
+  // offsets: each is merged from its own links (the short flap does not reach the post).
+  const SceneDescription short_scene = description(dir.write("short.urdf", urdf(0.1)), 0.0);
+  const SceneDescription long_scene = description(long_flap, 0.0);
+  const auto short_robot = loadRobotGeometry(short_scene), long_robot = loadRobotGeometry(long_scene);
+  for (int k = 0; k < 4; ++k)
+    EXPECT_EQ(k % 2 == 0 ? free(short_scene, short_robot) : free(long_scene, long_robot), k % 2 == 0) << "robot " << k;
+}
+
 TEST(MotionCertified, ConcaveLinkAroundAPostIsDecidedByItsElements) {
   // One link, a fork of three boxes (the gripper's palm and fingers as one link): its hull covers the
   // post between the prongs, but the prongs stay 38 mm clear of it, as dense sampling says.
