@@ -2,7 +2,8 @@
 # The test command: installs dependencies, builds with AddressSanitizer and UndefinedBehaviorSanitizer,
 # and runs every test through CTest, then lists the GoogleTest cases skipped. The benchmark programs
 # (benchmarks/, FCL side by side) are left to the Release build they are run from (benchmarks/build_bench.sh):
-# compiling them sanitized, only not to run them, cost CI minutes. `clearway bench`'s suites are part of the tool and built here.
+# compiling them sanitized, only not to run them, cost CI minutes. `clearway bench`'s suites are part of
+# the tool and built here.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -11,14 +12,16 @@ BUILD=${BUILD:-build-test}
 # About 16 GoogleTest cases per process (tests/CMakeLists.txt): sanitized, a robot's load costs more than
 # most cases, and the cases of one process share it.
 cmake -S . -B "$BUILD" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DCLEARWAY_SANITIZE=ON \
-  -DCLEARWAY_BUILD_TESTS=ON -DCLEARWAY_BUILD_BENCHMARKS=OFF -DCLEARWAY_BUILD_TOOLS=ON -DCLEARWAY_TEST_CASES_PER_PROCESS=16
+  -DCLEARWAY_BUILD_TESTS=ON -DCLEARWAY_BUILD_BENCHMARKS=OFF -DCLEARWAY_BUILD_TOOLS=ON \
+  -DCLEARWAY_TEST_CASES_PER_PROCESS=16
 cmake --build "$BUILD" -j2
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 ctest --test-dir "$BUILD" --output-on-failure -j2
 # CTest then names processes, not cases: GoogleTest's log names the cases it skipped, and why.
 log=$BUILD/Testing/Temporary/LastTest.log
 cases=$({ grep -hE '^\[==========\] [0-9]+ tests? from .* ran' "$log" || true; } | awk '{n += $2} END {print n + 0}')
-skipped=$({ grep -hE '^\[  SKIPPED \] [A-Za-z0-9_]+\.[A-Za-z0-9_]+ \(' "$log" || true; } | sed -E 's/^\[  SKIPPED \] ([^ ]+) .*/\1/' | sort -u)
+skipped=$({ grep -hE '^\[  SKIPPED \] [A-Za-z0-9_]+\.[A-Za-z0-9_]+ \(' "$log" || true; } |
+  sed -E 's/^\[  SKIPPED \] ([^ ]+) .*/\1/' | sort -u)
 echo "test.sh: $cases GoogleTest cases ran; skipped: $(printf '%s' "$skipped" | grep -c . || true)"
 if [ -n "$skipped" ]; then
   printf '  %s\n' $skipped
