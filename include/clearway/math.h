@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <vector>
 
 namespace clearway {
 
@@ -43,6 +44,13 @@ struct Pose {
     return zero == 0.0;
   }
 };
+
+/// Appends p's twelve entries (R column by column, then t) to `out`: the part of a key that results computed
+/// at this pose are remembered by (one list for every such key).
+inline void appendPose(const Pose& p, std::vector<double>& out) {
+  out.insert(out.end(), p.R.data(), p.R.data() + 9);
+  out.insert(out.end(), p.t.data(), p.t.data() + 3);
+}
 
 /// The pose of frame b expressed in frame a: inverse(a) * b, computed without forming the inverse.
 inline Pose relativePose(const Pose& a, const Pose& b) {

@@ -1,8 +1,8 @@
 #pragma once
-
-#include <vector>
 // Every tolerance and iteration cap of the narrow phase, with its unit and meaning, in one place.
 // Queries take a Tolerances by const reference; nothing here is global or mutable.
+
+#include <vector>
 
 namespace clearway {
 

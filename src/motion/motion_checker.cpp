@@ -44,10 +44,7 @@ std::shared_ptr<const LinkGeometry> mergedGeometry(const std::shared_ptr<const R
   static detail::WeakMemo<MergedKey, std::shared_ptr<const LinkGeometry>, RobotGeometry> memo;
   const RobotModel& model = robot->model();
   MergedKey key{robot.get(), members, {}};
-  for (const Pose& p : offsets) {
-    key.offsets.insert(key.offsets.end(), p.R.data(), p.R.data() + 9);
-    key.offsets.insert(key.offsets.end(), p.t.data(), p.t.data() + 3);
-  }
+  for (const Pose& p : offsets) appendPose(p, key.offsets);
   // (A NaN would break the keys' order: such a body is merged afresh.)
   const bool keyed = std::none_of(key.offsets.begin(), key.offsets.end(), [](double v) { return std::isnan(v); });
   if (keyed)

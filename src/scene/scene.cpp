@@ -56,10 +56,8 @@ bool rigidPairIntersects(const RobotGeometry& geometry, int a, const Pose& pose_
   const LinkGeometry& ga = *geometry.link(a);
   const LinkGeometry& gb = *geometry.link(b);
   RigidPairKey key{&ga, &gb, {}};
-  for (const Pose* p : {&pose_a, &pose_b}) {
-    key.values.insert(key.values.end(), p->R.data(), p->R.data() + 9);
-    key.values.insert(key.values.end(), p->t.data(), p->t.data() + 3);
-  }
+  appendPose(pose_a, key.values);
+  appendPose(pose_b, key.values);
   key.values.insert(key.values.end(), {padding, static_cast<double>(mode)});
   appendTolerances(tol, key.values);
   // (A NaN would break the keys' order: such a question is answered afresh.)
