@@ -22,7 +22,7 @@ packages=(
   doxygen                            # the API reference (target clearway_docs)
   libfcl-dev                         # benchmarks only: FCL side by side
   gnuplot-nox                        # benchmark plots (PNG)
-  clang libfuzzer-14-dev             # scripts/fuzz.sh: the libFuzzer targets in fuzz/
+  clang libfuzzer-14-dev             # scripts/test.sh (the sanitized build), scripts/fuzz.sh (libFuzzer, fuzz/)
   slurmd slurmctld slurm-client munge parallel  # clearway bench shards: the one-node Slurm test (GNU parallel without root)
 )
 missing=()
