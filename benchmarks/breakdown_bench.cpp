@@ -5,8 +5,12 @@
 // segments as RRTConnect draws them (a fifth of the bounds' extent at most): free and colliding certified
 // motions (verdict only, 1 mm contact), their distance queries, and how many colliding ones no query settled.
 // Times are the best of five rounds, one thread; compare shares and ratios, not nanoseconds across machines.
+// Instructions, which do not depend on the machine's load: one round (--once) under callgrind, then each
+// phase function's inclusive count over the items it printed, e.g.
+//   valgrind --tool=callgrind bench_breakdown --once --states 3000 SCENE.yaml
+//   callgrind_annotate --inclusive=yes callgrind.out.* | grep phase
 //
-// Usage: bench_breakdown [--states N] [SCENE.yaml ...]   (default: problem 0001 of box_panda and box_ur5)
+// Usage: bench_breakdown [--states N] [--once] [SCENE.yaml ...]   (default: problem 0001 of box_panda, box_ur5)
 #include <clearway/motion/motion.h>
 #include <clearway/scene/scene.h>
 #include <clearway/scene/scene_file.h>
@@ -31,16 +35,62 @@ namespace cw = clearway;
 
 namespace {
 
-// The best of five rounds of `body`, in nanoseconds per item.
+int g_rounds = 5;
+
+// The best of g_rounds rounds of `body`, in nanoseconds per item.
 template <class Body>
 double bestNs(std::size_t items, Body&& body) {
   double best = INFINITY;
-  for (int round = 0; round < 5; ++round) {
+  for (int round = 0; round < g_rounds; ++round) {
     const auto t0 = std::chrono::steady_clock::now();
     body();
     best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   }
   return items ? 1e9 * best / static_cast<double>(items) : 0.0;
+}
+
+// The phases, each a function of its own so that callgrind counts it (inclusive): states flat, n values each.
+// Each first stores its number, so that no two have the same code (identical functions may be folded into
+// one, and callgrind would count them together).
+volatile int g_phase = 0;
+[[gnu::noinline]] void phasePoses(const cw::Scene& scene, const std::vector<double>& states, cw::SceneContext& ctx) {
+  g_phase = 1;
+  const std::size_t n = static_cast<std::size_t>(scene.dimension());
+  for (std::size_t i = 0; i < states.size() / n; ++i) scene.computePoses(&states[i * n], ctx);
+}
+[[gnu::noinline]] void phasePosesAndSelf(const cw::Scene& scene, const std::vector<double>& states,
+                                         cw::SceneContext& ctx, cw::SelfCollisionContext& self_ctx) {
+  g_phase = 2;
+  const std::size_t n = static_cast<std::size_t>(scene.dimension());
+  for (std::size_t i = 0; i < states.size() / n; ++i) {
+    scene.computePoses(&states[i * n], ctx);
+    scene.selfCollision().firstCollision(ctx.poses().data(), self_ctx, ctx.jointValues().data());
+  }
+}
+[[gnu::noinline]] void phaseFreeStates(const cw::Scene& scene, const std::vector<double>& states,
+                                       cw::SceneContext& ctx) {
+  g_phase = 3;
+  const std::size_t n = static_cast<std::size_t>(scene.dimension());
+  for (std::size_t i = 0; i < states.size() / n; ++i) scene.isFree(&states[i * n], ctx);
+}
+[[gnu::noinline]] void phaseCollidingStates(const cw::Scene& scene, const std::vector<double>& states,
+                                            cw::SceneContext& ctx) {
+  g_phase = 4;
+  const std::size_t n = static_cast<std::size_t>(scene.dimension());
+  for (std::size_t i = 0; i < states.size() / n; ++i) scene.isFree(&states[i * n], ctx);
+}
+[[gnu::noinline]] void phaseFreeMotions(const cw::MotionChecker& checker, const std::vector<std::vector<double>>& from,
+                                        const std::vector<std::vector<double>>& to,
+                                        const std::vector<std::size_t>& which, cw::MotionContext& ctx) {
+  g_phase = 5;
+  for (const std::size_t k : which) checker.check(from[k].data(), to[k].data(), ctx, false);
+}
+[[gnu::noinline]] void phaseCollidingMotions(const cw::MotionChecker& checker,
+                                             const std::vector<std::vector<double>>& from,
+                                             const std::vector<std::vector<double>>& to,
+                                             const std::vector<std::size_t>& which, cw::MotionContext& ctx) {
+  g_phase = 6;
+  for (const std::size_t k : which) checker.check(from[k].data(), to[k].data(), ctx, false);
 }
 
 void breakdown(const std::string& file, int count) {
@@ -64,21 +114,10 @@ void breakdown(const std::string& file, int count) {
   const std::size_t nf = free_flat.size() / n, nc = colliding_flat.size() / n, na = all_flat.size() / n;
   const cw::SelfCollision& self = scene->selfCollision();
   cw::SelfCollisionContext self_ctx = self.makeContext();
-  const double poses = bestNs(nf, [&] {
-    for (std::size_t i = 0; i < nf; ++i) scene->computePoses(&free_flat[i * n], ctx);
-  });
-  const double with_self = bestNs(nf, [&] {
-    for (std::size_t i = 0; i < nf; ++i) {
-      scene->computePoses(&free_flat[i * n], ctx);
-      self.firstCollision(ctx.poses().data(), self_ctx, ctx.jointValues().data());
-    }
-  });
-  const double free_state = bestNs(nf, [&] {
-    for (std::size_t i = 0; i < nf; ++i) scene->isFree(&free_flat[i * n], ctx);
-  });
-  const double colliding_state = bestNs(nc, [&] {
-    for (std::size_t i = 0; i < nc; ++i) scene->isFree(&colliding_flat[i * n], ctx);
-  });
+  const double poses = bestNs(nf, [&] { phasePoses(*scene, free_flat, ctx); });
+  const double with_self = bestNs(nf, [&] { phasePosesAndSelf(*scene, free_flat, ctx, self_ctx); });
+  const double free_state = bestNs(nf, [&] { phaseFreeStates(*scene, free_flat, ctx); });
+  const double colliding_state = bestNs(nc, [&] { phaseCollidingStates(*scene, colliding_flat, ctx); });
   const double one = bestNs(na, [&] {
     for (std::size_t i = 0; i < na; ++i) scene->isFree(&all_flat[i * n], ctx);
   });
@@ -124,17 +163,17 @@ void breakdown(const std::string& file, int count) {
   const double mixed = bestNs(from.size(), [&] {
     for (std::size_t k = 0; k < from.size(); ++k) checker.check(from[k].data(), to[k].data(), mctx, false);
   });
-  const auto only = [&](const std::vector<std::size_t>& which) {
-    return bestNs(which.size(), [&] {
-      for (const std::size_t k : which) checker.check(from[k].data(), to[k].data(), mctx, false);
-    });
-  };
+
   const double nfm = std::max<double>(1.0, static_cast<double>(free_motions.size()));
   const double ncm = std::max<double>(1.0, static_cast<double>(colliding_motions.size()));
-  std::printf("  motions (%zu, mixed): %.0f ns; free (%zu) %.0f ns alone, %.2f distance queries each; colliding (%zu) "
-              "%.0f ns alone, %.2f queries each, %ld settled with none\n",
-              from.size(), mixed, free_motions.size(), only(free_motions), free_queries / nfm, colliding_motions.size(),
-              only(colliding_motions), colliding_queries / ncm, colliding_without);
+  std::printf(
+      "  motions (%zu, mixed): %.0f ns; free (%zu) %.0f ns alone, %.2f distance queries each; colliding (%zu) "
+      "%.0f ns alone, %.2f queries each, %ld settled with none\n",
+      from.size(), mixed, free_motions.size(),
+      bestNs(free_motions.size(), [&] { phaseFreeMotions(checker, from, to, free_motions, mctx); }), free_queries / nfm,
+      colliding_motions.size(),
+      bestNs(colliding_motions.size(), [&] { phaseCollidingMotions(checker, from, to, colliding_motions, mctx); }),
+      colliding_queries / ncm, colliding_without);
 }
 
 }  // namespace
@@ -145,8 +184,10 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--states") && i + 1 < argc) {
       count = std::max(8, std::atoi(argv[++i]));
+    } else if (!std::strcmp(argv[i], "--once")) {
+      g_rounds = 1;
     } else if (argv[i][0] == '-') {
-      std::fprintf(stderr, "usage: bench_breakdown [--states N] [SCENE.yaml ...]\n");
+      std::fprintf(stderr, "usage: bench_breakdown [--states N] [--once] [SCENE.yaml ...]\n");
       return 2;
     } else {
       files.push_back(argv[i]);
