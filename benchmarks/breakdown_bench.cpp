@@ -1,9 +1,10 @@
 // Where a state check's and a certified motion's time goes, per shared problem (issue 41: a sphere stage
 // must beat every part at once, so each part's share is the first thing to know). For random states in the
-// bounds: free states' kinematics alone, kinematics and the self pairs, and the whole check (the rest is the
-// environment and the pair tables); colliding states; the same states eight to a call (Scene::areFree). For
-// segments as RRTConnect draws them (a fifth of the bounds' extent at most): free and colliding certified
-// motions (verdict only, 1 mm contact), their distance queries, and how many colliding ones no query settled.
+// bounds: free states' kinematics alone, kinematics and the self pairs (their tables' look-ups among them), and
+// the whole check (the rest: the environment and the check's own steps); colliding states; the same states
+// eight to a call (Scene::areFree). For segments as RRTConnect draws them (a fifth of the bounds' extent at
+// most): free and colliding certified motions (verdict only, 1 mm contact), their distance queries, and how
+// many colliding ones no query settled.
 // Times are the best of five rounds, one thread; compare shares and ratios, not nanoseconds across machines.
 // Instructions, which do not depend on the machine's load: one round (--once) under callgrind, then each
 // phase function's inclusive count over the items it printed, e.g.
@@ -127,12 +128,17 @@ void breakdown(const std::string& file, int count) {
   });
   std::printf("%s: %d joints, %zu checked self pairs\n", file.substr(file.find_last_of('/') + 1).c_str(), n,
               self.pairs().size());
+  if (nf == 0 || nc == 0) {
+    std::printf("  %zu free and %zu colliding states of %d: nothing to split\n", nf, nc, count);
+    return;
+  }
+  const double self_ns = with_self - poses, rest = free_state - with_self;
   std::printf("  free state (%zu): %.0f ns = kinematics %.0f (%.0f%%) + self pairs %.0f (%.0f%%) + environment and "
               "the rest %.0f (%.0f%%)\n",
-              nf, free_state, poses, 100 * poses / free_state, with_self - poses, 100 * (with_self - poses) / free_state,
-              free_state - with_self, 100 * (free_state - with_self) / free_state);
-  std::printf("  colliding state (%zu): %.0f ns; all states one per call %.0f ns, eight per call %.0f ns per state\n", nc,
-              colliding_state, one, eight);
+              nf, free_state, poses, 100 * poses / free_state, self_ns, 100 * self_ns / free_state, rest,
+              100 * rest / free_state);
+  std::printf("  colliding state (%zu): %.0f ns; all states one per call %.0f ns, eight per call %.0f ns per state\n",
+              nc, colliding_state, one, eight);
 
   // Segments: from a random state towards another, at most a fifth of the bounds' extent long.
   double extent = 0.0;

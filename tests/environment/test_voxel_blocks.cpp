@@ -249,9 +249,10 @@ TEST(VoxelBlocks, QueriesAgreeWithEveryVoxel) {
     pose.t = Vec3(uniform(-1.3, 1.3), uniform(-1.3, 1.3), uniform(-1.3, 1.3));
     const double padding = trial % 4 == 0 ? uniform(0.0, 0.03) : 0.0;
     // The brute force visits the voxels nearest the link's origin first, and skips only those that cannot
-    // matter by the triangle inequality: every point of linkOf's links lies within `reach` of pose.t (a
-    // corner of the farther box of two is (3.5·hx, hy, hz) in the link's frame), so a voxel whose box is
-    // g from pose.t is at least g − reach from the link. (Every voxel in turn cost a minute sanitized.)
+    // matter by the triangle inequality: every point of linkOf's links lies within 3.5·|half| of pose.t (a
+    // corner of the farther box of two is (3.5·hx, hy, hz) in the link's frame), so a voxel whose box is g
+    // from pose.t is at least g − reach from the link; reach's extra half |half| (17 mm at least) is far
+    // beyond any rounding band. (Every voxel for every trial is most of the test's time sanitized.)
     const double reach = 4.0 * half.norm();
     std::vector<std::pair<double, int>> by_gap;
     for (std::size_t v = 0; v < voxels.size(); ++v)
