@@ -5,7 +5,8 @@
 // eight to a call (Scene::areFree). For segments as RRTConnect draws them (a fifth of the bounds' extent at
 // most): free and colliding certified motions (verdict only, 1 mm contact), their distance queries, and how
 // many colliding ones no query settled.
-// Times are the best of five rounds, one thread; compare shares and ratios, not nanoseconds across machines.
+// Times are the best of five rounds of this thread's CPU time (bench_clock.h); compare shares and ratios, not
+// nanoseconds across machines.
 // Instructions, which do not depend on the machine's load: one round (--once) under callgrind, then each
 // phase function's inclusive count over the items it printed, e.g.
 //   valgrind --tool=callgrind bench_breakdown --once --states 3000 SCENE.yaml
@@ -18,7 +19,6 @@
 #include <clearway/scene/self_collision.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -27,6 +27,8 @@
 #include <random>
 #include <string>
 #include <vector>
+
+#include "bench_clock.h"
 
 #ifndef CLEARWAY_SHARED_DIR
 #define CLEARWAY_SHARED_DIR "../shared"
@@ -43,9 +45,9 @@ template <class Body>
 double bestNs(std::size_t items, Body&& body) {
   double best = INFINITY;
   for (int round = 0; round < g_rounds; ++round) {
-    const auto t0 = std::chrono::steady_clock::now();
+    const double t0 = cw::bench::threadSeconds();
     body();
-    best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    best = std::min(best, cw::bench::threadSeconds() - t0);
   }
   return items ? 1e9 * best / static_cast<double>(items) : 0.0;
 }
