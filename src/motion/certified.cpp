@@ -86,6 +86,10 @@ struct MotionChecker::Sweep {
   // Only the verdict is asked: the first measurement within contact settles it (it is a contact, if not
   // the first one), and nothing else is measured.
   bool verdict_only = false;
+  // The rake may place its finer levels' balls in lanes (the segment within the bounds the lanes were made
+  // for), and the lane of the piece it is testing (−1: placed one piece at a time).
+  bool points_in_lanes = false;
+  int lane = -1;
   bool stop() const noexcept { return capped || (verdict_only && hit); }
   // The cap on distance queries reached, or the caller's stop condition true (asked every 256 queries).
   bool overBudget() const noexcept {
@@ -519,13 +523,22 @@ struct MotionChecker::Sweep {
   enum class Raked { Settled, Halve, Near };
   // Body `body`'s bounding ball at the rake's current piece (placed once per piece: bodies share items),
   // grown by the rounding of its placed centre and of its radius (margins.h).
+  // At a level placed in lanes (lane ≥ 0), its centre is the lanes' and the radius grows by their error bound.
   const motion_detail::Scratch::RakeBall& rakeBall(int body, int frame, const LinkGeometry& g, double s) {
     motion_detail::Scratch::RakeBall& b = ctx.rake_balls[body];
     if (b.piece != ctx.rake_piece || b.geometry != &g) {  // (an index names one geometry; checked, not assumed)
-      const Pose& p = pose(s, frame);
-      b.center = p * g.sphereCenter();
-      b.radius =
-          g.sphereRadius() * (1.0 + margins::kRounding) + margins::placedRounding(g.sphereCenter().norm(), p.t.norm());
+      const int k = lane >= 0 ? mc.rake_point_[body] : -1;
+      if (k >= 0 && mc.rake_point_geometry_[body] == &g) {
+        constexpr int L = PointLanes::kLanes;
+        const float* x = ctx.rake_xyz.data() + 3 * k * L + lane;
+        b.center = Vec3(x[0], x[L], x[2 * L]);
+        b.radius = g.sphereRadius() * (1.0 + margins::kRounding) + mc.rake_points_.error(k);
+      } else {
+        const Pose& p = pose(s, frame);
+        b.center = p * g.sphereCenter();
+        b.radius = g.sphereRadius() * (1.0 + margins::kRounding) +
+                   margins::placedRounding(g.sphereCenter().norm(), p.t.norm());
+      }
       b.norm = b.center.norm();
       b.piece = ctx.rake_piece;
       b.geometry = &g;
@@ -601,6 +614,22 @@ struct MotionChecker::Sweep {
     mc.rake_rows_.apart(ctx.rake_x.data(), ctx.rake_y.data(), ctx.rake_z.data(), ctx.rake_r.data(),
                         ctx.rake_norm.data(), band, ctx.rake_apart.data());
   }
+  // The bodies' ball centres at the middle of each of the level's `pieces` pieces (of width 2·half), in float
+  // lanes: one pass where each piece's poses cost a pass of double kinematics. (Not for the whole segment:
+  // its one piece's poses serve the first measurement, in its middle, too.)
+  void placeInLanes(int pieces, double half) {
+    static_assert(kRakePieces <= PointLanes::kLanes, "a level's pieces in one pass");
+    const std::vector<int>& group = mc.scene_->groupVariables();
+    const double* q[PointLanes::kLanes];
+    for (int p = 0; p < pieces; ++p) {
+      mc.interpolate(q0, q1, (2 * p + 1) * half, ctx.q.data());
+      std::vector<double>& full = ctx.rake_lane_q[p];
+      for (std::size_t i = 0; i < group.size(); ++i) full[group[i]] = ctx.q[i];
+      q[p] = full.data();
+    }
+    mc.rake_points_.compute(q, pieces, ctx.rake_xyz.data(), ctx.rake_lane_scratch.data());
+  }
+
   // Self items due at the first piece from which the lanes pay: they place every body's ball and test every
   // pair, a few operations each (our dual arm's 500-odd pairs: 2.3% fewer instructions per free segment; the
   // Panda's and UR5's few due pairs would gain nothing).
@@ -636,9 +665,12 @@ struct MotionChecker::Sweep {
         for (const int k : due) self += mc.rake_pair_[k] >= 0;
         lanes = self >= kLanesFrom;
       }
+      const bool placed = points_in_lanes && step > 0;
+      if (placed) placeInLanes(pieces, half);
       for (int p = 0; p < pieces; ++p) {
         const double m = (2 * p + 1) * half;  // (exact: dyadic)
         ++ctx.rake_piece;
+        lane = placed ? p : -1;
         if (lanes) rakeInLanes(m, half);
         for (const int k : due) {
           if (!(ctx.rake_now[k] >> p & 1u)) continue;
@@ -652,6 +684,7 @@ struct MotionChecker::Sweep {
           }
         }
       }
+      lane = -1;
       for (const int k : next) ctx.rake_now[k] = ctx.rake_next[k];
       std::swap(due, next);
     }
@@ -750,6 +783,7 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
   Sweep sweep{*this, ctx, r, q0, q1};
   sweep.t0 = t0, sweep.t1 = t1;
   sweep.verdict_only = !locate_contact;
+  sweep.points_in_lanes = rake_points_.serves() && !end_invalid && quaternions_.empty();
   // The item that met the last contact goes first: a planner's next segment often meets it again, and a
   // contact found early bounds every other item's work.
   const int lead = ctx.lead >= 0 && ctx.lead < n_items && items_[ctx.lead].group < 0 ? ctx.lead : -1;

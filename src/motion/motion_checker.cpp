@@ -111,6 +111,7 @@ MotionChecker::MotionChecker(std::shared_ptr<const Scene> scene, MotionOptions o
   buildItems();
   buildItemTables();
   buildRakeRows();
+  buildRakePoints();
   const std::vector<int>& begin = bodies_.parts_begin;
   for (int k = 0; k < env_begin_; ++k) {
     const Item& it = items_[k];
@@ -144,6 +145,31 @@ void MotionChecker::buildRakeRows() {
       }
   }
   rake_rows_ = BoundsRows(a, b, padding, rake_body_count_);
+}
+
+void MotionChecker::buildRakePoints() {
+  const Scene& sc = *scene_;
+  const RobotModel& model = sc.robot();
+  rake_point_.assign(rake_body_count_, -1);
+  rake_point_geometry_.assign(rake_body_count_, nullptr);
+  std::vector<PointLanes::Point> points;
+  for (const Item& it : items_) {
+    if (it.group >= 0) continue;  // (a group's members are measured, never raked)
+    for (const auto& [body, frame, g] : {std::tuple{it.a, it.frame_a, it.ga}, std::tuple{it.b, it.frame_b, it.gb}}) {
+      if (body < 0 || !g || rake_point_[body] >= 0) continue;
+      rake_point_[body] = static_cast<int>(points.size());
+      rake_point_geometry_[body] = g;
+      points.push_back({frame, g->sphereCenter()});
+    }
+  }
+  // The joint values a segment between valid states can hold: the group's within its bounds (a box: convex),
+  // the others at the values the scene holds them.
+  std::vector<double> most(model.variableCount());
+  const SceneContext held = sc.makeContext();
+  for (int v = 0; v < model.variableCount(); ++v) most[v] = std::abs(held.jointValues()[v]);
+  for (int i = 0; i < sc.dimension(); ++i)
+    most[sc.groupVariables()[i]] = std::max(std::abs(sc.validLower(i)), std::abs(sc.validUpper(i)));
+  rake_points_ = PointLanes(model, std::move(points), most);
 }
 
 void MotionChecker::buildItemTables() {
@@ -361,6 +387,11 @@ MotionContext MotionChecker::makeContext() const {
     v->assign(static_cast<std::size_t>(rake_body_count_ + BoundsRows::kSpare), 0.0);
   c.rake_apart.assign(static_cast<std::size_t>(rake_rows_.size() + BoundsRows::kSpare), 0);
   c.body_bound.assign(rake_body_count_, 0.0);
+  if (rake_points_.serves()) {
+    c.rake_lane_q.assign(PointLanes::kLanes, c.scene.jointValues());
+    c.rake_xyz.resize(static_cast<std::size_t>(3 * rake_points_.size() * PointLanes::kLanes));
+    c.rake_lane_scratch.resize(rake_points_.scratchSize());
+  }
   c.contact.assign(items_.size(), {options_.contact_distance, options_.contact_distance});
   c.contact_stamp.assign(items_.size(), 0);
   c.split_slot.assign(env_begin_, 0);

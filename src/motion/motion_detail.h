@@ -55,6 +55,10 @@ struct Scratch {
   std::vector<double> rake_x, rake_y, rake_z, rake_r, rake_norm;
   std::vector<std::uint8_t> rake_apart;
   std::uint64_t rake_piece = 0;  // the rake's pieces so far (names each)
+  // The rake's ball centres at every piece of a level at once (MotionChecker::rake_points_): per piece its
+  // full joint vector, the centres (PointLanes' layout) and the lanes' scratch.
+  std::vector<std::vector<double>> rake_lane_q;
+  std::vector<float> rake_xyz, rake_lane_scratch;
   // Per item: its contact distance at either end of this segment, set when it first comes within
   // contact_distance (contact_stamp[k] == segment): half an end's clearance where that is below
   // contact_distance (Sweep::contactOf grows it away from the end).

@@ -33,6 +33,7 @@
 // it free too (MotionChecker::within). Every ball is at least contact_distance / B wide, so the loops end;
 // a cap on the number of distance queries ends them too (reported as a collision).
 #include <clearway/body/enclosing.h>
+#include <clearway/kinematics/point_lanes.h>
 #include <clearway/serial.h>
 #include <clearway/scene/scene.h>
 
@@ -359,6 +360,13 @@ class MotionChecker {
   std::vector<RakeBody> rake_bodies_;
   int rake_body_count_ = 0;  // bodies the items name (merged ones included): the rows', a context's per body
   void buildRakeRows();
+  // The rake's balls at a level's pieces, all pieces at once in float lanes (certified.cpp: Sweep::placeInLanes):
+  // the centres of the bounding balls of the bodies the items name; per body its point (−1: none) and the
+  // geometry it was made for.
+  PointLanes rake_points_;
+  std::vector<int> rake_point_;
+  std::vector<const LinkGeometry*> rake_point_geometry_;
+  void buildRakePoints();
 };
 
 }  // namespace clearway
