@@ -515,10 +515,11 @@ struct MotionChecker::Sweep {
   // there is near, and is left to the distances (one test spent). A piece costs one subtraction and a
   // squared norm where a measurement costs a ladder of GJKs, and one pose per piece serves every item. Where
   // a slender self pair's balls leave a piece, its hulls' boxes, apart by the same reach, may settle it.
-  static constexpr int kRakeLevels = 4;
+  static constexpr int kRakeLevels = motion_detail::Scratch::kRakeLevels;
   static constexpr int kRakePieces = 1 << (kRakeLevels - 1);  // the finest pieces: bits of ctx.settled[k]
-  static constexpr std::uint8_t kRakeAll = (1u << kRakePieces) - 1u;
-  static_assert(kRakePieces <= 8, "settled pieces are bits of a byte");
+  using Bits = motion_detail::Scratch::RakeBits;
+  static constexpr Bits kRakeAll = static_cast<Bits>((1u << kRakePieces) - 1u);
+  static_assert(kRakePieces <= 8 * sizeof(Bits), "settled pieces are bits of RakeBits");
 
   enum class Raked { Settled, Halve, Near };
   // Body `body`'s bounding ball at the rake's current piece (placed once per piece: bodies share items),
@@ -529,8 +530,8 @@ struct MotionChecker::Sweep {
     if (b.piece != ctx.rake_piece || b.geometry != &g) {  // (an index names one geometry; checked, not assumed)
       const int k = lane >= 0 ? mc.rake_point_[body] : -1;
       if (k >= 0 && mc.rake_point_geometry_[body] == &g) {
-        constexpr int L = PointLanes::kLanes;
-        const float* x = ctx.rake_xyz.data() + 3 * k * L + lane;
+        constexpr int L = PointLanes::kLanes;  // (lanes of L pieces each, a pass after another)
+        const float* x = ctx.rake_xyz.data() + 3 * (mc.rake_points_.size() * (lane / L) + k) * L + lane % L;
         b.center = Vec3(x[0], x[L], x[2 * L]);
         b.radius = g.sphereRadius() * (1.0 + margins::kRounding) + mc.rake_points_.error(k);
       } else {
@@ -618,16 +619,20 @@ struct MotionChecker::Sweep {
   // lanes: one pass where each piece's poses cost a pass of double kinematics. (Not for the whole segment:
   // its one piece's poses serve the first measurement, in its middle, too.)
   void placeInLanes(int pieces, double half) {
-    static_assert(kRakePieces <= PointLanes::kLanes, "a level's pieces in one pass");
+    constexpr int L = PointLanes::kLanes;
     const std::vector<int>& group = mc.scene_->groupVariables();
-    const double* q[PointLanes::kLanes];
-    for (int p = 0; p < pieces; ++p) {
-      mc.interpolate(q0, q1, (2 * p + 1) * half, ctx.q.data());
-      std::vector<double>& full = ctx.rake_lane_q[p];
-      for (std::size_t i = 0; i < group.size(); ++i) full[group[i]] = ctx.q[i];
-      q[p] = full.data();
+    const double* q[L];
+    for (int first = 0; first < pieces; first += L) {
+      const int n = std::min(L, pieces - first);
+      for (int l = 0; l < n; ++l) {
+        mc.interpolate(q0, q1, (2 * (first + l) + 1) * half, ctx.q.data());
+        std::vector<double>& full = ctx.rake_lane_q[l];
+        for (std::size_t i = 0; i < group.size(); ++i) full[group[i]] = ctx.q[i];
+        q[l] = full.data();
+      }
+      const std::size_t pass = static_cast<std::size_t>(3 * mc.rake_points_.size() * L) * (first / L);
+      mc.rake_points_.compute(q, n, ctx.rake_xyz.data() + pass, ctx.rake_lane_scratch.data());
     }
-    mc.rake_points_.compute(q, pieces, ctx.rake_xyz.data(), ctx.rake_lane_scratch.data());
   }
 
   // Self items due at the first piece from which the lanes pay: they place every body's ball and test every
@@ -646,9 +651,10 @@ struct MotionChecker::Sweep {
       ctx.rake_now[k] = 1;
       if (mc.items_[k].group < 0 && ctx.safe_until[k] == 0.0) due.push_back(k);
     }
-    // The levels tested: the whole segment, quarters, eighths. Halves settled too little to pay for their
-    // poses (free motions: 2% fewer instructions without them on the shared Panda, 1% on the UR5); eighths
-    // only, too much of a segment left in short runs (50% more).
+    // The levels tested: the whole segment, quarters, sixteenths (their balls placed in lanes: eighths in
+    // between, or thirty-seconds after, cost more than the distance queries they save). Halves settled too
+    // little to pay for their poses (free motions: 2% fewer instructions without them on the shared Panda, 1%
+    // on the UR5); the finest level only, too much of a segment left in short runs (50% more).
     static constexpr int kLevels[] = {0, 2, kRakeLevels - 1};
     constexpr int kSteps = sizeof(kLevels) / sizeof(kLevels[0]);
     for (int step = 0; step < kSteps && !due.empty(); ++step) {
@@ -677,10 +683,10 @@ struct MotionChecker::Sweep {
           const int pair = lanes ? mc.rake_pair_[k] : -1;
           const Raked t = pair >= 0 && ctx.rake_apart[pair] ? Raked::Settled : rakeTest(k, m, half, last, pair >= 0);
           if (t == Raked::Settled) {
-            ctx.settled[k] |= static_cast<std::uint8_t>(((1u << width) - 1u) << (p * width));
+            ctx.settled[k] |= static_cast<Bits>(((1u << width) - 1u) << (p * width));
           } else if (t == Raked::Halve && !last) {
             if (ctx.rake_next[k] == 0) next.push_back(k);
-            ctx.rake_next[k] |= static_cast<std::uint8_t>(((1u << span) - 1u) << (span * p));
+            ctx.rake_next[k] |= static_cast<Bits>(((1u << span) - 1u) << (span * p));
           }
         }
       }
@@ -695,7 +701,7 @@ struct MotionChecker::Sweep {
   // Covers what the rake left of item k: each run of pieces it did not settle, left first (a run after a
   // settled piece starts where the item is certified clear).
   template <class Cover>
-  static void coverUnsettled(int k, std::uint8_t settled, Cover&& cover) {
+  static void coverUnsettled(int k, Bits settled, Cover&& cover) {
     for (int i = 0; i < kRakePieces;) {
       if (settled >> i & 1u) {
         ++i;

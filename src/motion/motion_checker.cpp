@@ -389,7 +389,9 @@ MotionContext MotionChecker::makeContext() const {
   c.body_bound.assign(rake_body_count_, 0.0);
   if (rake_points_.serves()) {
     c.rake_lane_q.assign(PointLanes::kLanes, c.scene.jointValues());
-    c.rake_xyz.resize(static_cast<std::size_t>(3 * rake_points_.size() * PointLanes::kLanes));
+    constexpr int passes =
+        ((1 << (motion_detail::Scratch::kRakeLevels - 1)) + PointLanes::kLanes - 1) / PointLanes::kLanes;
+    c.rake_xyz.resize(static_cast<std::size_t>(3 * rake_points_.size() * PointLanes::kLanes * passes));
     c.rake_lane_scratch.resize(rake_points_.scratchSize());
   }
   c.contact.assign(items_.size(), {options_.contact_distance, options_.contact_distance});

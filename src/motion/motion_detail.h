@@ -39,7 +39,10 @@ struct Scratch {
   // Per item: the rake's settled pieces of this segment (bit i: [i, i + 1] / kRakePieces; certified.cpp),
   // and its scratch: per item the pieces of the current and next level still to test, and the items that
   // have some.
-  std::vector<std::uint8_t> settled, rake_now, rake_next;
+  // The rake's levels (the whole segment, halves, ... : certified.cpp) and a set of its finest pieces.
+  static constexpr int kRakeLevels = 5;
+  using RakeBits = std::uint16_t;
+  std::vector<RakeBits> settled, rake_now, rake_next;
   std::vector<int> rake_items, rake_items_next;
   // Per body of the bound (a link, or a merged body past them): its bounding ball, world frame, at the rake's
   // piece `piece` (placed at most once per piece).
