@@ -511,9 +511,10 @@ struct MotionChecker::Sweep {
   // the environment: farther from the obstacles' boxes) than padding + contact_distance + B·h, B the item's
   // motion bound: over the piece neither body moves more than B·h relative to the other, so the clearance
   // stays beyond contact_distance, the largest contactOf can be. Pieces split from the whole segment to
-  // eighths, and only while the balls at the middle clear the contact distance: an item whose balls meet
+  // sixteenths, and only while the balls at the middle clear the contact distance: an item whose balls meet
   // there is near, and is left to the distances (one test spent). A piece costs one subtraction and a
-  // squared norm where a measurement costs a ladder of GJKs, and one pose per piece serves every item. Where
+  // squared norm where a measurement costs a ladder of GJKs; the whole segment's one pose serves every item,
+  // and a finer level's balls are placed for all its pieces at once in float lanes (placeInLanes). Where
   // a slender self pair's balls leave a piece, its hulls' boxes, apart by the same reach, may settle it.
   static constexpr int kRakeLevels = motion_detail::Scratch::kRakeLevels;
   static constexpr int kRakePieces = 1 << (kRakeLevels - 1);  // the finest pieces: bits of ctx.settled[k]

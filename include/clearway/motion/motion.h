@@ -24,7 +24,7 @@
 // two bodies whose every link pair is checked are measured as one item on their merged hulls, and a body
 // against the environment likewise, until the merged hulls come within contact; the member pairs then
 // cover that interval. Before any distance is measured, the rake (MotionOptions::rake) settles each item on
-// the pieces of the segment (the whole, halves, quarters, eighths) over which its bodies' bounding balls,
+// the pieces of the segment (the whole, quarters, sixteenths) over which its bodies' bounding balls,
 // grown by the item's motion over the piece, stay farther apart than the contact distance; only the rest is
 // covered by measurements. A self item whose pairs are tabulated (scene/pair_table.h) over joints that keep
 // them more than padding + 2·contact_distance apart in every cell the segment crosses is not swept at all.
@@ -176,7 +176,7 @@ struct MotionOptions {
   /// segment near contact would take (200,000 queries of meshes are tens of seconds). Empty: never asked.
   std::function<bool()> stop;
   /// Certified: before any distance is measured, the bodies' bounding balls settle the pieces of the
-  /// segment (halves down to eighths) on which they stay farther apart than contact_distance (certified.cpp:
+  /// segment (quarters down to sixteenths) on which they stay farther apart than contact_distance (certified.cpp:
   /// the rake). false: every item is measured (the same verdicts but where a clearance lies within
   /// distance_relative_error of the contact distance, for comparing).
   bool rake = true;
