@@ -49,7 +49,9 @@ void PlacePoints(const PointLanes::Step* steps, int n_steps, const int* point_sl
           s32[l] = static_cast<float>(sine[l]) * st.axis_sign;
         }
       } else {
-        for (int l = 0; l < L; ++l) v32[l] = static_cast<float>(value[l]);
+        // (Clamped into float's range, where converting is defined: such a value is outside the lanes'
+        // bound anyway, whose positions are then meaningless but never undefined.)
+        for (int l = 0; l < L; ++l) v32[l] = static_cast<float>(std::clamp(value[l], -1e38, 1e38));
       }
     }
     const int p = st.parent_slot, me = s + 1;
@@ -177,17 +179,6 @@ PointLanes::PointLanes(const RobotModel& model, std::vector<Point> points, const
     if (!needed[l]) continue;
     const detail::KinematicStep& st = model.kinematicStep(l);
     if (st.kind == Kind::Other || st.kind == Kind::Root || st.parent < 0 || slot[st.parent] < 0) return;
-    Step s{};
-    s.parent_slot = slot[st.parent];
-    s.kind = static_cast<int>(st.kind);
-    s.turned = st.origin.R != Mat3::Identity();
-    for (int k = 0; k < 9; ++k) s.O[k] = static_cast<float>(st.origin.R.data()[k]);
-    for (int k = 0; k < 3; ++k) {
-      s.origin[k] = static_cast<float>(st.origin.t[k]);
-      s.axis[k] = static_cast<float>(st.axis[k]);
-    }
-    s.axis_sign = static_cast<float>(st.axis_sign);
-    s.step = &st;
     double o_norm = st.origin.t.norm();
     if (st.kind == Kind::Slide) {
       const double q_most =
@@ -198,10 +189,22 @@ PointLanes::PointLanes(const RobotModel& model, std::vector<Point> points, const
       o_norm += v;
     }
     const int parent = slot[st.parent];
+    // (Before any value is rounded to float: one beyond float's range would not convert.)
+    if (!(reach[parent] + o_norm <= kMaxReach) || !st.origin.R.allFinite() || !st.axis.allFinite()) return;
+    Step s{};
+    s.parent_slot = parent;
+    s.kind = static_cast<int>(st.kind);
+    s.turned = st.origin.R != Mat3::Identity();
+    for (int k = 0; k < 9; ++k) s.O[k] = static_cast<float>(st.origin.R.data()[k]);
+    for (int k = 0; k < 3; ++k) {
+      s.origin[k] = static_cast<float>(st.origin.t[k]);
+      s.axis[k] = static_cast<float>(st.axis[k]);
+    }
+    s.axis_sign = static_cast<float>(st.axis_sign);
+    s.step = &st;
     bf.push_back(stepBound(rf, bf[parent], reach[parent], s.turned, st.kind, o_norm));
     bd.push_back(stepBound(rd, bd[parent], reach[parent], s.turned, st.kind, o_norm));
     reach.push_back(reach[parent] + o_norm);
-    if (!(reach.back() <= kMaxReach)) return;
     slot[l] = static_cast<int>(steps_.size()) + 1;
     steps_.push_back(s);
   }
@@ -215,12 +218,12 @@ PointLanes::PointLanes(const RobotModel& model, std::vector<Point> points, const
       const double u = rnd.u, p_hat = p * (1.0 + u);
       total += b.e * p_hat + u * p + rnd.gamma(4) * ((root3 + b.e) * p_hat + reach[sl] + b.eps) + b.eps;
     }
-    error_.push_back(2.0 * total);
-    for (int k = 0; k < 3; ++k) point_p_.push_back(static_cast<float>(pt.p[k]));
-    if (!(p + reach[sl] <= kMaxReach) || !(error_.back() < 1e-3)) {
+    if (!(p + reach[sl] <= kMaxReach) || !(2.0 * total < kMaxError)) {
       error_.clear();
       return;
     }
+    error_.push_back(2.0 * total);
+    for (int k = 0; k < 3; ++k) point_p_.push_back(static_cast<float>(pt.p[k]));
   }
   serves_ = true;
 }

@@ -190,6 +190,15 @@ TEST(PointLanes, RefusesWhatFloatCannotBound) {
   EXPECT_FALSE(PointLanes(chain, points, most).serves());
   most[slide] = 2 * PointLanes::kMaxReach;
   EXPECT_FALSE(PointLanes(chain, points, most).serves());
+  // A chain that reaches 2 km, and a point beyond float's range (refused before anything is rounded).
+  const RobotModel far =
+      loadRobot(dir.write("far.urdf",
+                          "<robot name=\"far\"><link name=\"a\"/><link name=\"b\"/><joint name=\"j\" type=\"revolute\">"
+                          "<parent link=\"a\"/><child link=\"b\"/><origin xyz=\"2000 0 0\"/><axis xyz=\"0 0 1\"/>"
+                          "<limit lower=\"-1\" upper=\"1\" velocity=\"1\" effort=\"1\"/></joint></robot>"));
+  EXPECT_FALSE(PointLanes(far, pointsOn({1}), magnitudes(far)).serves());
+  EXPECT_TRUE(PointLanes(far, pointsOn({0}), magnitudes(far)).serves());
+  EXPECT_FALSE(PointLanes(chain, {{1, Vec3(1e300, 0, 0)}}, magnitudes(chain)).serves());
   // A point that is not finite, or on a link that does not exist.
   EXPECT_FALSE(PointLanes(chain, {{1, Vec3(NAN, 0, 0)}}, magnitudes(chain)).serves());
   EXPECT_FALSE(PointLanes(chain, {{chain.linkCount(), Vec3::Zero()}}, magnitudes(chain)).serves());

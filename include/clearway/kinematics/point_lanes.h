@@ -47,11 +47,13 @@ class PointLanes {
   /// For `model` (which must outlive this), the points given, and joint vectors whose entries v satisfy
   /// |v| ≤ most[v] (one per variable of the model; only slides' are read, ∞ allowed). Serves nothing when
   /// the robot has a planar or floating joint on a point's chain, when a slide's bound is not finite, or when
-  /// the chains reach farther than kMaxReach (float then rounds coarsely).
+  /// the chains reach farther than kMaxReach (float then rounds coarsely), or a bound exceeds kMaxError.
   PointLanes(const RobotModel& model, std::vector<Point> points, const std::vector<double>& most);
 
   /// How far (metres) the chains may reach from the root for the lanes to serve.
   static constexpr double kMaxReach = 1000.0;
+  /// The largest error bound (metres) the lanes serve with: a ball grown by more settles little.
+  static constexpr double kMaxError = 1e-3;
 
   /// True when compute() may be called.
   bool serves() const noexcept { return serves_; }
