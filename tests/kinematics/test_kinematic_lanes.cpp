@@ -12,12 +12,13 @@
 #include <hwy/targets.h>
 
 #include "forced_target.h"
+#include "kinematics/chain_urdf.h"
+#include "kinematics/random_states.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <iterator>
 #include <random>
 #include <string>
 #include <vector>
@@ -110,47 +111,12 @@ void expectLanesEqualScalar(const RobotModel& m, const std::vector<std::vector<d
 
 // States within the limits (continuous and unbounded variables within ±4), and a few far outside.
 std::vector<std::vector<double>> randomStates(const RobotModel& m, int n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<std::vector<double>> out(n, std::vector<double>(m.variableCount()));
-  for (int s = 0; s < n; ++s)
-    for (int v = 0; v < m.variableCount(); ++v) {
-      const JointVariable& var = m.variables()[v];
-      const double lo = std::isfinite(var.lower) ? var.lower : -4.0, hi = std::isfinite(var.upper) ? var.upper : 4.0;
-      double x = lo + (hi - lo) * u(rng);
-      if (s % 7 == 3) x *= 1e5;  // past 2^16 rad: sin and cos from libm
-      out[s][v] = x;
-    }
-  return out;
+  // (past 2^16 rad: sin and cos from libm)
+  return test::randomJointVectors(m, n, seed, [](int s, int, auto&&) { return s % 7 == 3 ? 1e5 : 1.0; });
 }
 
-// A chain of every joint kind, each with an origin whose every coordinate and angle is nonzero (so that
-// no term of a product vanishes and a change in the order of the sums shows), planar and floating
-// joints between turning ones, and mimics of a revolute and a prismatic joint.
-std::string everyKindChain() {
-  const char* kinds[][3] = {{"revolute", "0 0 1", ""},          {"prismatic", "0.3 -0.5 0.8", ""},
-                            {"revolute", "0 0 -1", ""},         {"fixed", "", ""},
-                            {"continuous", "-2 1 0.5", ""},     {"planar", "0 0 1", ""},
-                            {"revolute", "1 0 0", "j0"},        {"floating", "", ""},
-                            {"prismatic", "0 1 0", "j1"},       {"revolute", "0.3 -0.5 0.8", "j4"},
-                            {"planar", "0.6 0.8 0", ""},        {"revolute", "0 1 0", ""}};
-  std::mt19937 rng(17);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  const auto num = [&] { return std::to_string(u(rng) * 0.7 + (u(rng) < 0 ? -0.3 : 0.3)); };
-  std::string urdf = "<robot name=\"chain\"><link name=\"l0\"/>";
-  for (int k = 0; k < static_cast<int>(std::size(kinds)); ++k) {
-    const std::string type = kinds[k][0], n = std::to_string(k);
-    urdf += "<link name=\"l" + std::to_string(k + 1) + "\"/><joint name=\"j" + n + "\" type=\"" + type +
-            "\"><parent link=\"l" + n + "\"/><child link=\"l" + std::to_string(k + 1) + "\"/><origin xyz=\"" + num() +
-            " " + num() + " " + num() + "\" rpy=\"" + num() + " " + num() + " " + num() + "\"/>";
-    if (*kinds[k][1]) urdf += std::string("<axis xyz=\"") + kinds[k][1] + "\"/>";
-    if (type == "revolute" || type == "prismatic")
-      urdf += "<limit lower=\"-3\" upper=\"3\" velocity=\"1\" effort=\"1\"/>";
-    if (*kinds[k][2]) urdf += std::string("<mimic joint=\"") + kinds[k][2] + "\" multiplier=\"-1.5\" offset=\"0.25\"/>";
-    urdf += "</joint>";
-  }
-  return urdf + "</robot>";
-}
+// A chain of every joint kind (chain_urdf.h).
+std::string everyKindChain() { return test::chainUrdf(test::everyJointKind()); }
 
 }  // namespace
 

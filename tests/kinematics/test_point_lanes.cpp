@@ -13,11 +13,12 @@
 #include <hwy/targets.h>
 
 #include "forced_target.h"
+#include "kinematics/chain_urdf.h"
+#include "kinematics/random_states.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <iterator>
 #include <random>
 #include <string>
 #include <vector>
@@ -38,19 +39,10 @@ std::vector<double> magnitudes(const RobotModel& m) {
 // States within the limits (unbounded ones within ±4); every third state's turning joints far beyond them
 // (up to 1e5 rad: sin and cos from libm past 2^16), which the bound allows (only slides' values count).
 std::vector<std::vector<double>> randomStates(const RobotModel& m, int n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<std::vector<double>> out(n, std::vector<double>(m.variableCount()));
-  for (int s = 0; s < n; ++s)
-    for (int v = 0; v < m.variableCount(); ++v) {
-      const JointVariable& var = m.variables()[v];
-      const double lo = std::isfinite(var.lower) ? var.lower : -4.0, hi = std::isfinite(var.upper) ? var.upper : 4.0;
-      double x = lo + (hi - lo) * u(rng);
-      const JointType type = m.joint(var.joint).type;
-      if (s % 3 == 1 && (type == JointType::Revolute || type == JointType::Continuous)) x *= 1e5 * u(rng);
-      out[s][v] = x;
-    }
-  return out;
+  return test::randomJointVectors(m, n, seed, [&](int s, int v, auto&& draw) {
+    const JointType type = m.joint(m.variables()[v].joint).type;
+    return s % 3 == 1 && (type == JointType::Revolute || type == JointType::Continuous) ? 1e5 * draw() : 1.0;
+  });
 }
 
 // Points on every link given: its origin, and three offsets of up to half a metre.
@@ -117,30 +109,12 @@ double expectWithinBounds(const RobotModel& m, const std::vector<PointLanes::Poi
   return worst;
 }
 
-// A chain of every joint kind the lanes serve: turns about z, −z and skew axes, slides along skew axes,
-// fixed joints, mimics of a turn and a slide; every origin coordinate and angle nonzero.
+// A chain of every joint kind the lanes serve: every kind but planar and floating joints (chain_urdf.h).
 std::string servedChain() {
-  const char* kinds[][3] = {{"revolute", "0 0 1", ""},      {"prismatic", "0.3 -0.5 0.8", ""},
-                            {"revolute", "0 0 -1", ""},     {"fixed", "", ""},
-                            {"continuous", "-2 1 0.5", ""}, {"revolute", "1 0 0", "j0"},
-                            {"prismatic", "0 1 0", "j1"},   {"revolute", "0.3 -0.5 0.8", "j4"},
-                            {"revolute", "0 1 0", ""}};
-  std::mt19937 rng(17);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  const auto num = [&] { return std::to_string(u(rng) * 0.7 + (u(rng) < 0 ? -0.3 : 0.3)); };
-  std::string urdf = "<robot name=\"chain\"><link name=\"l0\"/>";
-  for (int k = 0; k < static_cast<int>(std::size(kinds)); ++k) {
-    const std::string type = kinds[k][0], n = std::to_string(k);
-    urdf += "<link name=\"l" + std::to_string(k + 1) + "\"/><joint name=\"j" + n + "\" type=\"" + type +
-            "\"><parent link=\"l" + n + "\"/><child link=\"l" + std::to_string(k + 1) + "\"/><origin xyz=\"" + num() +
-            " " + num() + " " + num() + "\" rpy=\"" + num() + " " + num() + " " + num() + "\"/>";
-    if (*kinds[k][1]) urdf += std::string("<axis xyz=\"") + kinds[k][1] + "\"/>";
-    if (type == "revolute" || type == "prismatic")
-      urdf += "<limit lower=\"-3\" upper=\"3\" velocity=\"1\" effort=\"1\"/>";
-    if (*kinds[k][2]) urdf += std::string("<mimic joint=\"") + kinds[k][2] + "\" multiplier=\"-1.5\" offset=\"0.25\"/>";
-    urdf += "</joint>";
-  }
-  return urdf + "</robot>";
+  std::vector<test::ChainJoint> served;
+  for (const test::ChainJoint& j : test::everyJointKind())
+    if (std::string(j.type) != "planar" && std::string(j.type) != "floating") served.push_back(j);
+  return test::chainUrdf(served);
 }
 
 }  // namespace
