@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
-#include <limits>
+#include <utility>
 
 #include "detail/simd_targets.h"
 #define HWY_DISABLED_TARGETS CLEARWAY_LANES_DISABLED  // (before Highway's headers)
@@ -213,8 +213,8 @@ PointLanes::PointLanes(const RobotModel& model, std::vector<Point> points, const
     point_slot_.push_back(sl);
     const double p = pt.p.norm();
     double total = 0.0;
-    for (const Rounding& rnd : {rf, rd}) {
-      const Bound& b = rnd.u == rf.u ? bf[sl] : bd[sl];
+    for (const auto& [rnd, bounds] : {std::pair{rf, &bf}, std::pair{rd, &bd}}) {
+      const Bound& b = (*bounds)[static_cast<std::size_t>(sl)];
       const double u = rnd.u, p_hat = p * (1.0 + u);
       total += b.e * p_hat + u * p + rnd.gamma(4) * ((root3 + b.e) * p_hat + reach[sl] + b.eps) + b.eps;
     }
