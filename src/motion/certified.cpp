@@ -468,13 +468,70 @@ struct MotionChecker::Sweep {
       }
       const double rad = reach(k, d, std::max(m - iv.a, hi - m));
       // Left first (popped first), so that advancement starts clear of everything before it. A verdict
-      // keeps the same order: then it measures what the located check measures until a contact, so the
-      // two agree even where the contact distance grows along the segment (near an end), where another
-      // order's balls could miss a measurement within it that this order makes.
+      // keeps each item's order (its turns, coverInTurns, take its intervals as this loop does): then it
+      // measures what the located check measures until a contact, so the two agree even where the contact
+      // distance grows along the segment (near an end), where another order's balls could miss a
+      // measurement within it that this order makes.
       if (m + rad < hi) ctx.intervals.push_back({m + rad, hi, m});
       if (m - rad > iv.a) ctx.intervals.push_back({iv.a, m - rad, iv.witness});
     }
     ctx.intervals.resize(base);
+  }
+
+  // A verdict's covers of many items, in turns: each item's intervals on a stack of its own (cover's), one
+  // measurement an item a turn, so that the item within contact is met after a few measurements of every
+  // item, not after all of those before it (a shortcut past a shelf: a finger kept 2–9 mm from a board for
+  // thirty measurements before the next finger, through the board, was measured at all). Each item measures
+  // what cover() would, in the same order: a free segment costs the same. queue() adds an interval, under
+  // those queued before (cover() covers them one after another, each in full); coverInTurns() covers them
+  // all, or stops at the first contact.
+  void queue(int k, double a, double b, double witness) {
+    std::vector<motion_detail::Scratch::Interval>& stack = ctx.turn_stacks[k];
+    if (stack.empty()) ctx.turns.push_back(k);
+    stack.insert(stack.begin(), {a, b, witness});
+  }
+  void coverInTurns() {
+    while (ctx.turn_head < ctx.turns.size() && !stop()) {
+      const int k = ctx.turns[ctx.turn_head++];
+      takeTurn(k);
+      if (!ctx.turn_stacks[k].empty()) ctx.turns.push_back(k);
+      if (ctx.turn_head >= 1024 && 2 * ctx.turn_head >= ctx.turns.size()) {  // (the turns taken: dropped)
+        ctx.turns.erase(ctx.turns.begin(), ctx.turns.begin() + static_cast<std::ptrdiff_t>(ctx.turn_head));
+        ctx.turn_head = 0;
+      }
+    }
+    for (std::size_t i = ctx.turn_head; i < ctx.turns.size(); ++i) ctx.turn_stacks[ctx.turns[i]].clear();
+    ctx.turns.clear();
+    ctx.turn_head = 0;
+  }
+  // Item k's turn: one measurement of cover()'s loop (a group within contact hands the interval to its
+  // members, which take turns of their own).
+  void takeTurn(int k) {
+    const Item& it = mc.items_[k];
+    std::vector<motion_detail::Scratch::Interval>& stack = ctx.turn_stacks[k];
+    CollisionReport report;
+    while (!stack.empty() && !stop()) {
+      const motion_detail::Scratch::Interval iv = stack.back();
+      stack.pop_back();
+      const double hi = std::min(iv.b, limit);
+      if (iv.a > hi || (hit && iv.a >= hi)) continue;
+      const double m = measuringPoint(iv.a, hi);
+      const double d = measureItem(k, m, asked(k, std::max(m - iv.a, hi - m)), report);
+      if (d <= contactOf(k, m)) {
+        if (it.last > it.first) {
+          for (int member = it.first; member < it.last; ++member) queue(member, iv.a, hi, iv.witness);
+        } else {
+          found(m, report);
+          ctx.lead = it.group >= 0 ? it.group : k;
+          stack.clear();
+        }
+        return;
+      }
+      const double rad = reach(k, d, std::max(m - iv.a, hi - m));
+      if (m + rad < hi) stack.push_back({m + rad, hi, m});
+      if (m - rad > iv.a) stack.push_back({iv.a, m - rad, iv.witness});
+      return;
+    }
   }
 
   // Conservative advancement of item k from a (clear at `witness`) towards `until`: true when it meets a
@@ -794,7 +851,10 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
   // The item that met the last contact goes first: a planner's next segment often meets it again, and a
   // contact found early bounds every other item's work.
   const int lead = ctx.lead >= 0 && ctx.lead < n_items && items_[ctx.lead].group < 0 ? ctx.lead : -1;
+  // (A verdict covers its items in turns, the lead's first: Sweep::coverInTurns.)
+  const bool in_turns = sweep.verdict_only;
   const auto cover = [&](int k, double a, double b, double witness) {
+    if (in_turns) return sweep.queue(k, a, b, witness);
     const int before = sweep.contacts;
     sweep.cover(k, a, b, witness);
     if (sweep.contacts > before) ctx.lead = k;
@@ -843,6 +903,7 @@ MotionResult MotionChecker::certified(const double* q0, double t0, const double*
       if (mid + rad < sweep.limit) cover(k, mid + rad, 1.0, mid);
     }
   }
+  if (in_turns) sweep.coverInTurns();
   if (sweep.capped) {
     r.capped = true;
     r.first_contact = r.last_valid = 0.0;

@@ -419,6 +419,8 @@ MotionContext MotionChecker::makeContext() const {
   c.pose_path.reserve(scene_->robot().linkCount());
   c.step_cache = bound_.makeStepCache();
   c.intervals.reserve(256);
+  c.turn_stacks.assign(items_.size(), {});
+  c.turns.reserve(256);
   if (options_.mode == MotionMode::Cast) c.end_poses.resize(scene_->robot().linkCount());
   return MotionContext(std::move(scratch));
 }

@@ -93,6 +93,11 @@ struct Scratch {
     double witness;  // a parameter ≤ a the item was measured clear at (−1: none)
   };
   std::vector<Interval> intervals;  // scratch: what items have yet to cover
+  // A verdict's covers in turns (certified.cpp: Sweep::coverInTurns): per item its own intervals to cover,
+  // and the items in the order of their turns (from turn_head on).
+  std::vector<std::vector<Interval>> turn_stacks;
+  std::vector<int> turns;
+  std::size_t turn_head = 0;
   int lead = -1;                    // the item that met the last contact: measured first
   // The probe (probe.cpp): how often it has found a collision lately (a moving average over the segments
   // it ran on), and the segments since it last ran.

@@ -110,6 +110,45 @@ TEST(MotionCertified, ThinPostAnalyticContact) {
   EXPECT_GE(back.first_contact, back_touch - 1e-3 / 1.4 / 3.0 * 2);
 }
 
+TEST(MotionCertified, AVerdictMeetsTheCollidingLinkBeforeCoveringAHoveringOne) {
+  // The planar arm turns its shoulder from 0 to 1 rad: link1 sweeps 1 cm above a plate the whole way (covering
+  // it takes a measurement every few hundredths of a radian), and link2 goes through a thin post at 0.6 rad,
+  // where the probe's states (1, 1/2, 1/4, 3/4) do not look. Link by link, a verdict would cover link1 to
+  // the end before measuring link2 once; in turns, link2 meets the post after a few of each.
+  TempDir dir;
+  const double top = 0.05 - 0.01;  // the links' undersides are at z = 0.05
+  const auto scene =
+      planarScene(dir,
+                  "    - {name: plate, box: {size: [0.75, 0.35, 0.02]}, pose: {position: [0.525, 0.075, " +
+                      std::to_string(top - 0.01) + "]}}\n" +
+                      "    - {name: post, cylinder: {radius: 0.005, length: 1}, pose: {position: [" +
+                      std::to_string(1.25 * std::cos(0.6)) + ", " + std::to_string(1.25 * std::sin(0.6)) + ", 0.1]}}\n",
+                  "[environment, continuous]");
+  const double q0[2] = {0, 0}, q1[2] = {1, 0};
+  const MotionChecker certified(scene);
+  MotionContext ctx = certified.makeContext();
+  const MotionResult located = certified.check(q0, q1, ctx);
+  ASSERT_FALSE(located.free);
+  EXPECT_EQ(located.report.link, scene->robot().linkIndex("link2"));
+  // Link1 alone, over the plate without the post: what covering it costs.
+  const auto plate_only =
+      planarScene(dir,
+                  "    - {name: plate, box: {size: [0.75, 0.35, 0.02]}, pose: {position: [0.525, 0.075, " +
+                      std::to_string(top - 0.01) + "]}}\n",
+                  "[environment, continuous]");
+  const MotionChecker hover(plate_only);
+  MotionContext hc = hover.makeContext();
+  const MotionResult covered = hover.check(q0, q1, hc, /*locate_contact=*/false);
+  ASSERT_TRUE(covered.free);
+  MotionContext fresh = certified.makeContext();  // (no lead from the located check)
+  const MotionResult verdict = certified.check(q0, q1, fresh, /*locate_contact=*/false);
+  ASSERT_FALSE(verdict.free);
+  EXPECT_EQ(verdict.report.link, scene->robot().linkIndex("link2"));
+  EXPECT_GT(covered.distance_queries, 40) << "the test needs a link that takes many measurements to cover";
+  EXPECT_LT(verdict.distance_queries, covered.distance_queries / 2)
+      << "located: " << located.distance_queries << ", link1 covered alone: " << covered.distance_queries;
+}
+
 TEST(MotionCertified, RigidBodiesAreOneItemUntilNear) {
   TempDir dir;
   // Far from everything: one query per item. The environment sees the arm and the gripper body (not its
