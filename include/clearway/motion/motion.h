@@ -19,6 +19,8 @@
 // shorter intervals, left first, so a free segment costs one measurement per ball twice as wide as
 // one-sided advancement's. A measurement within contact_distance switches the item to advancement from
 // the interval's left end, whose first contact then bounds every item's work (nothing after it matters).
+// A verdict alone (locate_contact false) ends at any contact: it covers the item that met the last one
+// first, then the others in turns, a measurement each, every item in its own order.
 // Bounds get tighter and dearer (balls, hulls, convex parts, triangles) only until one clears what is
 // asked. Links joined by joints the group does not move (a gripper on its flange) are one rigid body:
 // two bodies whose every link pair is checked are measured as one item on their merged hulls, and a body
