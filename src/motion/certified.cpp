@@ -446,36 +446,46 @@ struct MotionChecker::Sweep {
     while (ctx.intervals.size() > base && !stop()) {
       const motion_detail::Scratch::Interval iv = ctx.intervals.back();
       ctx.intervals.pop_back();
-      const double hi = std::min(iv.b, limit);
-      if (iv.a > hi || (hit && iv.a >= hi)) continue;
-      const double m = measuringPoint(iv.a, hi);
-      const double d = measureItem(k, m, asked(k, std::max(m - iv.a, hi - m)), report);
-      if (d <= contactOf(k, m)) {
-        if (it.last > it.first) {  // a group within contact: its members take over here, exactly
-          for (int member = it.first; member < it.last && !stop(); ++member) cover(member, iv.a, hi, iv.witness);
-          continue;
-        }
-        if (verdict_only) {
-          found(m, report);
-          ctx.intervals.resize(base);
-          return;
-        }
-        if (advance(k, iv.a, iv.witness, hi)) {
-          ctx.intervals.resize(base);  // all to the right of the contact
-          return;
-        }
+      double m = 0.0, hi = 0.0;
+      if (measureOnce(k, iv, ctx.intervals, m, hi, report) != Measured::Contact) continue;
+      if (it.last > it.first) {  // a group within contact: its members take over here, exactly
+        for (int member = it.first; member < it.last && !stop(); ++member) cover(member, iv.a, hi, iv.witness);
         continue;
       }
-      const double rad = reach(k, d, std::max(m - iv.a, hi - m));
-      // Left first (popped first), so that advancement starts clear of everything before it. A verdict
-      // keeps each item's order (its turns, coverInTurns, take its intervals as this loop does): then it
-      // measures what the located check measures until a contact, so the two agree even where the contact
-      // distance grows along the segment (near an end), where another order's balls could miss a
-      // measurement within it that this order makes.
-      if (m + rad < hi) ctx.intervals.push_back({m + rad, hi, m});
-      if (m - rad > iv.a) ctx.intervals.push_back({iv.a, m - rad, iv.witness});
+      if (verdict_only) {
+        found(m, report);
+        ctx.intervals.resize(base);
+        return;
+      }
+      if (advance(k, iv.a, iv.witness, hi)) {
+        ctx.intervals.resize(base);  // all to the right of the contact
+        return;
+      }
     }
     ctx.intervals.resize(base);
+  }
+
+  // One step of covering item k: interval iv, cut at the limit, measured at its measuring point m (up to
+  // hi, its end within the limit). Within contact there: Contact. Else Clear, and what the ball there
+  // leaves of iv pushed on `stack`, the left part on top. Skipped (nothing measured) past the limit.
+  enum class Measured { Skipped, Clear, Contact };
+  Measured measureOnce(int k, const motion_detail::Scratch::Interval& iv,
+                       std::vector<motion_detail::Scratch::Interval>& stack, double& m, double& hi,
+                       CollisionReport& report) {
+    hi = std::min(iv.b, limit);
+    if (iv.a > hi || (hit && iv.a >= hi)) return Measured::Skipped;
+    m = measuringPoint(iv.a, hi);
+    const double d = measureItem(k, m, asked(k, std::max(m - iv.a, hi - m)), report);
+    if (d <= contactOf(k, m)) return Measured::Contact;
+    const double rad = reach(k, d, std::max(m - iv.a, hi - m));
+    // Left first (popped first), so that advancement starts clear of everything before it. A verdict
+    // keeps each item's order (its turns, coverInTurns, take its intervals as cover() does): then it
+    // measures what the located check measures until a contact, so the two agree even where the contact
+    // distance grows along the segment (near an end), where another order's balls could miss a
+    // measurement within it that this order makes.
+    if (m + rad < hi) stack.push_back({m + rad, hi, m});
+    if (m - rad > iv.a) stack.push_back({iv.a, m - rad, iv.witness});
+    return Measured::Clear;
   }
 
   // A verdict's covers of many items, in turns: each item's intervals on a stack of its own (cover's), one
@@ -513,23 +523,16 @@ struct MotionChecker::Sweep {
     while (!stack.empty() && !stop()) {
       const motion_detail::Scratch::Interval iv = stack.back();
       stack.pop_back();
-      const double hi = std::min(iv.b, limit);
-      if (iv.a > hi || (hit && iv.a >= hi)) continue;
-      const double m = measuringPoint(iv.a, hi);
-      const double d = measureItem(k, m, asked(k, std::max(m - iv.a, hi - m)), report);
-      if (d <= contactOf(k, m)) {
-        if (it.last > it.first) {
-          for (int member = it.first; member < it.last; ++member) queue(member, iv.a, hi, iv.witness);
-        } else {
-          found(m, report);
-          ctx.lead = it.group >= 0 ? it.group : k;
-          stack.clear();
-        }
-        return;
+      double m = 0.0, hi = 0.0;
+      const Measured measured = measureOnce(k, iv, stack, m, hi, report);
+      if (measured == Measured::Skipped) continue;
+      if (measured == Measured::Contact && it.last > it.first) {
+        for (int member = it.first; member < it.last; ++member) queue(member, iv.a, hi, iv.witness);
+      } else if (measured == Measured::Contact) {
+        found(m, report);
+        ctx.lead = it.group >= 0 ? it.group : k;
+        stack.clear();
       }
-      const double rad = reach(k, d, std::max(m - iv.a, hi - m));
-      if (m + rad < hi) stack.push_back({m + rad, hi, m});
-      if (m - rad > iv.a) stack.push_back({iv.a, m - rad, iv.witness});
       return;
     }
   }
