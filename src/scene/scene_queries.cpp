@@ -192,37 +192,39 @@ bool Scene::environmentFree(const Pose* poses, SceneScratch& ctx, CollisionRepor
     const auto slackOf = [&](double padding, const Vec3& center, double radius) {
       return env.linkSlack(padding, center.cwiseAbs().maxCoeff() + radius, options_.tolerances);
     };
-    const auto boxCleared = [&](int i) {
-      if (balls.ballCount(i) == 0) return false;
-      const EnclosingBalls::Placed bound = balls.placed(i, 0);
-      return boxes->ballClear(bound.center, bound.radius, slackOf(link_padding_[i], bound.center, bound.radius));
-    };
-    const auto cleared = [&](int i) {
-      const int n = balls.ballCount(i);
-      if (n == 0) return false;
-      const EnclosingBalls::Placed bound = balls.placed(i, 0);
+    // Link i's bounding ball (placed) cleared by the boxes, else by the grid; counted.
+    const auto boundCleared = [&](int i, const EnclosingBalls::Placed& bound) {
       const double slack = slackOf(link_padding_[i], bound.center, bound.radius);
-      if (grid->lowerBound(bound.center) > bound.radius + slack) return true;
+      if (boxes && boxes->ballClear(bound.center, bound.radius, slack)) {
+        ++ctx.counters.environment.box_clears;
+        return true;
+      }
+      if (grid && grid->lowerBound(bound.center) > bound.radius + slack) {
+        ++ctx.counters.environment.grid_clears;
+        return true;
+      }
+      return false;
+    };
+    // Link i's parts' balls cleared by the grid (the balls placed): their union holds the link where its
+    // bounding ball was not cleared.
+    const auto partsCleared = [&](int i) {
+      const int n = balls.ballCount(i);
       // (Not in Hull mode, where linkIntersects tests the hull, which the parts' balls need not hold. Nor for
       // closed meshes, which they hold only grown: on the shared robots, whose links are all closed, the
       // parts cleared too few links to pay for their look-ups, +3.8% instructions on box_panda's states.)
-      if (n == 1 || options_.mode != GeometryMode::Mesh || geometry_->link(i)->solidCount() > 0) return false;
+      if (!grid || n < 2 || options_.mode != GeometryMode::Mesh || geometry_->link(i)->solidCount() > 0) return false;
+      const EnclosingBalls::Placed bound = balls.placed(i, 0);
+      const double slack = slackOf(link_padding_[i], bound.center, bound.radius);
       for (int k = 1; k < n; ++k) {
         const EnclosingBalls::Placed part = balls.placed(i, k);
         if (!(grid->lowerBound(part.center) > part.radius + slack)) return false;
       }
+      ++ctx.counters.environment.grid_clears;
       return true;
     };
-    const auto hits = [&](int k) {
+    // Link k of env_links_ tested exactly (its balls did not clear it): true when it meets an obstacle.
+    const auto hitsExactly = [&](int k) {
       const int i = env_links_[k];
-      if (boxes && boxCleared(i)) {
-        ++ctx.counters.environment.box_clears;
-        return false;
-      }
-      if (grid && cleared(i)) {
-        ++ctx.counters.environment.grid_clears;
-        return false;
-      }
       EnvironmentHit hit;
       if (!environment_->linkIntersects(*geometry_->link(i), poses[i], options_.tolerances,
                                         {link_padding_[i], options_.mode},
@@ -233,6 +235,12 @@ bool Scene::environmentFree(const Pose* poses, SceneScratch& ctx, CollisionRepor
       r.hit = hit;
       ctx.env_last_hit = k;
       return true;
+    };
+    const auto hits = [&](int k) {
+      const int i = env_links_[k];
+      if (balls_placed && balls.ballCount(i) > 0 && (boundCleared(i, balls.placed(i, 0)) || partsCleared(i)))
+        return false;
+      return hitsExactly(k);
     };
     // A rigid body of several links: its one ball (which holds every member's bounding ball) cleared by the
     // boxes or the grid clears them all.
@@ -254,11 +262,19 @@ bool Scene::environmentFree(const Pose* poses, SceneScratch& ctx, CollisionRepor
     };
     // The link that met an obstacle last goes first: a planner's next state is near its last, and the links
     // before it in order would each be tested for nothing. Each link is still tested once at most.
+    // Its own bounding ball, placed alone, is asked of the boxes and the grid first, as every link's is: the
+    // lead stays the lead through the free states that follow a collision, and each would otherwise pay its
+    // exact test (box_panda's random free states: the lead's half of all their exact tests).
     const int n = static_cast<int>(env_links_.size());
     const int lead = ctx.env_last_hit >= 0 && ctx.env_last_hit < n ? ctx.env_last_hit : -1;
-    if (lead >= 0 && hits(lead)) return false;  // (before the balls are placed: it probably still collides)
     grid = env.hasMovingObstacles() ? nullptr : env.clearanceGrid();
     boxes = env.obstacleBoxes();
+    if (lead >= 0) {  // (before the balls are placed: it probably still collides)
+      const int i = env_links_[lead];
+      if (!((grid || boxes) && boundCleared(i, EnclosingBalls::boundOf(*geometry_->link(i), poses[i]))) &&
+          hitsExactly(lead))
+        return false;
+    }
     if ((grid || boxes) && !(balls_placed = ctx.balls.madeFor(*geometry_))) grid = nullptr, boxes = nullptr;
     if (balls_placed) ctx.balls.place(poses);
     for (const EnvBody& body : env_bodies_) {

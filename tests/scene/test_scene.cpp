@@ -846,6 +846,45 @@ TEST(Scene, TheLinkThatHitLastGoesFirstAndNoVerdictChanges) {
   std::printf("the lead changed the reported link on %d colliding states\n", changed);
 }
 
+// The link that hit last is asked first, and its own bounding ball is asked of the obstacles' boxes first as
+// every other link's is: a free state after a collision clears as many links by the boxes as a fresh
+// context's check of it, the lead included (before, the lead always took its exact test).
+TEST(Scene, TheLeadIsClearedByTheBoxesLikeEveryOtherLink) {
+  const auto scene = Scene::load(std::string(CLEARWAY_SOURCE_DIR) + "/robots/scenes/arm6_wall.yaml");
+  ASSERT_NE(scene->environment().obstacleBoxes(), nullptr);
+  std::mt19937 rng(41);
+  const int d = scene->dimension();
+  std::vector<double> hit(d), q(d);
+  const auto draw = [&](std::vector<double>& x) {
+    for (int i = 0; i < d; ++i)
+      x[i] = std::uniform_real_distribution<double>(std::max(scene->lower(i), -M_PI),
+                                                    std::min(scene->upper(i), M_PI))(rng);
+  };
+  int pairs = 0, lead_cleared = 0;
+  for (int attempt = 0; attempt < 4000 && pairs < 200; ++attempt) {
+    draw(hit);
+    SceneContext led = scene->makeContext();
+    CollisionReport why;
+    if (scene->isFree(hit.data(), led, &why) || why.kind != CollisionReport::Kind::Environment) continue;
+    draw(q);
+    SceneContext fresh = scene->makeContext();
+    CollisionReport fresh_why;
+    const bool free = scene->isFree(q.data(), fresh, &fresh_why);
+    if (!free) continue;
+    const long long clears = led.counters().environment.box_clears;
+    const long long exact = led.counters().environment.obstacle_tests;
+    ASSERT_TRUE(scene->isFree(q.data(), led)) << "state " << attempt;
+    EXPECT_EQ(led.counters().environment.box_clears - clears, fresh.counters().environment.box_clears)
+        << "state " << attempt << ": after " << scene->describe(why);
+    EXPECT_EQ(led.counters().environment.obstacle_tests - exact, fresh.counters().environment.obstacle_tests)
+        << "state " << attempt << ": after " << scene->describe(why);
+    ++pairs;
+    lead_cleared += fresh.counters().environment.box_clears > 0;
+  }
+  EXPECT_GE(pairs, 100) << "too few free states after a collision with an obstacle";
+  EXPECT_GT(lead_cleared, pairs / 2) << "the boxes cleared too few links to tell";
+}
+
 // Which shortcut of the environment a verdict test compares: the clearance grid, the obstacles' boxes, or
 // the map's voxels merged into blocks.
 enum class Shortcut { Grid, Boxes, Blocks };

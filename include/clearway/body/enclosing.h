@@ -102,9 +102,13 @@ class EnclosingBalls {
     Link& l = links_[i];
     if (k > 0 && l.parts_at != placement_) placeParts(i);
     const int at = l.first + k;
-    // (|t| ≤ |R·c + t| + |c| bounds the translation's norm.)
-    const double rounding = margins::placedRounding(local_norms_[at], local_norms_[at] + norms_[at]);
-    return {centers_[at], radii_[at] * (1.0 + margins::kRounding) + rounding};
+    return {centers_[at], grown(radii_[at], local_norms_[at], norms_[at])};
+  }
+  /// A link's bounding ball placed by `pose` on its own, as placed(i, 0) gives it after place(): for a
+  /// query that asks one link before it knows whether the others are needed.
+  static Placed boundOf(const LinkGeometry& link, const Pose& pose) noexcept {
+    const Vec3 center = pose * link.sphereCenter();
+    return {center, grown(link.sphereRadius(), link.sphereCenter().norm(), center.norm())};
   }
 
  private:
@@ -114,6 +118,11 @@ class EnclosingBalls {
     std::uint64_t parts_at = 0;  // the placement its parts' balls were placed at
   };
   void placeParts(int link) noexcept;
+  // A ball's radius grown by the rounding of its placed centre: `local_norm` the centre's norm in the link
+  // frame, `norm` its placed norm (|t| ≤ |R·c + t| + |c| bounds the translation's).
+  static double grown(double radius, double local_norm, double norm) noexcept {
+    return radius * (1.0 + margins::kRounding) + margins::placedRounding(local_norm, local_norm + norm);
+  }
   const Pose* poses_ = nullptr;  // as last placed
   std::uint64_t placement_ = 0;  // place() calls (the first is 1)
   const RobotGeometry* geometry_ = nullptr;
